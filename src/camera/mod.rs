@@ -1,0 +1,62 @@
+//! Cameras. Follow the course's convention: camera space has +x right, +y up and looks down +z;
+//! pixel `(col, row)` has row 0 at the top; image coordinates `(u, v)` in `[0, 1]^2` run right and
+//! down; the vertical extent is set by the field of view and the horizontal one by the aspect
+//! ratio `width / height`. Looking down +z with +y up, world -x is on the image's left.
+
+mod orthographic;
+mod perspective;
+
+pub use orthographic::Orthographic;
+pub use perspective::Perspective;
+
+use crate::geometry::Ray;
+use glam::Vec3A;
+
+/// The camera's orthonormal basis: `right x up` is `forward` in a left-handed sense, matching
+/// the course (right = up x forward).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Basis {
+    /// Unit viewing direction.
+    pub forward: Vec3A,
+    /// Unit image-right direction.
+    pub right: Vec3A,
+    /// Unit image-up direction.
+    pub up: Vec3A,
+}
+
+impl Basis {
+    /// The basis looking along `forward` with `up_hint` roughly up. Both must be non-zero and
+    /// not parallel (scene validation ensures it).
+    pub fn look(forward: Vec3A, up_hint: Vec3A) -> Self {
+        let forward = forward.normalize();
+        let right = up_hint.cross(forward).normalize();
+        let up = forward.cross(right);
+        Basis { forward, right, up }
+    }
+}
+
+/// A prepared camera (camera-relative: its position is the origin of the prepared scene).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Camera {
+    /// Pinhole perspective projection.
+    Perspective(Perspective),
+    /// Parallel projection.
+    Orthographic(Orthographic),
+}
+
+impl Camera {
+    /// The primary ray through image point `(u, v)`, both in `[0, 1]`, `(0, 0)` the top-left.
+    #[inline]
+    pub fn ray(&self, u: f32, v: f32) -> Ray {
+        match self {
+            Camera::Perspective(c) => c.ray(u, v),
+            Camera::Orthographic(c) => c.ray(u, v),
+        }
+    }
+}
+
+/// Map image coordinates to the image plane: `(2u - 1) * half_w` right, `(1 - 2v) * half_h` up.
+#[inline]
+pub(crate) fn plane_offset(b: &Basis, u: f32, v: f32, half_w: f32, half_h: f32) -> Vec3A {
+    (2.0 * u - 1.0) * half_w * b.right + (1.0 - 2.0 * v) * half_h * b.up
+}

@@ -1,0 +1,46 @@
+//! Subcommands of the `rtis` binary.
+
+mod check;
+mod render;
+
+use clap::{Parser, Subcommand};
+use rtis::scene::{self, Scene, SceneError};
+use std::path::{Path, PathBuf};
+
+/// rtis: a global-illumination ray tracer for learning, teaching and testing light transport.
+#[derive(Parser, Debug)]
+#[command(version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a scene to a PNG or EXR file.
+    Render(render::RenderArgs),
+    /// Validate a scene and print what it contains.
+    Check {
+        /// The scene file (RON).
+        scene: PathBuf,
+    },
+}
+
+/// Any error the CLI reports: already formatted for the user.
+pub type CliError = Box<dyn std::error::Error>;
+
+/// Run one subcommand.
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Render(args) => render::run(args),
+        Command::Check { scene } => check::run(&scene),
+    }
+}
+
+/// Load the scene at `path`, or the embedded Cornell box when there is none.
+pub fn load(path: Option<&Path>) -> Result<Scene, SceneError> {
+    match path {
+        Some(p) => scene::load_path(p),
+        None => Ok(scene::load_default()),
+    }
+}

@@ -1,0 +1,47 @@
+//! The closed set of materials. Each variant lives in its own file; [`Material`] dispatches by
+//! `match`.
+//!
+//! Directions follow pbrt's convention: `wo` points from the surface towards the viewer, `wi`
+//! from the surface towards the light; both are unit vectors; `n` is the unit normal on the
+//! side of `wo`.
+
+mod mirror;
+pub mod phong;
+mod transmissive;
+
+pub use mirror::Mirror;
+pub use phong::{Phong, reflect};
+pub use transmissive::{Refraction, Transmissive};
+
+use glam::Vec3A;
+
+/// A prepared material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Material {
+    /// Diffuse plus glossy reflection (the course's Phong model).
+    Phong(Phong),
+    /// Perfect specular reflection, tinted.
+    Mirror(Mirror),
+    /// Perfect specular refraction (Snell), tinted; total internal reflection when needed.
+    Transmissive(Transmissive),
+}
+
+impl Material {
+    /// The diffuse coefficient `kd` used by the ambient term (Eq. 2), if the material has one.
+    ///
+    /// Only Phong reflects light arriving from every direction, so only Phong answers; the
+    /// others answer `None` (the course's framework printed a warning and returned -1 instead).
+    #[inline]
+    pub fn diffuse_coefficient(&self) -> Option<Vec3A> {
+        match self {
+            Material::Phong(p) => Some(p.kd),
+            Material::Mirror(_) | Material::Transmissive(_) => None,
+        }
+    }
+
+    /// True for materials that only scatter into one direction (mirror, glass).
+    #[inline]
+    pub fn is_specular(&self) -> bool {
+        !matches!(self, Material::Phong(_))
+    }
+}

@@ -1,0 +1,190 @@
+//! The one place that reads the ECS world: it queries the components once and builds the flat,
+//! camera-relative, single-precision [`RenderScene`] that the per-ray code uses.
+//!
+//! Scene coordinates are doubles. Preparing subtracts the camera position (in double precision)
+//! before rounding to `f32`, so a scene far from the origin renders as precisely as one at it.
+
+use crate::accel::{Geometry, Prim};
+use crate::camera::{Basis, Camera, Orthographic, Perspective};
+use crate::light::{Light, PointLight};
+use crate::material::{Material, Mirror, Phong, Transmissive};
+use crate::scene::file::{CameraFields, Transfer};
+use crate::scene::{LightDesc, MaterialDesc, Model, Scene, ShapeDesc};
+use crate::shader::Shader;
+use crate::shape::{Plane, Shape, Sphere, Triangle};
+use glam::{DVec3, Vec3A};
+
+/// Image size, sampling and output transfer of a render.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Film {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// PNG transfer curve.
+    pub transfer: Transfer,
+}
+
+/// Everything a render needs, as flat arrays. Per-ray code reads only this.
+#[derive(Clone, Debug)]
+pub struct RenderScene {
+    /// The camera, at the origin of the prepared coordinates.
+    pub camera: Camera,
+    /// Primitives and their BVH.
+    pub geometry: Geometry,
+    /// Materials, indexed by [`Prim::material`].
+    pub materials: Vec<Material>,
+    /// Lights.
+    pub lights: Vec<Light>,
+    /// Radiance of escaped rays.
+    pub background: Vec3A,
+    /// The shader with its parameters.
+    pub shader: Shader,
+    /// Light-transport model.
+    pub model: Model,
+    /// Image settings.
+    pub film: Film,
+    /// Seed of the render's random numbers.
+    pub seed: u64,
+    /// World position of the prepared origin (the camera).
+    pub origin: DVec3,
+    /// Notes from preparing (ignored degenerate triangles...).
+    pub warnings: Vec<String>,
+}
+
+fn rgb(c: crate::scene::Rgb) -> Vec3A {
+    c.0.as_vec3a()
+}
+
+/// Convert a material description (never `Named` once loaded).
+pub fn material(m: &MaterialDesc) -> Material {
+    match m {
+        MaterialDesc::Phong { kd, ks, shininess } => Material::Phong(Phong {
+            kd: rgb(*kd),
+            ks: rgb(*ks),
+            shininess: shininess.0 as f32,
+        }),
+        MaterialDesc::Mirror { color } => Material::Mirror(Mirror { color: rgb(*color) }),
+        MaterialDesc::Transmissive { ior, color } => Material::Transmissive(Transmissive {
+            ior: ior.0 as f32,
+            color: rgb(*color),
+        }),
+        MaterialDesc::Named(n) => unreachable!("material \"{n}\" was resolved when loading"),
+    }
+}
+
+impl RenderScene {
+    /// Query the world once and build the render data.
+    pub fn prepare(scene: &Scene) -> RenderScene {
+        let s = &scene.settings;
+        let (position, look_at, up) = s.camera.0.frame();
+        let origin = position;
+        let rel = |p: DVec3| (p - origin).as_vec3a();
+        let basis = Basis::look((look_at - position).as_vec3a(), up.as_vec3a());
+        let aspect = s.film.width as f32 / s.film.height as f32;
+        let camera = match s.camera.0 {
+            CameraFields::Perspective { fov, .. } => Camera::Perspective(Perspective {
+                origin: Vec3A::ZERO,
+                basis,
+                tan_half_fov: (fov.0.to_radians() * 0.5).tan() as f32,
+                aspect,
+            }),
+            CameraFields::Orthographic { height, .. } => Camera::Orthographic(Orthographic {
+                origin: Vec3A::ZERO,
+                basis,
+                height: height.0 as f32,
+                aspect,
+            }),
+        };
+
+        let mut warnings = Vec::new();
+        let mut materials: Vec<Material> = Vec::new();
+        let mut prims = Vec::new();
+        for (entity, shape, mat, name) in scene
+            .world
+            .query::<(
+                hecs::Entity,
+                &ShapeDesc,
+                &MaterialDesc,
+                Option<&crate::scene::Name>,
+            )>()
+            .iter()
+        {
+            let m = material(mat);
+            let material = match materials.iter().position(|x| *x == m) {
+                Some(i) => i as u32,
+                None => {
+                    materials.push(m);
+                    (materials.len() - 1) as u32
+                }
+            };
+            let label = name.map_or_else(|| format!("entity {}", entity.id()), |n| n.0.clone());
+            let mut push = |shape| prims.push(Prim { shape, material });
+            match shape {
+                ShapeDesc::Sphere { center, radius } => push(Shape::Sphere(Sphere {
+                    c: rel(center.0),
+                    r: radius.0 as f32,
+                })),
+                ShapeDesc::InfinitePlane { point, normal } => push(Shape::Plane(Plane::through(
+                    rel(point.0),
+                    normal.0.normalize().as_vec3a(),
+                ))),
+                ShapeDesc::Triangle { a, b, c } => {
+                    match Triangle::new(rel(a.0), rel(b.0), rel(c.0)) {
+                        Some(t) => push(Shape::Triangle(t)),
+                        None => warnings.push(format!(
+                            "{label}: zero-area triangle ignored (it can never be hit)"
+                        )),
+                    }
+                }
+                ShapeDesc::TriangleMesh { vertices, faces } => {
+                    let mut dropped = 0;
+                    for &(i, j, k) in faces.iter() {
+                        let v = |i: u32| rel(vertices[i as usize].0);
+                        match Triangle::new(v(i), v(j), v(k)) {
+                            Some(t) => push(Shape::Triangle(t)),
+                            None => dropped += 1,
+                        }
+                    }
+                    if dropped > 0 {
+                        warnings.push(format!("{label}: {dropped} zero-area triangles ignored"));
+                    }
+                }
+            }
+        }
+        let lights = scene
+            .world
+            .query::<&LightDesc>()
+            .iter()
+            .map(|l| match l {
+                LightDesc::Point {
+                    position,
+                    intensity,
+                } => Light::Point(PointLight {
+                    position: rel(position.0),
+                    intensity: rgb(*intensity),
+                }),
+            })
+            .collect();
+        RenderScene {
+            camera,
+            geometry: Geometry::build(prims),
+            materials,
+            lights,
+            background: rgb(s.background),
+            shader: Shader::from_desc(&s.shader),
+            model: s.model,
+            film: Film {
+                width: s.film.width,
+                height: s.film.height,
+                spp: s.film.spp,
+                transfer: s.film.transfer,
+            },
+            seed: s.seed,
+            origin,
+            warnings,
+        }
+    }
+}

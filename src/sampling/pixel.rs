@@ -1,0 +1,76 @@
+//! Where inside a pixel each sample goes.
+
+use super::Sampler;
+
+/// The image-plane offset in `[0, 1)^2` of sample `i` of `spp` inside a pixel.
+///
+/// One sample goes through the pixel centre. A square count `m^2` jitters one sample in each
+/// cell of an `m x m` grid; any other count uses Latin-hypercube (n-rooks) strata, one row and
+/// one column of an `spp x spp` grid per sample, with the column order shuffled per pixel by
+/// `perm_seed` so the strata stay independent.
+#[inline]
+pub fn pixel_sample(i: u32, spp: u32, perm_seed: u64, rng: &mut Sampler) -> (f32, f32) {
+    if spp == 1 {
+        return (0.5, 0.5);
+    }
+    let (jx, jy) = rng.next_2d();
+    let m = (spp as f64).sqrt() as u32;
+    if m * m == spp {
+        let (cx, cy) = (i % m, i / m);
+        return ((cx as f32 + jx) / m as f32, (cy as f32 + jy) / m as f32);
+    }
+    let col = permute(i, spp, perm_seed);
+    ((col as f32 + jx) / spp as f32, (i as f32 + jy) / spp as f32)
+}
+
+/// A pseudo-random permutation of `0..n` evaluated at `i` (Kensler's hashed permutation,
+/// "Correlated Multi-Jittered Sampling", 2013), so no table is stored per pixel.
+fn permute(mut i: u32, n: u32, seed: u64) -> u32 {
+    let p = seed as u32;
+    let mut w = n - 1;
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
+    loop {
+        i ^= p;
+        i = i.wrapping_mul(0xe170893d);
+        i ^= p >> 16;
+        i ^= (i & w) >> 4;
+        i ^= p >> 8;
+        i = i.wrapping_mul(0x0929eb3f);
+        i ^= p >> 23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(1 | p >> 27);
+        i = i.wrapping_mul(0x6935fa69);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dcb303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e501cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860a3df);
+        i &= w;
+        i ^= i >> 5;
+        if i < n {
+            break;
+        }
+    }
+    (i + p) % n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn permute_is_a_permutation() {
+        for n in [2u32, 3, 5, 7, 10, 33] {
+            for seed in [0u64, 1, 12345] {
+                let mut seen: Vec<u32> = (0..n).map(|i| permute(i, n, seed)).collect();
+                seen.sort();
+                assert_eq!(seen, (0..n).collect::<Vec<_>>(), "n={n} seed={seed}");
+            }
+        }
+    }
+}

@@ -1,0 +1,109 @@
+//! Shading pieces shared by the Direct, Global and Path shaders: the local frame at a hit, the
+//! direct light from point lights (Eq. 3), the reflectance under each model, and the single
+//! scattered ray of a mirror or glass.
+
+use super::Tracer;
+use crate::geometry::{Hit, Ray, offset_origin};
+use crate::material::{Material, Phong};
+use crate::render::stats::RayKind;
+use crate::scene::Model;
+use glam::Vec3A;
+
+/// A hit seen from the ray that found it.
+#[derive(Clone, Copy, Debug)]
+pub struct Interaction {
+    /// The hit.
+    pub hit: Hit,
+    /// Unit direction back along the incoming ray (towards the viewer).
+    pub wo: Vec3A,
+    /// Unit normal on the side of `wo` (two-sided shading).
+    pub n: Vec3A,
+    /// The surface's material.
+    pub material: Material,
+}
+
+impl Interaction {
+    /// The interaction of `ray` with its nearest hit.
+    #[inline]
+    pub fn new(tr: &Tracer, ray: &Ray, hit: Hit) -> Self {
+        let wo = -ray.d;
+        let n = if hit.n.dot(wo) < 0.0 { -hit.n } else { hit.n };
+        let prim = tr.scene.geometry.prim(hit.prim);
+        Interaction {
+            hit,
+            wo,
+            n,
+            material: tr.scene.materials[prim.material as usize],
+        }
+    }
+
+    /// A ray leaving the surface in unit direction `w`, started off the surface on `w`'s side.
+    #[inline]
+    pub fn spawn(&self, w: Vec3A) -> Ray {
+        Ray::new(offset_origin(&self.hit, w), w)
+    }
+}
+
+/// The reflectance that weights incident radiance under `model`: the course's `r(wi, wo)`, or the
+/// BRDF times the cosine `f(wi, wo) (wi.n)` for the physically based model.
+#[inline]
+pub fn reflectance(model: Model, phong: &Phong, wi: Vec3A, wo: Vec3A, n: Vec3A) -> Vec3A {
+    match model {
+        Model::Course => phong.course_reflectance(wi, wo, n),
+        Model::Physical => phong.brdf(wi, wo, n) * wi.dot(n).max(0.0),
+    }
+}
+
+/// Eq. 3: `L_dir = sum_s L_i^s r(wi^s, wo) V^s` over the point lights. A light counts only when
+/// it is above the surface (`wi.n > 0`) and the shadow ray reaches it.
+#[inline]
+pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
+    let mut l_dir = Vec3A::ZERO;
+    let model = tr.scene.model;
+    for light in &tr.scene.lights {
+        let Some(inc) = light.incident(si.hit.p) else {
+            continue;
+        };
+        if inc.wi.dot(si.n) <= 0.0 {
+            continue;
+        }
+        // Shadow ray V^s: stop just short of the light, so that a surface the light sits on
+        // does not block it.
+        let shadow = Ray::segment(
+            offset_origin(&si.hit, inc.wi),
+            inc.wi,
+            inc.dist * SHADOW_END,
+        );
+        if tr.unoccluded(&shadow) {
+            l_dir += inc.li * reflectance(model, phong, inc.wi, si.wo, si.n);
+        }
+    }
+    l_dir
+}
+
+/// Shadow rays end at this fraction of the distance to the light.
+const SHADOW_END: f32 = 1.0 - 1e-4;
+
+/// The one ray a mirror or glass surface sends on, its tint, and its kind; `None` for Phong.
+///
+/// Mirrors reflect `wo` about the normal. Glass refracts with Snell's law (`eta = 1 / ior`
+/// entering, `ior` leaving) and reflects under total internal reflection.
+#[inline]
+pub fn specular_bounce(si: &Interaction) -> Option<(Ray, Vec3A, RayKind)> {
+    match si.material {
+        Material::Phong(_) => None,
+        Material::Mirror(m) => {
+            let wr = m.reflect(si.wo, si.n);
+            Some((si.spawn(wr), m.color, RayKind::Reflection))
+        }
+        Material::Transmissive(g) => {
+            let r = g.refract(si.wo, si.hit.n);
+            let kind = if r.total_internal_reflection {
+                RayKind::Reflection
+            } else {
+                RayKind::Refraction
+            };
+            Some((si.spawn(r.wt), g.color, kind))
+        }
+    }
+}

@@ -1,0 +1,104 @@
+//! Triangles with the watertight test of Woop, Benthin and Wald (JCGT 2013).
+
+use super::{Surface, point_error};
+use crate::geometry::{Aabb, Ray};
+use glam::Vec3A;
+
+/// A two-sided triangle with vertices `v0, v1, v2` and unit winding normal
+/// `n = normalize((v1 - v0) x (v2 - v0))`.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangle {
+    /// Vertices.
+    pub v: [Vec3A; 3],
+    /// Unit normal by winding order.
+    pub n: Vec3A,
+}
+
+impl Triangle {
+    /// The triangle with these vertices, or `None` if it has zero area (it would never be hit).
+    pub fn new(v0: Vec3A, v1: Vec3A, v2: Vec3A) -> Option<Self> {
+        let c = (v1 - v0).cross(v2 - v0);
+        let len = c.length();
+        (len > 0.0 && len.is_finite()).then(|| Triangle {
+            v: [v0, v1, v2],
+            n: c / len,
+        })
+    }
+
+    /// Distance to the triangle in `(0, t_max]`.
+    ///
+    /// Watertight: vertices are translated to the ray origin and sheared so the ray runs along
+    /// +z; the three 2D edge functions are exact negations across a shared edge, and an edge
+    /// function that is exactly zero is decided by a top-left rule, so a ray through an edge
+    /// shared by two triangles hits exactly one of them, and never falls through the crack.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<f32> {
+        let [kx, ky, kz] = ray.k;
+        let [sx, sy, sz] = ray.shear;
+        let a = self.v[0] - ray.o;
+        let b = self.v[1] - ray.o;
+        let c = self.v[2] - ray.o;
+        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            // Retry the edge functions in double precision, as the paper does.
+            let e = |px: f32, py: f32, qx: f32, qy: f32| {
+                (qx as f64 * py as f64 - qy as f64 * px as f64) as f32
+            };
+            u = e(bx, by, cx, cy);
+            v = e(cx, cy, ax, ay);
+            w = e(ax, ay, bx, by);
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        // On an edge (edge function exactly 0): keep the hit only for a top-left edge, judged in
+        // the triangle's own orientation so that the two owners of an edge disagree.
+        let s = det.signum();
+        let top_left = |px: f32, py: f32, qx: f32, qy: f32| {
+            let (ex, ey) = (s * (qx - px), s * (qy - py));
+            ey > 0.0 || (ey == 0.0 && ex < 0.0)
+        };
+        if (u == 0.0 && !top_left(bx, by, cx, cy))
+            || (v == 0.0 && !top_left(cx, cy, ax, ay))
+            || (w == 0.0 && !top_left(ax, ay, bx, by))
+        {
+            return None;
+        }
+        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
+        let t_scaled = u * az + v * bz + w * cz;
+        let t = t_scaled / det;
+        (t > 0.0 && t <= ray.t_max).then_some(t)
+    }
+
+    /// Hit point projected onto the triangle's plane, the winding normal, error bound.
+    #[inline]
+    pub fn surface(&self, ray: &Ray, t: f32) -> Surface {
+        let p = ray.at(t);
+        let p = p - self.n.dot(p - self.v[0]) * self.n;
+        let scale = self.v[0]
+            .abs()
+            .max(self.v[1].abs())
+            .max(self.v[2].abs())
+            .max(p.abs())
+            .max_element();
+        Surface {
+            p,
+            n: self.n,
+            err: point_error(scale),
+        }
+    }
+
+    /// Bounding box.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::EMPTY.grow(self.v[0]).grow(self.v[1]).grow(self.v[2])
+    }
+}
