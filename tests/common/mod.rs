@@ -1,0 +1,33 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use glam::Vec3A;
+use rtis::render::Rendered;
+use rtis::scene::{self, Scene};
+use rtis::{RenderScene, render};
+use std::path::{Path, PathBuf};
+
+/// The repository's `scenes/` folder.
+pub fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
+
+/// Parse a scene from text (panics with the located error on failure).
+pub fn scene(text: &str) -> Scene {
+    scene::load_str(text, "test.ron", Some(&scenes_dir())).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Prepare and render a loaded scene on the global pool.
+pub fn render_scene(s: &Scene) -> Rendered {
+    render(&RenderScene::prepare(s), &|| {})
+}
+
+/// Parse and render scene text.
+pub fn render_str(text: &str) -> Rendered {
+    render_scene(&scene(text))
+}
+
+/// Relative closeness of two colours.
+pub fn close(a: Vec3A, b: Vec3A, rel: f32) -> bool {
+    (a - b).abs().max_element() <= rel * b.abs().max_element().max(1e-6)
+}
