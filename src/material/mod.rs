@@ -11,7 +11,7 @@ mod transmissive;
 
 pub use mirror::Mirror;
 pub use phong::{Phong, reflect};
-pub use transmissive::{Refraction, Transmissive};
+pub use transmissive::{Refraction, Transmissive, fresnel_dielectric};
 
 use glam::Vec3A;
 

@@ -24,7 +24,7 @@ impl Sampler {
     pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
         let state = mix(mix(mix(seed) ^ pixel) ^ sample.rotate_left(32));
         Sampler {
-            rng: Pcg32::new(state, 0xa02b_dbf7_bb3c_0a7),
+            rng: Pcg32::new(state, 0x0a02_bdbf_7bb3_c0a7),
         }
     }
 

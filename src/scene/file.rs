@@ -1,7 +1,7 @@
 //! The scene file format: serde structs read from RON. Every struct rejects unknown fields;
 //! every optional field documents its default. `docs/scene-format.md` is the user's guide.
 
-use super::values::{Count, Direction, Fov, NonNegative, Point, Positive, Rgb};
+use super::values::{Count, Direction, Fov, NonNegative, Point, Positive, Rgb, UpTo};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -298,7 +298,7 @@ pub enum ShaderDesc {
         samples: Count<MAX_GLOBAL_SAMPLES>,
         /// Phong hits before the ambient term takes over, `D` (default 3).
         #[serde(default = "global_depth")]
-        max_depth: u32,
+        max_depth: UpTo<MAX_GLOBAL_DEPTH>,
         /// Ambient radiance `a_t` (default `(0.3, 0.3, 0.3)`).
         #[serde(default = "ambient")]
         ambient: Rgb,
@@ -317,8 +317,8 @@ fn max_specular() -> u32 {
 fn global_samples() -> Count<MAX_GLOBAL_SAMPLES> {
     Count(64)
 }
-fn global_depth() -> u32 {
-    3
+fn global_depth() -> UpTo<MAX_GLOBAL_DEPTH> {
+    UpTo(3)
 }
 fn ambient() -> Rgb {
     Rgb::grey(0.3)

@@ -33,7 +33,8 @@ fn parse(src: &Source) -> Result<SceneFile, SceneError> {
 /// Load the scene file at `path`.
 pub fn load_path(path: &Path) -> Result<Scene, SceneError> {
     let src = read(path)?;
-    resolve(src, &mut Vec::new()).and_then(|r| r.into_scene(path.display().to_string()))
+    let mut chain: Vec<PathBuf> = path.canonicalize().into_iter().collect();
+    resolve(src, &mut chain).and_then(|r| r.into_scene(path.display().to_string()))
 }
 
 /// Load a scene from text; `name` labels errors and `dir` resolves `extends` (the current folder

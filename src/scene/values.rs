@@ -178,3 +178,24 @@ impl<const MAX: u32> From<Count<MAX>> for u32 {
         c.0
     }
 }
+
+/// A whole number from 0 to `MAX` (depths).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(try_from = "u64", into = "u32")]
+pub struct UpTo<const MAX: u32>(pub u32);
+
+impl<const MAX: u32> TryFrom<u64> for UpTo<MAX> {
+    type Error = String;
+    fn try_from(v: u64) -> Result<Self, String> {
+        if v > MAX as u64 {
+            Err(format!("must be at most {MAX}, got {v}"))
+        } else {
+            Ok(UpTo(v as u32))
+        }
+    }
+}
+impl<const MAX: u32> From<UpTo<MAX>> for u32 {
+    fn from(c: UpTo<MAX>) -> Self {
+        c.0
+    }
+}

@@ -68,7 +68,7 @@ impl Shader {
                 max_specular,
             } => Shader::Global(Global {
                 samples: samples.0,
-                max_depth,
+                max_depth: max_depth.0,
                 ambient: ambient.0.as_vec3a(),
                 max_specular,
             }),

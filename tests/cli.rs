@@ -1,0 +1,120 @@
+//! The command line: renders, checks, and fails cleanly (message, location, non-zero exit, no
+//! panic, no half-written file).
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn rtis(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rtis"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run rtis")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rtis-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn render_default_scene_writes_png_and_summary() {
+    let d = tmp("default");
+    let out = d.join("cornell.png");
+    let o = rtis(&["render", "--width", "40", "--height", "32", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap();
+    assert_eq!((img.width(), img.height()), (40, 32));
+    let e = stderr(&o);
+    assert!(e.contains("Mrays/s") && e.contains("rays (camera 1280"), "{e}");
+    // Nothing but the image is left in the folder (the temporary file was renamed).
+    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn render_exr_and_stats_json() {
+    let d = tmp("exr");
+    let (out, stats) = (d.join("s.exr"), d.join("s.json"));
+    let o = rtis(&[
+        "render", "scenes/spheres.ron", "--width", "24", "--height", "16", "--spp", "4",
+        "-o", out.to_str().unwrap(), "--stats", stats.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().to_rgb32f();
+    assert_eq!(img.dimensions(), (24, 16));
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(json["rays"]["camera"], 24 * 16 * 4);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn same_image_for_any_thread_count() {
+    let d = tmp("threads");
+    let mut bytes = Vec::new();
+    for t in ["1", "2", "3"] {
+        let out = d.join(format!("t{t}.exr"));
+        let o = rtis(&[
+            "render", "scenes/cornell-n-bounce.ron", "--width", "36", "--height", "29",
+            "--spp", "2", "--threads", t, "-o", out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        bytes.push(std::fs::read(&out).unwrap());
+    }
+    assert!(bytes.windows(2).all(|w| w[0] == w[1]), "images differ between thread counts");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn check_prints_contents() {
+    let o = rtis(&["check", "scenes/cornell.ron"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(s.contains("5 x InfinitePlane") && s.contains("3 x Sphere") && s.contains("lights      3"), "{s}");
+}
+
+#[test]
+fn broken_scene_is_located_with_nonzero_exit() {
+    let d = tmp("broken");
+    let f = d.join("broken.ron");
+    std::fs::write(&f, "Scene(\n  entities: [\n    (shape: Sphere(center: (0, 0, 5), radius: -1), material: Mirror()),\n  ],\n)\n").unwrap();
+    for cmd in ["check", "render"] {
+        let o = rtis(&[cmd, f.to_str().unwrap(), "-o", d.join("x.png").to_str().unwrap()][..if cmd == "check" { 2 } else { 4 }]);
+        assert_eq!(o.status.code(), Some(1));
+        let e = stderr(&o);
+        assert!(e.contains("broken.ron:3:47: must be a finite number greater than 0, got -1"), "{e}");
+        assert!(!e.contains("panicked"), "{e}");
+    }
+    assert!(!d.join("x.png").exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn unwritable_or_unknown_output_fails_before_rendering() {
+    let o = rtis(&["render", "-o", "/nonexistent-dir/x.png"]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("/nonexistent-dir/x.png: cannot write output"), "{e}");
+    assert!(!e.contains("panicked") && !e.contains("Mrays"), "{e}");
+    let o = rtis(&["render", "-o", "x.bmp"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("unsupported output format"));
+    let o = rtis(&["render", "--width", "0"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("must be at least 1"), "{}", stderr(&o));
+    let o = rtis(&["check", "no/such/scene.ron"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("cannot read scene file"));
+}
+
+#[test]
+fn embedded_default_scene_equals_scenes_cornell() {
+    assert_eq!(rtis::scene::DEFAULT_SCENE, std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron")).unwrap());
+    let _ = rtis::scene::load_default();
+}
