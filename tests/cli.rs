@@ -26,12 +26,23 @@ fn stderr(o: &Output) -> String {
 fn render_default_scene_writes_png_and_summary() {
     let d = tmp("default");
     let out = d.join("cornell.png");
-    let o = rtis(&["render", "--width", "40", "--height", "32", "-o", out.to_str().unwrap()]);
+    let o = rtis(&[
+        "render",
+        "--width",
+        "40",
+        "--height",
+        "32",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let img = image::open(&out).unwrap();
     assert_eq!((img.width(), img.height()), (40, 32));
     let e = stderr(&o);
-    assert!(e.contains("Mrays/s") && e.contains("rays (camera 1280"), "{e}");
+    assert!(
+        e.contains("Mrays/s") && e.contains("rays (camera 1280"),
+        "{e}"
+    );
     // Nothing but the image is left in the folder (the temporary file was renamed).
     assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
     std::fs::remove_dir_all(&d).unwrap();
@@ -42,8 +53,18 @@ fn render_exr_and_stats_json() {
     let d = tmp("exr");
     let (out, stats) = (d.join("s.exr"), d.join("s.json"));
     let o = rtis(&[
-        "render", "scenes/spheres.ron", "--width", "24", "--height", "16", "--spp", "4",
-        "-o", out.to_str().unwrap(), "--stats", stats.to_str().unwrap(),
+        "render",
+        "scenes/spheres.ron",
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--spp",
+        "4",
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let img = image::open(&out).unwrap().to_rgb32f();
@@ -60,13 +81,26 @@ fn same_image_for_any_thread_count() {
     for t in ["1", "2", "3"] {
         let out = d.join(format!("t{t}.exr"));
         let o = rtis(&[
-            "render", "scenes/cornell-n-bounce.ron", "--width", "36", "--height", "29",
-            "--spp", "2", "--threads", t, "-o", out.to_str().unwrap(),
+            "render",
+            "scenes/cornell-n-bounce.ron",
+            "--width",
+            "36",
+            "--height",
+            "29",
+            "--spp",
+            "2",
+            "--threads",
+            t,
+            "-o",
+            out.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         bytes.push(std::fs::read(&out).unwrap());
     }
-    assert!(bytes.windows(2).all(|w| w[0] == w[1]), "images differ between thread counts");
+    assert!(
+        bytes.windows(2).all(|w| w[0] == w[1]),
+        "images differ between thread counts"
+    );
     std::fs::remove_dir_all(&d).unwrap();
 }
 
@@ -75,7 +109,10 @@ fn check_prints_contents() {
     let o = rtis(&["check", "scenes/cornell.ron"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let s = String::from_utf8_lossy(&o.stdout);
-    assert!(s.contains("5 x InfinitePlane") && s.contains("3 x Sphere") && s.contains("lights      3"), "{s}");
+    assert!(
+        s.contains("5 x InfinitePlane") && s.contains("3 x Sphere") && s.contains("lights      3"),
+        "{s}"
+    );
 }
 
 #[test]
@@ -84,10 +121,20 @@ fn broken_scene_is_located_with_nonzero_exit() {
     let f = d.join("broken.ron");
     std::fs::write(&f, "Scene(\n  entities: [\n    (shape: Sphere(center: (0, 0, 5), radius: -1), material: Mirror()),\n  ],\n)\n").unwrap();
     for cmd in ["check", "render"] {
-        let o = rtis(&[cmd, f.to_str().unwrap(), "-o", d.join("x.png").to_str().unwrap()][..if cmd == "check" { 2 } else { 4 }]);
+        let o = rtis(
+            &[
+                cmd,
+                f.to_str().unwrap(),
+                "-o",
+                d.join("x.png").to_str().unwrap(),
+            ][..if cmd == "check" { 2 } else { 4 }],
+        );
         assert_eq!(o.status.code(), Some(1));
         let e = stderr(&o);
-        assert!(e.contains("broken.ron:3:47: must be a finite number greater than 0, got -1"), "{e}");
+        assert!(
+            e.contains("broken.ron:3:47: must be a finite number greater than 0, got -1"),
+            "{e}"
+        );
         assert!(!e.contains("panicked"), "{e}");
     }
     assert!(!d.join("x.png").exists());
@@ -99,7 +146,10 @@ fn unwritable_or_unknown_output_fails_before_rendering() {
     let o = rtis(&["render", "-o", "/nonexistent-dir/x.png"]);
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
-    assert!(e.contains("/nonexistent-dir/x.png: cannot write output"), "{e}");
+    assert!(
+        e.contains("/nonexistent-dir/x.png: cannot write output"),
+        "{e}"
+    );
     assert!(!e.contains("panicked") && !e.contains("Mrays"), "{e}");
     let o = rtis(&["render", "-o", "x.bmp"]);
     assert_eq!(o.status.code(), Some(1));
@@ -114,7 +164,12 @@ fn unwritable_or_unknown_output_fails_before_rendering() {
 
 #[test]
 fn embedded_default_scene_equals_scenes_cornell() {
-    assert_eq!(rtis::scene::DEFAULT_SCENE, std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron")).unwrap());
+    assert_eq!(
+        rtis::scene::DEFAULT_SCENE,
+        std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron")
+        )
+        .unwrap()
+    );
     let _ = rtis::scene::load_default();
 }

@@ -86,7 +86,9 @@ fn golden_scenes() {
             size: (w, h),
             spp: scene.settings.film.spp,
             shader: match scene.settings.shader {
-                ShaderDesc::Global { samples, max_depth, .. } => {
+                ShaderDesc::Global {
+                    samples, max_depth, ..
+                } => {
                     format!("Global(samples: {}, max_depth: {})", samples.0, max_depth.0)
                 }
                 s => format!("{s:?}"),
@@ -98,7 +100,8 @@ fn golden_scenes() {
         // Keep the picture beside the snapshot, rewritten only when it changes.
         let png = snap_dir.join(format!("{name}.png"));
         let mut encoded = std::io::Cursor::new(Vec::new());
-        rgb8.write_to(&mut encoded, image::ImageFormat::Png).unwrap();
+        rgb8.write_to(&mut encoded, image::ImageFormat::Png)
+            .unwrap();
         if std::fs::read(&png).ok().as_deref() != Some(encoded.get_ref().as_slice()) {
             std::fs::write(&png, encoded.get_ref()).unwrap();
         }

@@ -15,39 +15,108 @@ const CASES: &[(&str, &str)] = &[
     ("malformed RON", "Scene(film: (width: 10,, height: 10))"),
     ("unknown field", "Scene(film: (width: 10, hieght: 10))"),
     ("unknown top-level field", "Scene(lights: [])"),
-    ("unknown shape", "Scene(entities: [(shape: Cube(size: 1), material: Mirror())])"),
+    (
+        "unknown shape",
+        "Scene(entities: [(shape: Cube(size: 1), material: Mirror())])",
+    ),
     (
         "unknown material name",
         "Scene(\n  materials: { \"red\": Phong(kd: (1, 0, 0)), \"blue\": Phong(kd: (0, 0, 1)) },\n  entities: [\n    (shape: Sphere(center: (0, 0, 5), radius: 1), material: Named(\"green\")),\n  ],\n)",
     ),
-    ("non-finite number", "Scene(entities: [(shape: Sphere(center: (0, inf, 5), radius: 1), material: Mirror())])"),
+    (
+        "non-finite number",
+        "Scene(entities: [(shape: Sphere(center: (0, inf, 5), radius: 1), material: Mirror())])",
+    ),
     ("NaN", "Scene(background: (NaN, 0, 0))"),
-    ("radius zero", "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 0), material: Mirror())])"),
-    ("radius negative", "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: -2), material: Mirror())])"),
-    ("zero-length normal", "Scene(entities: [(shape: InfinitePlane(point: (0, 0, 0), normal: (0, 0, 0)), material: Mirror())])"),
-    ("zero-length up", "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), up: (0, 0, 0)))"),
-    ("look_at equals position", "Scene(camera: Perspective(position: (1, 2, 3), look_at: (1, 2, 3)))"),
-    ("up parallel to view", "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 5, 0), up: (0, 1, 0)))"),
-    ("fov 0", "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), fov: 0))"),
-    ("fov 180", "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), fov: 180))"),
-    ("orthographic height 0", "Scene(camera: Orthographic(position: (0, 0, 0), look_at: (0, 0, 1), height: 0))"),
+    (
+        "radius zero",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 0), material: Mirror())])",
+    ),
+    (
+        "radius negative",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: -2), material: Mirror())])",
+    ),
+    (
+        "zero-length normal",
+        "Scene(entities: [(shape: InfinitePlane(point: (0, 0, 0), normal: (0, 0, 0)), material: Mirror())])",
+    ),
+    (
+        "zero-length up",
+        "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), up: (0, 0, 0)))",
+    ),
+    (
+        "look_at equals position",
+        "Scene(camera: Perspective(position: (1, 2, 3), look_at: (1, 2, 3)))",
+    ),
+    (
+        "up parallel to view",
+        "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 5, 0), up: (0, 1, 0)))",
+    ),
+    (
+        "fov 0",
+        "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), fov: 0))",
+    ),
+    (
+        "fov 180",
+        "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), fov: 180))",
+    ),
+    (
+        "orthographic height 0",
+        "Scene(camera: Orthographic(position: (0, 0, 0), look_at: (0, 0, 1), height: 0))",
+    ),
     ("zero film width", "Scene(film: (width: 0, height: 10))"),
-    ("absurd film size", "Scene(film: (width: 30000, height: 30000))"),
-    ("film side too large", "Scene(film: (width: 100000, height: 1))"),
+    (
+        "absurd film size",
+        "Scene(film: (width: 30000, height: 30000))",
+    ),
+    (
+        "film side too large",
+        "Scene(film: (width: 100000, height: 1))",
+    ),
     ("samples 0", "Scene(film: (spp: 0))"),
     ("global samples 0", "Scene(shader: Global(samples: 0))"),
-    ("ior zero", "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Transmissive(ior: 0))])"),
-    ("ior negative", "Scene(materials: { \"glass\": Transmissive(ior: -1.5) })"),
-    ("negative colour", "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Phong(kd: (0.5, -0.1, 0)))])"),
-    ("negative intensity", "Scene(entities: [(light: Point(position: (0, 2, 0), intensity: (7, -7, 7)))])"),
-    ("shape without material", "Scene(entities: [(name: \"ball\", shape: Sphere(center: (0, 0, 5), radius: 1))])"),
-    ("material without shape", "Scene(entities: [(material: Mirror())])"),
+    (
+        "ior zero",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Transmissive(ior: 0))])",
+    ),
+    (
+        "ior negative",
+        "Scene(materials: { \"glass\": Transmissive(ior: -1.5) })",
+    ),
+    (
+        "negative colour",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Phong(kd: (0.5, -0.1, 0)))])",
+    ),
+    (
+        "negative intensity",
+        "Scene(entities: [(light: Point(position: (0, 2, 0), intensity: (7, -7, 7)))])",
+    ),
+    (
+        "shape without material",
+        "Scene(entities: [(name: \"ball\", shape: Sphere(center: (0, 0, 5), radius: 1))])",
+    ),
+    (
+        "material without shape",
+        "Scene(entities: [(material: Mirror())])",
+    ),
     ("empty entity", "Scene(entities: [()])"),
-    ("mesh index out of range", "Scene(entities: [(shape: TriangleMesh(vertices: [(0, 0, 0), (1, 0, 0), (0, 1, 0)], faces: [(0, 1, 3)]), material: Mirror())])"),
-    ("named material in table", "Scene(materials: { \"a\": Named(\"b\") })"),
+    (
+        "mesh index out of range",
+        "Scene(entities: [(shape: TriangleMesh(vertices: [(0, 0, 0), (1, 0, 0), (0, 1, 0)], faces: [(0, 1, 3)]), material: Mirror())])",
+    ),
+    (
+        "named material in table",
+        "Scene(materials: { \"a\": Named(\"b\") })",
+    ),
     ("missing base scene", "Scene(extends: \"no-such-file.ron\")"),
-    ("negative shininess", "Scene(materials: { \"p\": Phong(kd: (1, 1, 1), shininess: -3) })"),
-    ("global depth too large", "Scene(shader: Global(max_depth: 17))"),
+    (
+        "negative shininess",
+        "Scene(materials: { \"p\": Phong(kd: (1, 1, 1), shininess: -3) })",
+    ),
+    (
+        "global depth too large",
+        "Scene(shader: Global(max_depth: 17))",
+    ),
 ];
 
 #[test]
@@ -70,7 +139,10 @@ fn every_invalid_input_has_its_located_message() {
 fn unknown_material_lists_the_known_ones_with_its_position() {
     let e = error_of(CASES[4].1);
     assert_eq!(e.at, Some((4, 67)));
-    assert!(e.message.contains("\"green\"") && e.message.contains("\"blue\", \"red\""), "{e}");
+    assert!(
+        e.message.contains("\"green\"") && e.message.contains("\"blue\", \"red\""),
+        "{e}"
+    );
 }
 
 #[test]
@@ -100,7 +172,10 @@ fn extends_overrides_and_merges() {
     )
     .unwrap();
     assert_eq!(s.settings.film.width, 10);
-    assert!(matches!(s.settings.shader, rtis::scene::ShaderDesc::Direct { .. }));
+    assert!(matches!(
+        s.settings.shader,
+        rtis::scene::ShaderDesc::Direct { .. }
+    ));
     assert_eq!(s.world.len(), 12);
     let mirrors: Vec<_> = s
         .world
