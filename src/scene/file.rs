@@ -15,10 +15,13 @@ pub const MAX_SPP: u32 = 1 << 20;
 pub const MAX_GLOBAL_SAMPLES: u32 = 1 << 16;
 /// Largest `max_depth` of the Global shader: its rays grow as `n * 2^(D-1)` per pixel.
 pub const MAX_GLOBAL_DEPTH: u32 = 16;
+/// Largest `max_depth` of the Path shader.
+pub const MAX_PATH_DEPTH: u32 = 1024;
 
 /// One scene file as written. Every field is optional: a file that `extends` a base scene
 /// overrides the base's film, camera, shader, background, seed and model, adds or replaces
-/// materials by name, and appends its entities.
+/// materials by name, replaces the base's entities that have the same `name`, and appends the
+/// others.
 #[derive(Clone, Debug, Default, Deserialize, Serialize)]
 #[serde(rename = "Scene", deny_unknown_fields)]
 pub struct SceneFile {
@@ -306,6 +309,22 @@ pub enum ShaderDesc {
         #[serde(default = "max_specular")]
         max_specular: u32,
     },
+    /// The reference path tracer under the scene's `model`.
+    Path {
+        /// Largest number of bounces of any kind (default: none, Russian roulette ends paths).
+        #[serde(default)]
+        max_depth: Option<UpTo<MAX_PATH_DEPTH>>,
+        /// Bounces before Russian roulette starts (default 5).
+        #[serde(default = "rr_depth")]
+        rr_depth: u32,
+        /// Direction sampling at Phong vertices: `Uniform`, `Cosine` or `Brdf` (default).
+        #[serde(default)]
+        sampling: crate::shader::Sampling,
+    },
+}
+
+fn rr_depth() -> u32 {
+    5
 }
 
 fn white() -> Rgb {

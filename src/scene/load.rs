@@ -127,12 +127,18 @@ fn resolve(src: Source, chain: &mut Vec<PathBuf>) -> Result<Resolved, SceneError
     for (name, m) in file.materials.unwrap_or_default() {
         base.materials.insert(name, (m, idx));
     }
-    base.entities.extend(
-        file.entities
-            .unwrap_or_default()
-            .into_iter()
-            .map(|e| (e, idx)),
-    );
+    // An entity named like one of the base's replaces it in place; others are appended.
+    for e in file.entities.unwrap_or_default() {
+        let slot = e.0.name.as_ref().and_then(|n| {
+            base.entities
+                .iter()
+                .position(|(b, _)| b.0.name.as_ref() == Some(n))
+        });
+        match slot {
+            Some(i) => base.entities[i] = (e, idx),
+            None => base.entities.push((e, idx)),
+        }
+    }
     base.sources.push(src);
     Ok(base)
 }

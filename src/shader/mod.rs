@@ -8,9 +8,11 @@ mod direct;
 pub mod global;
 mod intersection;
 mod normal;
+pub mod path;
 pub mod surface;
 
 pub use global::Global;
+pub use path::{Path, Sampling};
 
 use crate::geometry::{Hit, Ray};
 use crate::prepare::RenderScene;
@@ -43,6 +45,8 @@ pub enum Shader {
     },
     /// The assignment's global shader (Eq. 1-4).
     Global(Global),
+    /// The reference path tracer.
+    Path(Path),
 }
 
 impl Shader {
@@ -71,6 +75,15 @@ impl Shader {
                 max_depth: max_depth.0,
                 ambient: ambient.0.as_vec3a(),
                 max_specular,
+            }),
+            ShaderDesc::Path {
+                max_depth,
+                rr_depth,
+                sampling,
+            } => Shader::Path(Path {
+                max_depth: max_depth.map(|d| d.0),
+                rr_depth,
+                sampling,
             }),
         }
     }
@@ -114,5 +127,6 @@ pub fn radiance(tr: &mut Tracer, ray: &Ray) -> Vec3A {
         Shader::Normal => normal::radiance(tr, ray),
         Shader::Direct { max_specular } => direct::radiance(tr, ray, max_specular),
         Shader::Global(g) => global::radiance(tr, ray, &g),
+        Shader::Path(p) => path::radiance(tr, ray, &p),
     }
 }
