@@ -8,6 +8,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod converge;
 pub mod geometry;
 pub mod light;
 pub mod material;

@@ -1,6 +1,8 @@
 //! Subcommands of the `rtis` binary.
 
+mod bench;
 mod check;
+mod converge;
 mod render;
 
 use clap::{Parser, Subcommand};
@@ -24,6 +26,10 @@ enum Command {
         /// The scene file (RON).
         scene: PathBuf,
     },
+    /// Measure error against time for a ladder of shader settings (CSV, table, plot).
+    Converge(converge::ConvergeArgs),
+    /// Print speed figures (seconds, Mrays/s, peak memory) for the course's Cornell box.
+    Bench(bench::BenchArgs),
 }
 
 /// Any error the CLI reports: already formatted for the user.
@@ -34,6 +40,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Render(args) => render::run(args),
         Command::Check { scene } => check::run(&scene),
+        Command::Converge(args) => converge::run(args),
+        Command::Bench(args) => bench::run(args),
     }
 }
 

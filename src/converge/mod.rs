@@ -1,0 +1,209 @@
+//! What accuracy costs in time: sweep a ladder of shader settings on one scene, time each render
+//! and measure its error against a reference image.
+
+pub mod metrics;
+pub mod plot;
+
+use crate::prepare::RenderScene;
+use crate::render::{film::Image, render};
+use crate::scene::Model;
+use crate::shader::{Global, Path, Sampling, Shader};
+use std::fmt::Write as _;
+
+/// One setting of the ladder.
+#[derive(Clone, Debug)]
+pub struct Rung {
+    /// The family the curve belongs to (`Direct`, `Global D=2`, `Path`...).
+    pub family: String,
+    /// Short label of the setting (`n=16`, `spp=64`...).
+    pub label: String,
+    /// The shader to render with.
+    pub shader: Shader,
+    /// Samples per pixel.
+    pub spp: u32,
+}
+
+/// The result of one rung.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Row {
+    /// Curve family.
+    pub family: String,
+    /// Setting.
+    pub label: String,
+    /// Median render seconds over the runs.
+    pub seconds: f64,
+    /// Rays traced by one render.
+    pub rays: u64,
+    /// Root mean squared error against the reference (linear RGB, all channels).
+    pub rmse: f64,
+    /// Relative MSE: mean of `(x - r)^2 / (r^2 + 0.01)`.
+    pub rel_mse: f64,
+}
+
+/// The reference integrator for a scene: an unbounded path tracer under the scene's model.
+pub fn reference_shader() -> Shader {
+    Shader::Path(Path {
+        max_depth: None,
+        rr_depth: 5,
+        sampling: Sampling::Brdf,
+    })
+}
+
+/// The ladder for the scene's shader. Course-family shaders (Direct, Global) get the cheapest
+/// rungs first (Direct, then the ambient-only Global), then Global for n in {4, 16, 64} and
+/// D in {1, 2, 3}, then the Path tracer of the same model at growing spp (the unbiased curve the
+/// Global shader approximates). A Path scene gets spp and max-depth ladders.
+pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
+    let mut rungs = Vec::new();
+    let rung = |family: &str, label: String, shader, spp| Rung {
+        family: family.into(),
+        label,
+        shader,
+        spp,
+    };
+    match scene.shader {
+        Shader::Path(p) => {
+            for spp in [1, 4, 16, 64, 256] {
+                rungs.push(rung("Path", format!("spp={spp}"), Shader::Path(p), spp));
+            }
+            for d in [1, 2, 3, 5] {
+                let shader = Shader::Path(Path {
+                    max_depth: Some(d),
+                    ..p
+                });
+                rungs.push(rung("Path 16 spp", format!("depth={d}"), shader, 16));
+            }
+        }
+        other => {
+            let (ambient, max_specular) = match other {
+                Shader::Global(g) => (g.ambient, g.max_specular),
+                _ => (glam::Vec3A::splat(0.3), 32),
+            };
+            rungs.push(rung(
+                "Direct",
+                "direct".into(),
+                Shader::Direct { max_specular },
+                1,
+            ));
+            let global = |samples, max_depth| {
+                Shader::Global(Global {
+                    samples,
+                    max_depth,
+                    ambient,
+                    max_specular,
+                })
+            };
+            rungs.push(rung("Ambient (D=0)", "D=0".into(), global(1, 0), 1));
+            for d in [1, 2, 3] {
+                for n in [4, 16, 64] {
+                    rungs.push(rung(
+                        &format!("Global D={d}"),
+                        format!("n={n}"),
+                        global(n, d),
+                        1,
+                    ));
+                }
+            }
+            for spp in [1, 4, 16, 64] {
+                rungs.push(rung("Path", format!("spp={spp}"), reference_shader(), spp));
+            }
+        }
+    }
+    rungs
+}
+
+/// Render `scene` with another shader and spp.
+pub fn with_settings(scene: &RenderScene, shader: Shader, spp: u32) -> RenderScene {
+    let mut s = scene.clone();
+    s.shader = shader;
+    s.film.spp = spp;
+    s
+}
+
+/// A key that changes whenever anything that affects the reference image changes.
+pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
+    let text = format!(
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
+        scene.camera,
+        scene.geometry.bounded,
+        scene.geometry.unbounded,
+        scene.materials,
+        scene.lights,
+        scene.background,
+        scene.film.width,
+        scene.film.height,
+        spp,
+        scene.seed,
+        scene.model,
+    );
+    metrics::fnv1a(text.as_bytes())
+}
+
+/// Time and measure every rung: median of `runs` renders, error of the first.
+pub fn sweep(
+    scene: &RenderScene,
+    reference: &Image,
+    rungs: &[Rung],
+    runs: usize,
+    on_rung: &mut dyn FnMut(&Row),
+) -> Vec<Row> {
+    rungs
+        .iter()
+        .map(|r| {
+            let s = with_settings(scene, r.shader, r.spp);
+            let mut times = Vec::new();
+            let mut first = None;
+            for _ in 0..runs.max(1) {
+                let out = render(&s, &|| {});
+                times.push(out.seconds);
+                first.get_or_insert(out);
+            }
+            times.sort_by(f64::total_cmp);
+            let out = first.expect("at least one run");
+            let row = Row {
+                family: r.family.clone(),
+                label: r.label.clone(),
+                seconds: times[times.len() / 2],
+                rays: out.stats.total(),
+                rmse: metrics::rmse(&out.image, reference),
+                rel_mse: metrics::rel_mse(&out.image, reference),
+            };
+            on_rung(&row);
+            row
+        })
+        .collect()
+}
+
+/// The rows as CSV.
+pub fn to_csv(rows: &[Row]) -> String {
+    let mut s = String::from("family,setting,seconds,rays,rmse,rel_mse\n");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{},{:.4},{},{:.6},{:.6}",
+            r.family, r.label, r.seconds, r.rays, r.rmse, r.rel_mse
+        );
+    }
+    s
+}
+
+/// The rows as a Markdown table.
+pub fn to_markdown(rows: &[Row], model: Model) -> String {
+    let mut s = format!(
+        "Error against the {model:?}-model reference (Path, unbounded depth).\n\n\
+         | family | setting | seconds | Mrays | RMSE | relMSE |\n|---|---|---|---|---|---|\n"
+    );
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.3} | {:.1} | {:.4} | {:.4} |",
+            r.family,
+            r.label,
+            r.seconds,
+            r.rays as f64 / 1e6,
+            r.rmse,
+            r.rel_mse
+        );
+    }
+    s
+}

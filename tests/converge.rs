@@ -1,0 +1,99 @@
+//! The converge sweep: rungs, metrics and outputs.
+
+mod common;
+
+use common::scene;
+use rtis::RenderScene;
+use rtis::converge::{self, metrics};
+use rtis::render::{film::Image, render};
+
+fn small_box() -> RenderScene {
+    let mut s = rtis::scene::load_default();
+    s.settings.film.width = 24;
+    s.settings.film.height = 20;
+    RenderScene::prepare(&s)
+}
+
+#[test]
+fn metrics_are_exact_on_known_images() {
+    let a = Image::new(2, 1);
+    let mut b = Image::new(2, 1);
+    b.pixels[0] = glam::Vec3A::splat(0.3);
+    // Half the pixels off by 0.3 in every channel: RMSE = sqrt(0.09 / 2).
+    assert!((metrics::rmse(&a, &b) - (0.045f64).sqrt()).abs() < 1e-7);
+    assert_eq!(metrics::rmse(&b, &b), 0.0);
+    // relMSE: pixel 0 is (0 - 0.3)^2 / (0.09 + 0.01) = 0.9 per channel; mean over 2 pixels.
+    assert!((metrics::rel_mse(&a, &b) - 0.45).abs() < 1e-6);
+}
+
+/// The course ladder has the cheap rungs first and every Global setting; the Path curve's error
+/// falls with spp (64 spp at least 3x below 1 spp against a 256-spp reference: the expected
+/// ratio is sqrt(64) = 8 for the noise part); the Global curve's error stops falling (bias).
+#[test]
+fn course_ladder_sweeps_and_path_converges() {
+    let s = small_box();
+    let rungs = converge::ladder(&s);
+    let labels: Vec<_> = rungs
+        .iter()
+        .map(|r| format!("{} {}", r.family, r.label))
+        .collect();
+    assert_eq!(labels[0], "Direct direct");
+    assert_eq!(labels[1], "Ambient (D=0) D=0");
+    assert!(labels.contains(&"Global D=3 n=64".to_string()));
+    assert_eq!(rungs.len(), 2 + 9 + 4);
+    let reference = render(
+        &converge::with_settings(&s, converge::reference_shader(), 256),
+        &|| {},
+    )
+    .image;
+    let rows = converge::sweep(&s, &reference, &rungs, 1, &mut |_| {});
+    let err = |fam: &str, label: &str| {
+        rows.iter()
+            .find(|r| r.family == fam && r.label == label)
+            .unwrap()
+            .rmse
+    };
+    assert!(
+        err("Path", "spp=64") * 3.0 < err("Path", "spp=1"),
+        "{rows:#?}"
+    );
+    // More hemisphere samples cannot remove the Global shader's bias: n = 64 is within a
+    // factor 2 of n = 16 while Path gains a factor 2 from 16 to 64 spp.
+    assert!(err("Global D=2", "n=64") > 0.5 * err("Global D=2", "n=16"));
+    let csv = converge::to_csv(&rows);
+    assert!(csv.starts_with("family,setting,seconds,rays,rmse,rel_mse\n"));
+    assert_eq!(csv.lines().count(), rows.len() + 1);
+    let dir = std::env::temp_dir().join(format!("rtis-conv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    converge::plot::plot(&rows, "test", &dir.join("c.png")).unwrap();
+    let png = image::open(dir.join("c.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (1100, 720));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn path_ladder_for_path_scenes() {
+    let s = scene("Scene(film: (width: 8, height: 8), shader: Path(), entities: [])");
+    let rungs = converge::ladder(&RenderScene::prepare(&s));
+    assert!(rungs.iter().all(|r| r.family.starts_with("Path")));
+    assert_eq!(rungs.len(), 9);
+}
+
+#[test]
+fn reference_key_tracks_the_scene() {
+    let a = small_box();
+    let mut b = a.clone();
+    assert_eq!(
+        converge::reference_key(&a, 64),
+        converge::reference_key(&b, 64)
+    );
+    assert_ne!(
+        converge::reference_key(&a, 64),
+        converge::reference_key(&a, 128)
+    );
+    b.background = glam::Vec3A::splat(0.1);
+    assert_ne!(
+        converge::reference_key(&a, 64),
+        converge::reference_key(&b, 64)
+    );
+}
