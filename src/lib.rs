@@ -9,6 +9,7 @@
 pub mod accel;
 pub mod camera;
 pub mod converge;
+pub mod effects;
 pub mod geometry;
 pub mod light;
 pub mod material;

@@ -6,6 +6,7 @@
 
 use crate::accel::{Geometry, Prim};
 use crate::camera::{Basis, Camera, Orthographic, Perspective};
+use crate::effects::{Effects, Kernel, kernel};
 use crate::light::{Light, PointLight};
 use crate::material::{Material, Mirror, Phong, Transmissive};
 use crate::scene::file::{CameraFields, Transfer};
@@ -50,6 +51,12 @@ pub struct RenderScene {
     pub seed: u64,
     /// World position of the prepared origin (the camera).
     pub origin: DVec3,
+    /// The effects this render simulates.
+    pub effects: Effects,
+    /// The render kernel: which effects' code is compiled into the loop that runs.
+    pub kernel: Kernel,
+    /// Kernel bits of the effects the scene switched off on purpose.
+    pub switched_off: Kernel,
     /// Notes from preparing (ignored degenerate triangles...).
     pub warnings: Vec<String>,
 }
@@ -168,7 +175,7 @@ impl RenderScene {
                 }),
             })
             .collect();
-        RenderScene {
+        let mut prepared = RenderScene {
             camera,
             geometry: Geometry::build(prims),
             materials,
@@ -184,7 +191,41 @@ impl RenderScene {
             },
             seed: s.seed,
             origin,
+            effects: Effects::default(),
+            kernel: kernel::ALL,
+            switched_off: 0,
             warnings,
+        };
+        let (effects, notes) = Effects::derive(&prepared, &s.effects);
+        let (all_on, _) = Effects::derive(&prepared, &Default::default());
+        prepared.switched_off = all_on.kernel() & !effects.kernel();
+        prepared.warnings.extend(notes);
+        prepared.set_effects(effects);
+        prepared
+    }
+
+    /// Simulate exactly `effects`: choose the kernel, and zero the ambient term and the
+    /// background when they are off.
+    pub fn set_effects(&mut self, effects: Effects) {
+        if !effects.ambient {
+            if let Shader::Global(g) = &mut self.shader {
+                g.ambient = Vec3A::ZERO;
+            }
+        }
+        if !effects.background {
+            self.background = Vec3A::ZERO;
+        }
+        self.effects = effects;
+        self.kernel = effects.kernel();
+    }
+
+    /// Render with the unspecialised kernel (every effect's code present, except those the
+    /// scene switched off on purpose), for checking that specialisation changes no pixel and
+    /// measuring what it saves.
+    pub fn unspecialised(&self) -> RenderScene {
+        RenderScene {
+            kernel: kernel::ALL & !self.switched_off,
+            ..self.clone()
         }
     }
 }

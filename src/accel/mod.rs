@@ -5,6 +5,7 @@ mod bvh;
 
 pub use bvh::{Bvh, Node};
 
+use crate::effects::kernel;
 use crate::geometry::{Hit, Ray};
 use crate::shape::{Shape, ShapeKind};
 
@@ -63,9 +64,15 @@ impl Geometry {
     /// The nearest hit along `ray` within `(0, ray.t_max]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_in::<{ kernel::ALL }>(ray)
+    }
+
+    /// [`Geometry::intersect`] in render kernel `K`.
+    #[inline]
+    pub fn intersect_in<const K: u32>(&self, ray: &Ray) -> Option<Hit> {
         let mut ray = *ray;
         let mut best: Option<u32> = None;
-        if let Some((i, t)) = self.bvh.closest(&self.bounded, &ray) {
+        if let Some((i, t)) = self.bvh.closest::<K>(&self.bounded, &ray) {
             ray.t_max = t;
             best = Some(i);
         }
@@ -90,9 +97,15 @@ impl Geometry {
     /// True if anything blocks `ray` within `(0, ray.t_max]` (any-hit query for shadow rays).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
+        self.occluded_in::<{ kernel::ALL }>(ray)
+    }
+
+    /// [`Geometry::occluded`] in render kernel `K`.
+    #[inline]
+    pub fn occluded_in<const K: u32>(&self, ray: &Ray) -> bool {
         self.unbounded
             .iter()
             .any(|p| p.shape.intersect(ray).is_some())
-            || self.bvh.any(&self.bounded, ray)
+            || self.bvh.any::<K>(&self.bounded, ray)
     }
 }

@@ -17,6 +17,70 @@ pub struct BenchArgs {
     /// Divide the film size by this (for a quick look; 1 is the course's 720x576).
     #[arg(long, default_value_t = 1)]
     shrink: u32,
+    /// Which figures: `cornell` (the course's box), `effects` (specialised against all-effects
+    /// kernels for every scene in --scenes), or `all`.
+    #[arg(long, default_value = "all")]
+    section: String,
+    /// Folder of scenes for the effects section.
+    #[arg(long, default_value = "scenes")]
+    scenes: std::path::PathBuf,
+}
+
+fn median_seconds(scene: &RenderScene, runs: usize) -> (f64, rtis::render::stats::RayStats) {
+    let mut results: Vec<_> = (0..runs.max(1)).map(|_| render(scene, &|| {})).collect();
+    results.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
+    let r = &results[results.len() / 2];
+    (r.seconds, r.stats)
+}
+
+/// Specialised kernel against the all-effects kernel for every scene in `dir`, at 360 pixels wide.
+fn effects_section(dir: &std::path::Path, runs: usize) -> Result<(), CliError> {
+    println!(
+        "-- effects: specialised kernel against all-effects kernel, 360 px wide, median of {runs}"
+    );
+    println!(
+        "{:<26} {:>7} {:>10} {:>10} {:>7}  {:>8} {:>8} {:>7} {:>7} {:>9}",
+        "scene",
+        "kernel",
+        "special s",
+        "all s",
+        "ratio",
+        "camera",
+        "shadow",
+        "refl",
+        "refr",
+        "indirect"
+    );
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let mut scene = rtis::scene::load_path(&path)?;
+        let f = &mut scene.settings.film;
+        f.height = ((360.0 * f.height as f64 / f.width as f64).round() as u32).max(1);
+        f.width = 360;
+        let special = RenderScene::prepare(&scene);
+        let all = special.unspecialised();
+        let (ts, s) = median_seconds(&special, runs);
+        let (ta, _) = median_seconds(&all, runs);
+        println!(
+            "{:<26} {:>7} {:>10.3} {:>10.3} {:>7.2}  {:>8} {:>8} {:>7} {:>7} {:>9}",
+            path.file_name().unwrap_or_default().to_string_lossy(),
+            format!("{:06b}", special.kernel),
+            ts,
+            ta,
+            ta / ts.max(1e-9),
+            s.camera,
+            s.shadow,
+            s.reflection,
+            s.refraction,
+            s.indirect
+        );
+    }
+    Ok(())
 }
 
 /// Peak resident set size of this process in MiB (Linux; 0 elsewhere).
@@ -32,17 +96,15 @@ pub fn peak_rss_mib() -> f64 {
 }
 
 fn case(name: &str, scene: &RenderScene, runs: usize) {
-    let mut results: Vec<_> = (0..runs.max(1)).map(|_| render(scene, &|| {})).collect();
-    results.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
-    let r = &results[results.len() / 2];
+    let (seconds, stats) = median_seconds(scene, runs);
     println!(
         "{name:<34} {:>4}x{:<4} {:>5} spp {:>9.3} s {:>8.1} Mrays {:>7.1} Mrays/s {:>8.1} MiB peak",
         scene.film.width,
         scene.film.height,
         scene.film.spp,
-        r.seconds,
-        r.stats.total() as f64 / 1e6,
-        r.mrays_per_second(),
+        seconds,
+        stats.total() as f64 / 1e6,
+        stats.total() as f64 / seconds.max(1e-9) / 1e6,
         peak_rss_mib()
     );
 }
@@ -58,6 +120,15 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         a.runs
     );
+    if a.section != "all" && a.section != "cornell" && a.section != "effects" {
+        return Err(format!("--section {}: use all, cornell or effects", a.section).into());
+    }
+    if a.section != "cornell" {
+        effects_section(&a.scenes, a.runs)?;
+        if a.section == "effects" {
+            return Ok(());
+        }
+    }
     let mut scene = load_default();
     scene.settings.film.width /= a.shrink;
     scene.settings.film.height /= a.shrink;

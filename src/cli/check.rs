@@ -77,7 +77,9 @@ pub fn run(path: &Path) -> Result<(), CliError> {
         } = l;
         println!("    Point at {} intensity {} W/sr", position.0, intensity.0);
     }
-    for w in &scene.warnings {
+    let prepared = rtis::RenderScene::prepare(&scene);
+    println!("  effects     {}", prepared.effects);
+    for w in scene.warnings.iter().chain(&prepared.warnings) {
         println!("warning: {w}");
     }
     Ok(())

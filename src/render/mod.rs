@@ -35,9 +35,15 @@ impl Rendered {
     }
 }
 
-/// The colour of pixel `(col, row)`: the mean radiance of its `spp` camera samples.
+/// The colour of pixel `(col, row)`: the mean radiance of its `spp` camera samples, traced by
+/// render kernel `K`.
 #[inline]
-pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStats) -> Vec3A {
+pub fn render_pixel<const K: u32>(
+    scene: &RenderScene,
+    col: u32,
+    row: u32,
+    stats: &mut RayStats,
+) -> Vec3A {
     let film = &scene.film;
     let pixel = row as u64 * film.width as u64 + col as u64;
     let mut sum = Vec3A::ZERO;
@@ -52,13 +58,25 @@ pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStat
             sampler,
             stats,
         };
-        sum += radiance(&mut tracer, &ray);
+        sum += radiance::<K>(&mut tracer, &ray);
     }
     sum / film.spp as f32
 }
 
 /// Render the scene on the current rayon pool; `on_tile` is called after each tile (progress).
+///
+/// The kernel is chosen here, once per render, from `scene.kernel`: each of the 64 effect sets
+/// is its own monomorphised copy of the loop below (see [`crate::effects`]).
 pub fn render(scene: &RenderScene, on_tile: &(dyn Fn() + Sync)) -> Rendered {
+    seq_macro::seq!(K in 0..64 {
+        match scene.kernel {
+            #( K => render_kernel::<K>(scene, on_tile), )*
+            k => unreachable!("render kernels have 6 bits, got {k}"),
+        }
+    })
+}
+
+fn render_kernel<const K: u32>(scene: &RenderScene, on_tile: &(dyn Fn() + Sync)) -> Rendered {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
     let tiles_x = w.div_ceil(TILE);
@@ -72,7 +90,7 @@ pub fn render(scene: &RenderScene, on_tile: &(dyn Fn() + Sync)) -> Rendered {
             let mut px = Vec::with_capacity((TILE * TILE) as usize);
             for row in y0..(y0 + TILE).min(h) {
                 for col in x0..(x0 + TILE).min(w) {
-                    px.push(render_pixel(scene, col, row, &mut stats));
+                    px.push(render_pixel::<K>(scene, col, row, &mut stats));
                 }
             }
             on_tile();

@@ -46,6 +46,9 @@ pub struct SceneFile {
     /// Light-transport model for the shaders that have one. Default: `Course`.
     #[serde(default)]
     pub model: Option<Model>,
+    /// Effects switched off (or asked for) on purpose. Default: all decided from the scene.
+    #[serde(default)]
+    pub effects: Option<crate::effects::EffectsDesc>,
     /// Named materials that entities refer to with `Named("...")`; a table entry
     /// cannot itself be `Named`.
     #[serde(default)]

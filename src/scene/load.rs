@@ -74,6 +74,7 @@ struct Resolved {
     background: Option<Rgb>,
     seed: Option<u64>,
     model: Option<super::Model>,
+    effects: Option<crate::effects::EffectsDesc>,
     materials: BTreeMap<String, (MaterialDesc, usize)>,
     entities: Vec<(EntityDesc, usize)>,
 }
@@ -89,6 +90,7 @@ fn resolve(src: Source, chain: &mut Vec<PathBuf>) -> Result<Resolved, SceneError
             background: None,
             seed: None,
             model: None,
+            effects: None,
             materials: BTreeMap::new(),
             entities: Vec::new(),
         },
@@ -124,6 +126,7 @@ fn resolve(src: Source, chain: &mut Vec<PathBuf>) -> Result<Resolved, SceneError
     base.background = file.background.or(base.background);
     base.seed = file.seed.or(base.seed);
     base.model = file.model.or(base.model);
+    base.effects = file.effects.or(base.effects);
     for (name, m) in file.materials.unwrap_or_default() {
         base.materials.insert(name, (m, idx));
     }
@@ -226,6 +229,7 @@ impl Resolved {
             background: self.background.unwrap_or(Rgb::BLACK),
             seed: self.seed.unwrap_or(0),
             model: self.model.unwrap_or_default(),
+            effects: self.effects.unwrap_or_default(),
         };
         Ok(Scene {
             world,

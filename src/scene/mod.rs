@@ -30,6 +30,8 @@ pub struct Settings {
     pub seed: u64,
     /// Light-transport model.
     pub model: Model,
+    /// Effect switches.
+    pub effects: crate::effects::EffectsDesc,
 }
 
 /// The `name` component of an entity.

@@ -20,6 +20,7 @@
 
 use super::Tracer;
 use super::surface::{Interaction, direct_light, reflectance, specular_bounce};
+use crate::effects::kernel;
 use crate::geometry::{Frame, Ray};
 use crate::material::Material;
 use crate::material::reflect;
@@ -42,15 +43,23 @@ pub struct Global {
 }
 
 /// Radiance along a camera ray (depth 0).
-pub fn radiance(tr: &mut Tracer, ray: &Ray, g: &Global) -> Vec3A {
-    li(tr, g, ray, RayKind::Camera, 0, 0)
+pub fn radiance<const K: u32>(tr: &mut Tracer, ray: &Ray, g: &Global) -> Vec3A {
+    li::<K>(tr, g, ray, RayKind::Camera, 0, 0)
 }
 
 /// Radiance arriving along `ray`. `depth` counts Phong hits so far; `chain` counts consecutive
 /// specular bounces (a safety cap, not part of the assignment).
-fn li(tr: &mut Tracer, g: &Global, ray: &Ray, kind: RayKind, depth: u32, chain: u32) -> Vec3A {
+/// `K` is the render kernel: without indirect light the ambient term stands in at every depth.
+fn li<const K: u32>(
+    tr: &mut Tracer,
+    g: &Global,
+    ray: &Ray,
+    kind: RayKind,
+    depth: u32,
+    chain: u32,
+) -> Vec3A {
     // A ray that leaves the scene: the background is its radiance.
-    let Some(hit) = tr.trace(ray, kind) else {
+    let Some(hit) = tr.trace::<K>(ray, kind) else {
         return tr.scene.background;
     };
     let si = Interaction::new(tr, ray, hit);
@@ -61,17 +70,19 @@ fn li(tr: &mut Tracer, g: &Global, ray: &Ray, kind: RayKind, depth: u32, chain: 
             if chain >= g.max_specular {
                 return Vec3A::ZERO;
             }
-            let (next, tint, kind) = specular_bounce(&si).expect("specular material");
-            return tint * li(tr, g, &next, kind, depth, chain + 1);
+            return match specular_bounce::<K>(&si) {
+                Some((next, tint, kind)) => tint * li::<K>(tr, g, &next, kind, depth, chain + 1),
+                None => Vec3A::ZERO,
+            };
         }
     };
     let (wo, n, model) = (si.wo, si.n, tr.scene.model);
 
     // Eq. 3: direct light from the point lights.
-    let l_dir = direct_light(tr, &si, &phong);
+    let l_dir = direct_light::<K>(tr, &si, &phong);
 
     // Indirect light.
-    let l_ind = if depth == g.max_depth {
+    let l_ind = if depth == g.max_depth || K & kernel::INDIRECT == 0 {
         // Eq. 2: the ambient term.
         g.ambient * phong.kd
     } else if depth == 0 {
@@ -81,15 +92,15 @@ fn li(tr: &mut Tracer, g: &Global, ray: &Ray, kind: RayKind, depth: u32, chain: 
         for _ in 0..g.samples {
             let (u1, u2) = tr.sampler.next_2d();
             let wj = frame.to_world(hemisphere::uniform(u1, u2));
-            let l_i = li(tr, g, &si.spawn(wj), RayKind::Indirect, depth + 1, 0);
+            let l_i = li::<K>(tr, g, &si.spawn(wj), RayKind::Indirect, depth + 1, 0);
             sum += l_i * reflectance(model, &phong, wj, wo, n);
         }
         sum / (2.0 * PI * g.samples as f32)
     } else {
         // Task 2: Eq. 4 with the directions fixed to the normal w_n and the reflection w_r.
         let (wn, wr) = (n, reflect(wo, n));
-        let l_n = li(tr, g, &si.spawn(wn), RayKind::Indirect, depth + 1, 0);
-        let l_r = li(tr, g, &si.spawn(wr), RayKind::Indirect, depth + 1, 0);
+        let l_n = li::<K>(tr, g, &si.spawn(wn), RayKind::Indirect, depth + 1, 0);
+        let l_r = li::<K>(tr, g, &si.spawn(wr), RayKind::Indirect, depth + 1, 0);
         (l_n * reflectance(model, &phong, wn, wo, n) + l_r * reflectance(model, &phong, wr, wo, n))
             / (4.0 * PI)
     };

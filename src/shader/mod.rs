@@ -100,33 +100,34 @@ pub struct Tracer<'a> {
 }
 
 impl Tracer<'_> {
-    /// Nearest hit of a ray of the given kind (counted).
+    /// Nearest hit of a ray of the given kind (counted), in render kernel `K`.
     #[inline]
-    pub fn trace(&mut self, ray: &Ray, kind: RayKind) -> Option<Hit> {
+    pub fn trace<const K: u32>(&mut self, ray: &Ray, kind: RayKind) -> Option<Hit> {
         self.stats.count(kind);
-        self.scene.geometry.intersect(ray)
+        self.scene.geometry.intersect_in::<K>(ray)
     }
 
-    /// True if nothing blocks the shadow ray (counted).
+    /// True if nothing blocks the shadow ray (counted), in render kernel `K`.
     #[inline]
-    pub fn unoccluded(&mut self, ray: &Ray) -> bool {
+    pub fn unoccluded<const K: u32>(&mut self, ray: &Ray) -> bool {
         self.stats.count(RayKind::Shadow);
-        !self.scene.geometry.occluded(ray)
+        !self.scene.geometry.occluded_in::<K>(ray)
     }
 }
 
-/// Radiance arriving at the camera along the camera ray `ray`.
+/// Radiance arriving at the camera along the camera ray `ray`, in render kernel `K`
+/// (see [`crate::effects`]).
 #[inline]
-pub fn radiance(tr: &mut Tracer, ray: &Ray) -> Vec3A {
+pub fn radiance<const K: u32>(tr: &mut Tracer, ray: &Ray) -> Vec3A {
     match tr.scene.shader {
-        Shader::Intersection { color } => intersection::radiance(tr, ray, color),
+        Shader::Intersection { color } => intersection::radiance::<K>(tr, ray, color),
         Shader::Depth {
             max_distance,
             color,
-        } => depth::radiance(tr, ray, max_distance, color),
-        Shader::Normal => normal::radiance(tr, ray),
-        Shader::Direct { max_specular } => direct::radiance(tr, ray, max_specular),
-        Shader::Global(g) => global::radiance(tr, ray, &g),
-        Shader::Path(p) => path::radiance(tr, ray, &p),
+        } => depth::radiance::<K>(tr, ray, max_distance, color),
+        Shader::Normal => normal::radiance::<K>(tr, ray),
+        Shader::Direct { max_specular } => direct::radiance::<K>(tr, ray, max_specular),
+        Shader::Global(g) => global::radiance::<K>(tr, ray, &g),
+        Shader::Path(p) => path::radiance::<K>(tr, ray, &p),
     }
 }

@@ -6,8 +6,8 @@ use crate::render::stats::RayKind;
 use glam::Vec3A;
 
 /// `(n + 1) / 2` with `n` the unit normal on the side facing the camera; background on a miss.
-pub fn radiance(tr: &mut Tracer, ray: &Ray) -> Vec3A {
-    match tr.trace(ray, RayKind::Camera) {
+pub fn radiance<const K: u32>(tr: &mut Tracer, ray: &Ray) -> Vec3A {
+    match tr.trace::<K>(ray, RayKind::Camera) {
         Some(hit) => {
             let n = if hit.n.dot(ray.d) > 0.0 {
                 -hit.n

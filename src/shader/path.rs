@@ -18,6 +18,7 @@
 
 use super::Tracer;
 use super::surface::{Interaction, direct_light, reflectance};
+use crate::effects::kernel;
 use crate::geometry::{Frame, Ray};
 use crate::material::{Material, Phong, fresnel_dielectric, reflect};
 use crate::render::stats::RayKind;
@@ -53,7 +54,9 @@ pub struct Path {
 const MAX_BOUNCES: u32 = 1024;
 
 /// Radiance along a camera ray.
-pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
+///
+/// `K` is the render kernel: scattering into an effect it leaves out ends the path.
+pub fn radiance<const K: u32>(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     let model = tr.scene.model;
     let max_depth = p.max_depth.unwrap_or(MAX_BOUNCES).min(MAX_BOUNCES);
     let mut l = Vec3A::ZERO;
@@ -63,7 +66,7 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     let mut depth = 0;
     loop {
         // Escaped rays see the background.
-        let Some(hit) = tr.trace(&ray, kind) else {
+        let Some(hit) = tr.trace::<K>(&ray, kind) else {
             l += beta * tr.scene.background;
             break;
         };
@@ -93,13 +96,25 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
             }
             Material::Phong(phong) => {
                 // Next-event estimation: Eq. 3 under the model.
-                l += beta * direct_light(tr, &si, &phong);
+                l += beta * direct_light::<K>(tr, &si, &phong);
+                if K & kernel::INDIRECT == 0 {
+                    break;
+                }
                 let Some((wi, weight)) = sample_phong(tr, &phong, &si, model, p.sampling) else {
                     break;
                 };
                 (wi, weight, RayKind::Indirect)
             }
         };
+        // An effect the kernel leaves out ends the path.
+        let bit = match next {
+            RayKind::Reflection => kernel::REFLECTION,
+            RayKind::Refraction => kernel::REFRACTION,
+            _ => kernel::INDIRECT,
+        };
+        if K & bit == 0 {
+            break;
+        }
         beta *= weight;
         depth += 1;
         // Russian roulette: survive with probability q, divide by q to stay unbiased.

@@ -3,6 +3,7 @@
 //! scattered ray of a mirror or glass.
 
 use super::Tracer;
+use crate::effects::kernel;
 use crate::geometry::{Hit, Ray, offset_origin};
 use crate::material::{Material, Phong};
 use crate::render::stats::RayKind;
@@ -56,8 +57,10 @@ pub fn reflectance(model: Model, phong: &Phong, wi: Vec3A, wo: Vec3A, n: Vec3A) 
 
 /// Eq. 3: `L_dir = sum_s L_i^s r(wi^s, wo) V^s` over the point lights. A light counts only when
 /// it is above the surface (`wi.n > 0`) and the shadow ray reaches it.
+///
+/// In a kernel without shadows (`effects: (shadows: false)`) every light facing the point counts.
 #[inline]
-pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
+pub fn direct_light<const K: u32>(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
     let mut l_dir = Vec3A::ZERO;
     let model = tr.scene.model;
     for light in &tr.scene.lights {
@@ -69,12 +72,11 @@ pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
         }
         // Shadow ray V^s: stop just short of the light, so that a surface the light sits on
         // does not block it.
-        let shadow = Ray::segment(
-            offset_origin(&si.hit, inc.wi),
-            inc.wi,
-            inc.dist * SHADOW_END,
-        );
-        if tr.unoccluded(&shadow) {
+        let visible = K & kernel::SHADOWS == 0 || {
+            let o = offset_origin(&si.hit, inc.wi);
+            tr.unoccluded::<K>(&Ray::segment(o, inc.wi, inc.dist * SHADOW_END))
+        };
+        if visible {
             l_dir += inc.li * reflectance(model, phong, inc.wi, si.wo, si.n);
         }
     }
@@ -84,25 +86,32 @@ pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
 /// Shadow rays end at this fraction of the distance to the light.
 const SHADOW_END: f32 = 1.0 - 1e-4;
 
-/// The one ray a mirror or glass surface sends on, its tint, and its kind; `None` for Phong.
+/// The one ray a mirror or glass surface sends on, its tint, and its kind, in the course's
+/// model; `None` for Phong, and for an effect kernel `K` leaves out (the surface is then black).
 ///
 /// Mirrors reflect `wo` about the normal. Glass refracts with Snell's law (`eta = 1 / ior`
 /// entering, `ior` leaving) and reflects under total internal reflection.
 #[inline]
-pub fn specular_bounce(si: &Interaction) -> Option<(Ray, Vec3A, RayKind)> {
+pub fn specular_bounce<const K: u32>(si: &Interaction) -> Option<(Ray, Vec3A, RayKind)> {
     match si.material {
         Material::Phong(_) => None,
         Material::Mirror(m) => {
+            if K & kernel::REFLECTION == 0 {
+                return None;
+            }
             let wr = m.reflect(si.wo, si.n);
             Some((si.spawn(wr), m.color, RayKind::Reflection))
         }
         Material::Transmissive(g) => {
             let r = g.refract(si.wo, si.hit.n);
-            let kind = if r.total_internal_reflection {
-                RayKind::Reflection
+            let (kind, bit) = if r.total_internal_reflection {
+                (RayKind::Reflection, kernel::REFLECTION)
             } else {
-                RayKind::Refraction
+                (RayKind::Refraction, kernel::REFRACTION)
             };
+            if K & bit == 0 {
+                return None;
+            }
             Some((si.spawn(r.wt), g.color, kind))
         }
     }

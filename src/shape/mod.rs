@@ -11,6 +11,7 @@ pub use plane::Plane;
 pub use sphere::Sphere;
 pub use triangle::Triangle;
 
+use crate::effects::kernel;
 use crate::geometry::{Aabb, Ray};
 use glam::Vec3A;
 
@@ -57,10 +58,18 @@ impl Shape {
     /// Distance to the nearest intersection in `(0, ray.t_max]`, if any.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
+        self.intersect_in::<{ kernel::ALL }>(ray)
+    }
+
+    /// [`Shape::intersect`] in render kernel `K`: the tests of shape kinds the kernel leaves
+    /// out are not compiled in (the scene has none of them).
+    #[inline(always)]
+    pub fn intersect_in<const K: u32>(&self, ray: &Ray) -> Option<f32> {
         match self {
-            Shape::Sphere(s) => s.intersect(ray),
+            Shape::Sphere(s) if K & kernel::SPHERES != 0 => s.intersect(ray),
             Shape::Plane(p) => p.intersect(ray),
-            Shape::Triangle(t) => t.intersect(ray),
+            Shape::Triangle(t) if K & kernel::TRIANGLES != 0 => t.intersect(ray),
+            _ => None,
         }
     }
 
