@@ -100,8 +100,7 @@ impl Effects {
         );
         let has_glass = any_mat(|m| matches!(m, Material::Transmissive(_)));
         let has_phong = any_mat(|m| matches!(m, Material::Phong(_)));
-        let has_geometry =
-            !scene.geometry.bounded.is_empty() || !scene.geometry.unbounded.is_empty();
+        let has_geometry = !scene.geometry.is_empty();
         let indirect = has_phong
             && match scene.shader {
                 Shader::Global(g) => g.max_depth >= 1,

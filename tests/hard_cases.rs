@@ -235,7 +235,7 @@ fn degenerate_triangle_is_ignored() {
                     material: Phong(kd: (1, 1, 1)))])"#,
     );
     let prepared = rtis::RenderScene::prepare(&s);
-    assert_eq!(prepared.geometry.bounded.len(), 0);
+    assert!(prepared.geometry.is_empty());
     assert!(
         prepared
             .warnings

@@ -4,6 +4,7 @@
 use super::Prim;
 use crate::geometry::{Aabb, Ray};
 use glam::{Vec3, Vec3A};
+use std::mem::MaybeUninit;
 
 /// A flattened node. An interior node's first child follows it; `index` is its second child.
 /// A leaf holds `count > 0` primitives starting at `index`.
@@ -76,7 +77,7 @@ impl Bvh {
         }
         let mut t_max = ray.t_max;
         let mut best = None;
-        let mut stack = [0u32; STACK];
+        let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
         let mut sp = 0usize;
         let mut node = 0usize;
         loop {
@@ -97,7 +98,7 @@ impl Bvh {
                 match (ta, tb) {
                     (Some(ta), Some(tb)) => {
                         let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
-                        stack[sp] = far as u32;
+                        stack[sp].write(far as u32);
                         sp += 1;
                         node = near;
                         continue;
@@ -117,14 +118,16 @@ impl Bvh {
                 break;
             }
             sp -= 1;
-            node = stack[sp] as usize;
+            // SAFETY: entries below `sp` were written before `sp` was raised past them.
+            node = unsafe { stack[sp].assume_init() } as usize;
             // Skip nodes that a closer hit found meanwhile has made irrelevant.
             while self.box_hit(node, ray, t_max).is_none() {
                 if sp == 0 {
                     return best;
                 }
                 sp -= 1;
-                node = stack[sp] as usize;
+                // SAFETY: entries below `sp` were written before `sp` was raised past them.
+                node = unsafe { stack[sp].assume_init() } as usize;
             }
         }
         best
@@ -136,7 +139,7 @@ impl Bvh {
         if self.nodes.is_empty() {
             return false;
         }
-        let mut stack = [0u32; STACK];
+        let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
         let mut sp = 0usize;
         let mut node = 0usize;
         loop {
@@ -151,7 +154,7 @@ impl Bvh {
                         return true;
                     }
                 } else {
-                    stack[sp] = n.index;
+                    stack[sp].write(n.index);
                     sp += 1;
                     node += 1;
                     continue;
@@ -161,7 +164,8 @@ impl Bvh {
                 return false;
             }
             sp -= 1;
-            node = stack[sp] as usize;
+            // SAFETY: entries below `sp` were written before `sp` was raised past them.
+            node = unsafe { stack[sp].assume_init() } as usize;
         }
     }
 

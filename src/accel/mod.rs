@@ -1,13 +1,15 @@
-//! Ray queries over the prepared geometry: a BVH over the finite primitives and a flat list of
-//! unbounded ones (infinite planes).
+//! Ray queries over the prepared geometry: packets of four planes and (in small scenes) four
+//! spheres tested with SSE, and a BVH over the remaining finite primitives.
 
 mod bvh;
+pub mod lanes;
 
 pub use bvh::{Bvh, Node};
 
 use crate::effects::kernel;
 use crate::geometry::{Hit, Ray};
 use crate::shape::{Shape, ShapeKind};
+use lanes::{Lanes, PlaneLanes, RayLanes, SphereLanes};
 
 /// A shape with the index of its material.
 #[derive(Clone, Copy, Debug)]
@@ -18,47 +20,83 @@ pub struct Prim {
     pub material: u32,
 }
 
+/// Scenes with at most this many spheres test them in packets instead of a BVH.
+pub const PACKED_SPHERES: usize = 16;
+
 /// All of a scene's primitives, ready for ray queries.
 #[derive(Clone, Debug, Default)]
 pub struct Geometry {
-    /// Finite primitives, in BVH leaf order.
-    pub bounded: Vec<Prim>,
-    /// BVH over `bounded`.
+    /// Every primitive; hits refer to indices here. The first `in_bvh` are the BVH's, in leaf
+    /// order; the packed spheres and the planes follow.
+    pub prims: Vec<Prim>,
+    /// How many of `prims` the BVH holds.
+    pub in_bvh: usize,
+    /// BVH over `prims[..in_bvh]`.
     pub bvh: Bvh,
-    /// Primitives without bounds, tested one by one. Hit indices continue after `bounded`.
-    pub unbounded: Vec<Prim>,
+    /// Spheres in packets of four (small scenes).
+    pub spheres: Lanes<SphereLanes>,
+    /// Infinite planes in packets of four.
+    pub planes: Lanes<PlaneLanes>,
 }
 
 impl Geometry {
-    /// Builds the BVH over the bounded primitives and sets the unbounded ones apart.
+    /// Sort the primitives into packets and a BVH.
     pub fn build(prims: Vec<Prim>) -> Self {
-        let (bounded, unbounded): (Vec<_>, Vec<_>) =
-            prims.into_iter().partition(|p| p.shape.bounds().is_some());
-        let (bvh, bounded) = Bvh::build(bounded);
+        let n_spheres = prims
+            .iter()
+            .filter(|p| p.shape.kind() == ShapeKind::Sphere)
+            .count();
+        let pack_spheres = n_spheres <= PACKED_SPHERES;
+        let (planes, rest): (Vec<_>, Vec<_>) = prims
+            .into_iter()
+            .partition(|p| p.shape.kind() == ShapeKind::Plane);
+        let (spheres, for_bvh): (Vec<_>, Vec<_>) = rest
+            .into_iter()
+            .partition(|p| pack_spheres && p.shape.kind() == ShapeKind::Sphere);
+        let (bvh, mut all) = Bvh::build(for_bvh);
+        let in_bvh = all.len();
+        let sphere_items: Vec<_> = spheres
+            .iter()
+            .enumerate()
+            .map(|(i, p)| match p.shape {
+                Shape::Sphere(s) => ((in_bvh + i) as u32, s),
+                _ => unreachable!("partitioned spheres"),
+            })
+            .collect();
+        all.extend(spheres);
+        let base = all.len();
+        let plane_items: Vec<_> = planes
+            .iter()
+            .enumerate()
+            .map(|(i, p)| match p.shape {
+                Shape::Plane(pl) => ((base + i) as u32, pl),
+                _ => unreachable!("partitioned planes"),
+            })
+            .collect();
+        all.extend(planes);
         Geometry {
-            bounded,
+            prims: all,
+            in_bvh,
             bvh,
-            unbounded,
+            spheres: lanes::pack(&sphere_items, SphereLanes::pack),
+            planes: lanes::pack(&plane_items, PlaneLanes::pack),
         }
     }
 
     /// The primitive a hit refers to.
     #[inline]
     pub fn prim(&self, index: u32) -> &Prim {
-        let i = index as usize;
-        match self.bounded.get(i) {
-            Some(p) => p,
-            None => &self.unbounded[i - self.bounded.len()],
-        }
+        &self.prims[index as usize]
+    }
+
+    /// True if the scene has no primitive at all.
+    pub fn is_empty(&self) -> bool {
+        self.prims.is_empty()
     }
 
     /// Number of primitives of each kind.
     pub fn count(&self, kind: ShapeKind) -> usize {
-        self.bounded
-            .iter()
-            .chain(&self.unbounded)
-            .filter(|p| p.shape.kind() == kind)
-            .count()
+        self.prims.iter().filter(|p| p.shape.kind() == kind).count()
     }
 
     /// The nearest hit along `ray` within `(0, ray.t_max]`.
@@ -70,23 +108,26 @@ impl Geometry {
     /// [`Geometry::intersect`] in render kernel `K`.
     #[inline]
     pub fn intersect_in<const K: u32>(&self, ray: &Ray) -> Option<Hit> {
-        let mut ray = *ray;
+        let mut t_max = ray.t_max;
         let mut best: Option<u32> = None;
-        if let Some((i, t)) = self.bvh.closest::<K>(&self.bounded, &ray) {
-            ray.t_max = t;
-            best = Some(i);
+        let lanes = RayLanes::new(ray.o, ray.d);
+        if K & kernel::SPHERES != 0 {
+            self.spheres
+                .closest(&lanes, &mut t_max, &mut best, SphereLanes::hit);
         }
-        let base = self.bounded.len() as u32;
-        for (j, p) in self.unbounded.iter().enumerate() {
-            if let Some(t) = p.shape.intersect(&ray) {
-                ray.t_max = t;
-                best = Some(base + j as u32);
+        if !self.bvh.nodes.is_empty() {
+            let r = ray.for_bvh(t_max, K & kernel::TRIANGLES != 0);
+            if let Some((i, t)) = self.bvh.closest::<K>(&self.prims[..self.in_bvh], &r) {
+                t_max = t;
+                best = Some(i);
             }
         }
+        self.planes
+            .closest(&lanes, &mut t_max, &mut best, PlaneLanes::hit);
         let prim = best?;
-        let s = self.prim(prim).shape.surface(&ray, ray.t_max);
+        let s = self.prim(prim).shape.surface(ray, t_max);
         Some(Hit {
-            t: ray.t_max,
+            t: t_max,
             p: s.p,
             n: s.n,
             err: s.err,
@@ -103,9 +144,13 @@ impl Geometry {
     /// [`Geometry::occluded`] in render kernel `K`.
     #[inline]
     pub fn occluded_in<const K: u32>(&self, ray: &Ray) -> bool {
-        self.unbounded
-            .iter()
-            .any(|p| p.shape.intersect(ray).is_some())
-            || self.bvh.any::<K>(&self.bounded, ray)
+        let lanes = RayLanes::new(ray.o, ray.d);
+        (K & kernel::SPHERES != 0 && self.spheres.any(&lanes, ray.t_max, SphereLanes::hit))
+            || self.planes.any(&lanes, ray.t_max, PlaneLanes::hit)
+            || (!self.bvh.nodes.is_empty()
+                && self.bvh.any::<K>(
+                    &self.prims[..self.in_bvh],
+                    &ray.for_bvh(ray.t_max, K & kernel::TRIANGLES != 0),
+                ))
     }
 }

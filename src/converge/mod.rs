@@ -123,10 +123,9 @@ pub fn with_settings(scene: &RenderScene, shader: Shader, spp: u32) -> RenderSce
 /// A key that changes whenever anything that affects the reference image changes.
 pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
     let text = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
         scene.camera,
-        scene.geometry.bounded,
-        scene.geometry.unbounded,
+        scene.geometry.prims,
         scene.materials,
         scene.lights,
         scene.background,

@@ -49,6 +49,36 @@ impl Ray {
         }
     }
 
+    /// A ray with only origin, direction and extent set: what the shaders spawn. The
+    /// geometry queries add the BVH's and the triangle test's data ([`Ray::for_bvh`]) only
+    /// when the scene needs them.
+    #[inline]
+    pub fn bare(o: Vec3A, d: Vec3A, t_max: f32) -> Self {
+        Ray {
+            o,
+            d,
+            t_max,
+            inv_d: Vec3A::ZERO,
+            k: [0, 1, 2],
+            shear: [0.0; 3],
+        }
+    }
+
+    /// This ray, limited to `t_max`, with the reciprocal direction for box tests and, if
+    /// `triangles`, the shear constants of the watertight triangle test.
+    #[inline]
+    pub fn for_bvh(&self, t_max: f32, triangles: bool) -> Ray {
+        if triangles {
+            Ray::segment(self.o, self.d, t_max)
+        } else {
+            Ray {
+                t_max,
+                inv_d: self.d.recip(),
+                ..*self
+            }
+        }
+    }
+
     /// The point at distance `t`.
     #[inline]
     pub fn at(&self, t: f32) -> Vec3A {

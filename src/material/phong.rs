@@ -31,6 +31,9 @@ impl Phong {
     #[inline]
     pub fn course_reflectance(&self, wi: Vec3A, wo: Vec3A, n: Vec3A) -> Vec3A {
         let cos_i = wi.dot(n).max(0.0);
+        if self.ks == Vec3A::ZERO {
+            return self.kd * cos_i;
+        }
         let wr = reflect(wi, n);
         let cos_r = wo.dot(wr).max(0.0);
         self.kd * cos_i + self.ks * cos_r.powf(self.shininess)

@@ -41,7 +41,7 @@ impl Interaction {
     /// A ray leaving the surface in unit direction `w`, started off the surface on `w`'s side.
     #[inline]
     pub fn spawn(&self, w: Vec3A) -> Ray {
-        Ray::new(offset_origin(&self.hit, w), w)
+        Ray::bare(offset_origin(&self.hit, w), w, f32::INFINITY)
     }
 }
 
@@ -74,7 +74,7 @@ pub fn direct_light<const K: u32>(tr: &mut Tracer, si: &Interaction, phong: &Pho
         // does not block it.
         let visible = K & kernel::SHADOWS == 0 || {
             let o = offset_origin(&si.hit, inc.wi);
-            tr.unoccluded::<K>(&Ray::segment(o, inc.wi, inc.dist * SHADOW_END))
+            tr.unoccluded::<K>(&Ray::bare(o, inc.wi, inc.dist * SHADOW_END))
         };
         if visible {
             l_dir += inc.li * reflectance(model, phong, inc.wi, si.wo, si.n);

@@ -1,0 +1,176 @@
+//! Primitives four to a packet in structure-of-arrays lanes, tested together with SSE
+//! (`glam::Vec4`). Planes always live here; spheres too when a scene has few of them, where a
+//! BVH costs more than it saves. The arithmetic is the scalar tests' (`shape::Sphere`,
+//! `shape::Plane`) operation for operation, so a packet finds exactly the hits the scalar
+//! code would.
+
+use crate::shape::{Plane, Sphere};
+use glam::{BVec4A, Vec3A, Vec4};
+
+/// A ray splatted across four lanes.
+#[derive(Clone, Copy)]
+pub struct RayLanes {
+    o: [Vec4; 3],
+    d: [Vec4; 3],
+}
+
+impl RayLanes {
+    /// Splat origin and direction.
+    #[inline(always)]
+    pub fn new(o: Vec3A, d: Vec3A) -> Self {
+        RayLanes {
+            o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
+            d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
+        }
+    }
+}
+
+#[inline(always)]
+fn dot(a: [Vec4; 3], b: [Vec4; 3]) -> Vec4 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Up to four spheres; unused lanes have `r2 = -1` and never hit.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SphereLanes {
+    c: [Vec4; 3],
+    r2: Vec4,
+}
+
+/// Up to four planes; unused lanes have a zero normal and never hit.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PlaneLanes {
+    n: [Vec4; 3],
+    dist: Vec4,
+}
+
+impl SphereLanes {
+    /// Pack up to four spheres.
+    pub fn pack(s: &[Sphere]) -> Self {
+        let lane = |i: usize, f: fn(&Sphere) -> f32, pad: f32| s.get(i).map_or(pad, f);
+        let v = |f: fn(&Sphere) -> f32, pad| {
+            Vec4::new(
+                lane(0, f, pad),
+                lane(1, f, pad),
+                lane(2, f, pad),
+                lane(3, f, pad),
+            )
+        };
+        SphereLanes {
+            c: [v(|s| s.c.x, 0.0), v(|s| s.c.y, 0.0), v(|s| s.c.z, 0.0)],
+            r2: v(|s| s.r * s.r, -1.0),
+        }
+    }
+
+    /// Distances of each lane's hit in `(0, t_max]`, and which lanes hit (the scalar
+    /// [`Sphere::intersect`], four at a time).
+    #[inline(always)]
+    pub fn hit(&self, r: &RayLanes, t_max: f32) -> (Vec4, BVec4A) {
+        let f = [r.o[0] - self.c[0], r.o[1] - self.c[1], r.o[2] - self.c[2]];
+        let b = -dot(f, r.d);
+        let l = [f[0] + b * r.d[0], f[1] + b * r.d[1], f[2] + b * r.d[2]];
+        let disc = self.r2 - dot(l, l);
+        let c = dot(f, f) - self.r2;
+        let q = b + disc.sqrt().copysign(b);
+        let a = c / q;
+        let first = a.cmple(q);
+        let t0 = Vec4::select(first, a, q);
+        let t1 = Vec4::select(first, q, a);
+        let zero = Vec4::ZERO;
+        let tm = Vec4::splat(t_max);
+        let ok0 = t0.cmpgt(zero) & t0.cmple(tm);
+        let ok1 = t1.cmpgt(zero) & t1.cmple(tm);
+        let t = Vec4::select(ok0, t0, t1);
+        (t, disc.cmpge(zero) & q.cmpne(zero) & (ok0 | ok1))
+    }
+}
+
+impl PlaneLanes {
+    /// Pack up to four planes.
+    pub fn pack(p: &[Plane]) -> Self {
+        let lane = |i: usize, f: fn(&Plane) -> f32| p.get(i).map_or(0.0, f);
+        let v = |f: fn(&Plane) -> f32| Vec4::new(lane(0, f), lane(1, f), lane(2, f), lane(3, f));
+        PlaneLanes {
+            n: [v(|p| p.n.x), v(|p| p.n.y), v(|p| p.n.z)],
+            dist: v(|p| p.dist),
+        }
+    }
+
+    /// Distances and hit lanes (the scalar [`Plane::intersect`], four at a time).
+    #[inline(always)]
+    pub fn hit(&self, r: &RayLanes, t_max: f32) -> (Vec4, BVec4A) {
+        let denom = dot(self.n, r.d);
+        let t = (self.dist - dot(self.n, r.o)) / denom;
+        let ok = denom.cmpne(Vec4::ZERO) & t.cmpgt(Vec4::ZERO) & t.cmple(Vec4::splat(t_max));
+        (t, ok)
+    }
+}
+
+/// Packed primitives with the prim index of each lane.
+#[derive(Clone, Debug, Default)]
+pub struct Lanes<P> {
+    /// The packets.
+    pub packs: Vec<P>,
+    /// `packs.len() * 4` prim indices; padding lanes repeat the last one (they never hit).
+    pub prim: Vec<u32>,
+}
+
+impl<P> Lanes<P> {
+    /// Closest hit over every packet, with the scalar loop's tie rule (a later lane at equal
+    /// distance wins), updating `t_max` and `best`.
+    #[inline(always)]
+    pub fn closest(
+        &self,
+        r: &RayLanes,
+        t_max: &mut f32,
+        best: &mut Option<u32>,
+        hit: impl Fn(&P, &RayLanes, f32) -> (Vec4, BVec4A),
+    ) {
+        for (k, p) in self.packs.iter().enumerate() {
+            let (t, ok) = hit(p, r, *t_max);
+            let mut mask = ok.bitmask();
+            if mask == 0 {
+                continue;
+            }
+            let t = t.to_array();
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if t[i] <= *t_max {
+                    *t_max = t[i];
+                    *best = Some(self.prim[k * 4 + i]);
+                }
+            }
+        }
+    }
+
+    /// True if any lane of any packet hits within `t_max`.
+    #[inline(always)]
+    pub fn any(
+        &self,
+        r: &RayLanes,
+        t_max: f32,
+        hit: impl Fn(&P, &RayLanes, f32) -> (Vec4, BVec4A),
+    ) -> bool {
+        self.packs.iter().any(|p| hit(p, r, t_max).1.any())
+    }
+}
+
+/// Pack `items` (with their prim indices) four at a time.
+pub fn pack<T, P>(items: &[(u32, T)], f: impl Fn(&[T]) -> P) -> Lanes<P>
+where
+    T: Copy,
+{
+    let mut out = Lanes {
+        packs: Vec::new(),
+        prim: Vec::new(),
+    };
+    for chunk in items.chunks(4) {
+        let shapes: Vec<T> = chunk.iter().map(|(_, s)| *s).collect();
+        out.packs.push(f(&shapes));
+        for i in 0..4 {
+            out.prim.push(chunk[i.min(chunk.len() - 1)].0);
+        }
+    }
+    out
+}
