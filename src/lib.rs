@@ -13,6 +13,7 @@ pub mod effects;
 pub mod geometry;
 pub mod light;
 pub mod material;
+pub mod mesh;
 pub mod prepare;
 pub mod render;
 pub mod sampling;

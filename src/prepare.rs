@@ -4,16 +4,16 @@
 //! Scene coordinates are doubles. Preparing subtracts the camera position (in double precision)
 //! before rounding to `f32`, so a scene far from the origin renders as precisely as one at it.
 
-use crate::accel::{Geometry, Prim};
+use crate::accel::{FLAT, Geometry, Prim};
 use crate::camera::{Basis, Camera, Orthographic, Perspective};
 use crate::effects::{Effects, Kernel, kernel};
 use crate::light::{Light, PointLight};
 use crate::material::{Material, Mirror, Phong, Transmissive};
 use crate::scene::file::{CameraFields, Transfer};
-use crate::scene::{LightDesc, MaterialDesc, Model, Scene, ShapeDesc};
+use crate::scene::{LightDesc, LoadedMesh, MaterialDesc, Model, Scene, ShapeDesc, TransformDesc};
 use crate::shader::Shader;
 use crate::shape::{Plane, Shape, Sphere, Triangle};
-use glam::{DVec3, Vec3A};
+use glam::{DAffine3, DMat3, DVec3, Vec3A};
 
 /// Image size, sampling and output transfer of a render.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -109,13 +109,16 @@ impl RenderScene {
         let mut warnings = Vec::new();
         let mut materials: Vec<Material> = Vec::new();
         let mut prims = Vec::new();
-        for (entity, shape, mat, name) in scene
+        let mut normals = Vec::new();
+        for (entity, shape, mat, name, transform, mesh) in scene
             .world
             .query::<(
                 hecs::Entity,
                 &ShapeDesc,
                 &MaterialDesc,
                 Option<&crate::scene::Name>,
+                Option<&TransformDesc>,
+                Option<&LoadedMesh>,
             )>()
             .iter()
         {
@@ -128,37 +131,25 @@ impl RenderScene {
                 }
             };
             let label = name.map_or_else(|| format!("entity {}", entity.id()), |n| n.0.clone());
-            let mut push = |shape| prims.push(Prim { shape, material });
-            match shape {
-                ShapeDesc::Sphere { center, radius } => push(Shape::Sphere(Sphere {
-                    c: rel(center.0),
-                    r: radius.0 as f32,
-                })),
-                ShapeDesc::InfinitePlane { point, normal } => push(Shape::Plane(Plane::through(
-                    rel(point.0),
-                    normal.0.normalize().as_vec3a(),
-                ))),
-                ShapeDesc::Triangle { a, b, c } => {
-                    match Triangle::new(rel(a.0), rel(b.0), rel(c.0)) {
-                        Some(t) => push(Shape::Triangle(t)),
-                        None => warnings.push(format!(
-                            "{label}: zero-area triangle ignored (it can never be hit)"
-                        )),
+            let place = Placement::new(transform, origin);
+            let dropped = flatten(shape, mesh, &place, &mut |shape, vertex_normals| {
+                let smooth = match vertex_normals {
+                    Some(n) => {
+                        normals.push(n);
+                        (normals.len() - 1) as u32
                     }
-                }
-                ShapeDesc::TriangleMesh { vertices, faces } => {
-                    let mut dropped = 0;
-                    for &(i, j, k) in faces.iter() {
-                        let v = |i: u32| rel(vertices[i as usize].0);
-                        match Triangle::new(v(i), v(j), v(k)) {
-                            Some(t) => push(Shape::Triangle(t)),
-                            None => dropped += 1,
-                        }
-                    }
-                    if dropped > 0 {
-                        warnings.push(format!("{label}: {dropped} zero-area triangles ignored"));
-                    }
-                }
+                    None => FLAT,
+                };
+                prims.push(Prim {
+                    shape,
+                    material,
+                    smooth,
+                })
+            });
+            if dropped > 0 {
+                warnings.push(format!(
+                    "{label}: {dropped} zero-area triangle(s) ignored (they can never be hit)"
+                ));
             }
         }
         let lights = scene
@@ -177,7 +168,7 @@ impl RenderScene {
             .collect();
         let mut prepared = RenderScene {
             camera,
-            geometry: Geometry::build(prims),
+            geometry: Geometry::build(prims, normals),
             materials,
             lights,
             background: rgb(s.background),
@@ -228,4 +219,96 @@ impl RenderScene {
             ..self.clone()
         }
     }
+}
+
+/// Where an entity's shape goes: its transform, then the shift to camera-relative coordinates.
+struct Placement {
+    affine: DAffine3,
+    normal_matrix: DMat3,
+    origin: DVec3,
+    uniform_scale: f64,
+}
+
+impl Placement {
+    fn new(t: Option<&TransformDesc>, origin: DVec3) -> Self {
+        let affine = t.map_or(DAffine3::IDENTITY, TransformDesc::affine);
+        Placement {
+            affine,
+            normal_matrix: affine.matrix3.inverse().transpose(),
+            origin,
+            uniform_scale: t.map_or(1.0, |t| t.scale.0.x.abs()),
+        }
+    }
+
+    /// A point, transformed and made camera-relative.
+    fn point(&self, p: DVec3) -> Vec3A {
+        (self.affine.transform_point3(p) - self.origin).as_vec3a()
+    }
+
+    /// A normal, transformed by the inverse transpose and normalised.
+    fn normal(&self, n: DVec3) -> Vec3A {
+        (self.normal_matrix * n).normalize().as_vec3a()
+    }
+}
+
+/// Turn one shape description into prepared shapes, each with its vertex normals when smooth;
+/// returns how many zero-area triangles were dropped.
+fn flatten(
+    shape: &ShapeDesc,
+    mesh: Option<&LoadedMesh>,
+    at: &Placement,
+    push: &mut dyn FnMut(Shape, Option<[Vec3A; 3]>),
+) -> usize {
+    let mut dropped = 0;
+    let mut triangle = |v: [Vec3A; 3], n: Option<[Vec3A; 3]>| match Triangle::new(v[0], v[1], v[2])
+    {
+        Some(t) => push(Shape::Triangle(t), n),
+        None => dropped += 1,
+    };
+    match shape {
+        ShapeDesc::Sphere { center, radius } => push(
+            Shape::Sphere(Sphere {
+                c: at.point(center.0),
+                r: (radius.0 * at.uniform_scale) as f32,
+            }),
+            None,
+        ),
+        ShapeDesc::InfinitePlane { point, normal } => push(
+            Shape::Plane(Plane::through(at.point(point.0), at.normal(normal.0))),
+            None,
+        ),
+        ShapeDesc::Triangle { a, b, c } => {
+            triangle([at.point(a.0), at.point(b.0), at.point(c.0)], None)
+        }
+        ShapeDesc::TriangleMesh {
+            vertices,
+            faces,
+            normals,
+        } => {
+            let v: Vec<Vec3A> = vertices.iter().map(|p| at.point(p.0)).collect();
+            let n: Vec<Vec3A> = normals.iter().map(|d| at.normal(d.0)).collect();
+            for &(i, j, k) in faces.iter() {
+                let idx = [i as usize, j as usize, k as usize];
+                triangle(
+                    idx.map(|i| v[i]),
+                    (!n.is_empty()).then(|| idx.map(|i| n[i])),
+                );
+            }
+        }
+        ShapeDesc::Mesh { .. } => {
+            let Some(LoadedMesh(m)) = mesh else {
+                unreachable!("meshes are loaded with the scene")
+            };
+            let v: Vec<Vec3A> = m.positions.iter().map(|p| at.point(p.as_dvec3())).collect();
+            let n: Vec<Vec3A> = m.normals.iter().map(|d| at.normal(d.as_dvec3())).collect();
+            for f in &m.faces {
+                let idx = f.map(|i| i as usize);
+                triangle(
+                    idx.map(|i| v[i]),
+                    (!n.is_empty()).then(|| idx.map(|i| n[i])),
+                );
+            }
+        }
+    }
+    dropped
 }

@@ -51,6 +51,7 @@ fn transform(scene: &mut Scene, s: f64, t: DVec3) {
             ShapeDesc::InfinitePlane { point, .. } => f(point),
             ShapeDesc::Triangle { a, b, c } => [a, b, c].into_iter().for_each(f),
             ShapeDesc::TriangleMesh { vertices, .. } => vertices.iter_mut().for_each(f),
+            ShapeDesc::Mesh { .. } => unreachable!("the Cornell box has no OBJ meshes"),
         }
     }
     for light in scene.world.query_mut::<&mut LightDesc>() {

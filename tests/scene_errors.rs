@@ -5,7 +5,8 @@ use rtis::scene::{SceneError, load_path, load_str};
 use std::path::Path;
 
 fn error_of(text: &str) -> SceneError {
-    match load_str(text, "bad.ron", None) {
+    // Tests run in the package root: relative paths keep the messages machine-independent.
+    match load_str(text, "bad.ron", Some(Path::new(""))) {
         Ok(_) => panic!("expected an error for:\n{text}"),
         Err(e) => e,
     }
@@ -116,6 +117,26 @@ const CASES: &[(&str, &str)] = &[
     (
         "global depth too large",
         "Scene(shader: Global(max_depth: 17))",
+    ),
+    (
+        "non-uniform sphere scale",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Mirror(), transform: (scale: (1, 2, 1)))])",
+    ),
+    (
+        "zero scale",
+        "Scene(entities: [(shape: Triangle(a: (0, 0, 0), b: (1, 0, 0), c: (0, 1, 0)), material: Mirror(), transform: (scale: (1, 0, 1)))])",
+    ),
+    (
+        "normals count",
+        "Scene(entities: [(shape: TriangleMesh(vertices: [(0, 0, 0), (1, 0, 0), (0, 1, 0)], faces: [(0, 1, 2)], normals: [(0, 0, 1)]), material: Mirror())])",
+    ),
+    (
+        "missing mesh file",
+        "Scene(entities: [(shape: Mesh(path: \"tests/data/no-such-mesh.obj\"), material: Mirror())])",
+    ),
+    (
+        "malformed mesh file",
+        "Scene(entities: [(shape: Mesh(path: \"tests/data/malformed.obj\"), material: Mirror())])",
     ),
 ];
 

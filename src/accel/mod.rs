@@ -18,7 +18,12 @@ pub struct Prim {
     pub shape: Shape,
     /// Index into the prepared material array.
     pub material: u32,
+    /// Index into [`Geometry::normals`] of a smooth triangle's vertex normals, or [`FLAT`].
+    pub smooth: u32,
 }
+
+/// [`Prim::smooth`] of a primitive shaded with its geometric normal.
+pub const FLAT: u32 = u32::MAX;
 
 /// Scenes with at most this many spheres test them in packets instead of a BVH.
 pub const PACKED_SPHERES: usize = 16;
@@ -37,11 +42,14 @@ pub struct Geometry {
     pub spheres: Lanes<SphereLanes>,
     /// Infinite planes in packets of four.
     pub planes: Lanes<PlaneLanes>,
+    /// Vertex normals of smooth triangles.
+    pub normals: Vec<[glam::Vec3A; 3]>,
 }
 
 impl Geometry {
-    /// Sort the primitives into packets and a BVH.
-    pub fn build(prims: Vec<Prim>) -> Self {
+    /// Sort the primitives into packets and a BVH; `normals` holds the vertex normals that
+    /// smooth primitives refer to.
+    pub fn build(prims: Vec<Prim>, normals: Vec<[glam::Vec3A; 3]>) -> Self {
         let n_spheres = prims
             .iter()
             .filter(|p| p.shape.kind() == ShapeKind::Sphere)
@@ -80,6 +88,29 @@ impl Geometry {
             bvh,
             spheres: lanes::pack(&sphere_items, SphereLanes::pack),
             planes: lanes::pack(&plane_items, PlaneLanes::pack),
+            normals,
+        }
+    }
+
+    /// The shading normal at point `p` of primitive `prim` whose geometric normal is `n`:
+    /// the vertex normals interpolated with `p`'s barycentric coordinates for smooth
+    /// triangles, `n` otherwise.
+    #[inline]
+    pub fn shading_normal(&self, prim: &Prim, p: glam::Vec3A, n: glam::Vec3A) -> glam::Vec3A {
+        match (prim.smooth, prim.shape) {
+            (FLAT, _) => n,
+            (i, Shape::Triangle(t)) => {
+                let [n0, n1, n2] = self.normals[i as usize];
+                let (e1, e2, ep) = (t.v[1] - t.v[0], t.v[2] - t.v[0], p - t.v[0]);
+                let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+                let (d20, d21) = (ep.dot(e1), ep.dot(e2));
+                let det = d00 * d11 - d01 * d01;
+                let b1 = (d11 * d20 - d01 * d21) / det;
+                let b2 = (d00 * d21 - d01 * d20) / det;
+                let ns = ((1.0 - b1 - b2) * n0 + b1 * n1 + b2 * n2).normalize_or_zero();
+                if ns == glam::Vec3A::ZERO { n } else { ns }
+            }
+            _ => n,
         }
     }
 

@@ -27,7 +27,11 @@ pub fn run(path: &Path) -> Result<(), CliError> {
 
     let mut shapes: BTreeMap<&str, usize> = BTreeMap::new();
     let mut triangles = 0usize;
-    for shape in scene.world.query::<&ShapeDesc>().iter() {
+    for (shape, mesh) in scene
+        .world
+        .query::<(&ShapeDesc, Option<&scene::LoadedMesh>)>()
+        .iter()
+    {
         let k = match shape {
             ShapeDesc::Sphere { .. } => "Sphere",
             ShapeDesc::InfinitePlane { .. } => "InfinitePlane",
@@ -35,6 +39,10 @@ pub fn run(path: &Path) -> Result<(), CliError> {
             ShapeDesc::TriangleMesh { faces, .. } => {
                 triangles += faces.len();
                 "TriangleMesh"
+            }
+            ShapeDesc::Mesh { .. } => {
+                triangles += mesh.map_or(0, |m| m.0.faces.len());
+                "Mesh"
             }
         };
         *shapes.entry(k).or_default() += 1;

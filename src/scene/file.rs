@@ -1,7 +1,7 @@
 //! The scene file format: serde structs read from RON. Every struct rejects unknown fields;
 //! every optional field documents its default. `docs/scene-format.md` is the user's guide.
 
-use super::values::{Count, Direction, Fov, NonNegative, Point, Positive, Rgb, UpTo};
+use super::values::{Count, Direction, Fov, NonNegative, Point, Positive, Rgb, Scale, UpTo};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -428,7 +428,53 @@ pub enum ShapeDesc {
         vertices: Vec<Point>,
         /// Triangles as triples of indices into `vertices`.
         faces: Vec<(u32, u32, u32)>,
+        /// Optional per-vertex normals for smooth shading (same count as `vertices`).
+        #[serde(default)]
+        normals: Vec<Direction>,
     },
+    /// A Wavefront OBJ file, relative to the scene file's folder: positions, faces
+    /// (triangulated), and vertex normals for smooth shading when the file has them.
+    Mesh {
+        /// Path of the .obj file.
+        path: String,
+    },
+}
+
+/// A transform applied to an entity's shape: scale, then rotate (degrees about x, then y, then
+/// z), then translate. A sphere takes only a uniform scale.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(rename = "Transform", deny_unknown_fields)]
+pub struct TransformDesc {
+    /// Scale per axis (default `(1, 1, 1)`); no component zero.
+    #[serde(default = "unit_scale")]
+    pub scale: Scale,
+    /// Rotation in degrees about x, then y, then z (default none).
+    #[serde(default = "origin")]
+    pub rotate: Point,
+    /// Translation (default none).
+    #[serde(default = "origin")]
+    pub translate: Point,
+}
+
+fn unit_scale() -> Scale {
+    Scale(glam::DVec3::ONE)
+}
+fn origin() -> Point {
+    Point(glam::DVec3::ZERO)
+}
+
+impl TransformDesc {
+    /// The affine map `translate * Rz * Ry * Rx * scale`.
+    pub fn affine(&self) -> glam::DAffine3 {
+        use glam::DMat3;
+        let r = self.rotate.0 * (std::f64::consts::PI / 180.0);
+        let rot =
+            DMat3::from_rotation_z(r.z) * DMat3::from_rotation_y(r.y) * DMat3::from_rotation_x(r.x);
+        glam::DAffine3 {
+            matrix3: rot * DMat3::from_diagonal(self.scale.0),
+            translation: self.translate.0,
+        }
+    }
 }
 
 /// A light as written.
@@ -465,6 +511,9 @@ pub struct EntityFields {
     /// A light source.
     #[serde(default)]
     pub light: Option<LightDesc>,
+    /// Placement of the `shape` (default: as written).
+    #[serde(default)]
+    pub transform: Option<TransformDesc>,
 }
 
 impl TryFrom<EntityFields> for EntityDesc {
@@ -480,7 +529,31 @@ impl TryFrom<EntityFields> for EntityDesc {
             (None, Some(_), _) => Err(format!("{label} has a material but no shape")),
             (None, None, None) => Err(format!("{label} has no shape and no light")),
             _ => {
-                if let Some(ShapeDesc::TriangleMesh { vertices, faces }) = &e.shape {
+                if let (Some(ShapeDesc::Sphere { .. }), Some(t)) = (&e.shape, &e.transform) {
+                    let s = t.scale.0.abs();
+                    if s.x != s.y || s.y != s.z {
+                        return Err(format!(
+                            "{label}: a sphere takes only a uniform scale, got {}",
+                            t.scale.0
+                        ));
+                    }
+                }
+                if let Some(ShapeDesc::TriangleMesh {
+                    vertices, normals, ..
+                }) = &e.shape
+                    && !normals.is_empty()
+                    && normals.len() != vertices.len()
+                {
+                    return Err(format!(
+                        "{label}: {} normals for {} vertices: give one per vertex or none",
+                        normals.len(),
+                        vertices.len()
+                    ));
+                }
+                if let Some(ShapeDesc::TriangleMesh {
+                    vertices, faces, ..
+                }) = &e.shape
+                {
                     let n = vertices.len() as u64;
                     if let Some((i, f)) = faces
                         .iter()

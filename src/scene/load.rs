@@ -1,6 +1,8 @@
 //! Reading scene files, resolving `extends`, checking names, and filling the world.
 
-use super::file::{CameraDesc, EntityDesc, FilmDesc, MaterialDesc, SceneFile, ShaderDesc};
+use super::file::{
+    CameraDesc, EntityDesc, FilmDesc, MaterialDesc, SceneFile, ShaderDesc, ShapeDesc,
+};
 use super::{MaterialName, Name, Scene, SceneError, Settings, values::Rgb};
 use ron::extensions::Extensions;
 use std::collections::BTreeMap;
@@ -187,6 +189,18 @@ impl Resolved {
             }
             if let Some(shape) = &e.shape {
                 b.add(shape.clone());
+                if let ShapeDesc::Mesh { path } = shape {
+                    let s = &self.sources[*idx];
+                    let file = s.dir.clone().unwrap_or_default().join(path);
+                    let mesh = crate::mesh::load_obj(&file).map_err(|m| {
+                        let off = s.text.find(&format!("\"{path}\"")).unwrap_or(0);
+                        SceneError::at_offset(&s.name, &s.text, off, m)
+                    })?;
+                    b.add(super::LoadedMesh(std::sync::Arc::new(mesh)));
+                }
+            }
+            if let Some(t) = &e.transform {
+                b.add(*t);
             }
             if let Some(light) = &e.light {
                 b.add(*light);

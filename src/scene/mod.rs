@@ -11,7 +11,9 @@ mod load;
 pub mod values;
 
 pub use error::SceneError;
-pub use file::{CameraDesc, FilmDesc, LightDesc, MaterialDesc, Model, ShaderDesc, ShapeDesc};
+pub use file::{
+    CameraDesc, FilmDesc, LightDesc, MaterialDesc, Model, ShaderDesc, ShapeDesc, TransformDesc,
+};
 pub use load::{DEFAULT_SCENE, load_default, load_path, load_str};
 pub use values::Rgb;
 
@@ -42,10 +44,15 @@ pub struct Name(pub String);
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MaterialName(pub String);
 
+/// The triangles of a `Mesh` shape, loaded from its OBJ file when the scene was loaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedMesh(pub std::sync::Arc<crate::mesh::MeshData>);
+
 /// A loaded scene: an ECS world plus its resources.
 pub struct Scene {
     /// Entities with [`ShapeDesc`], [`MaterialDesc`] (always inline, never `Named`),
-    /// [`MaterialName`], [`LightDesc`] and [`Name`] components.
+    /// [`MaterialName`], [`LightDesc`], [`TransformDesc`], [`LoadedMesh`] and [`Name`]
+    /// components.
     pub world: hecs::World,
     /// Film, camera, shader, background, seed, model.
     pub settings: Settings,

@@ -199,3 +199,27 @@ impl<const MAX: u32> From<UpTo<MAX>> for u32 {
         c.0
     }
 }
+
+/// A scale `(sx, sy, sz)`: finite, no component zero (negative mirrors).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "[f64; 3]", into = "[f64; 3]")]
+pub struct Scale(pub DVec3);
+
+impl TryFrom<[f64; 3]> for Scale {
+    type Error = String;
+    fn try_from(v: [f64; 3]) -> Result<Self, String> {
+        let s = finite3(v)?;
+        if s.x == 0.0 || s.y == 0.0 || s.z == 0.0 {
+            return Err(format!(
+                "zero scale ({}, {}, {}): every component must be non-zero",
+                v[0], v[1], v[2]
+            ));
+        }
+        Ok(Scale(s))
+    }
+}
+impl From<Scale> for [f64; 3] {
+    fn from(p: Scale) -> Self {
+        p.0.to_array()
+    }
+}

@@ -17,7 +17,8 @@ pub struct Interaction {
     pub hit: Hit,
     /// Unit direction back along the incoming ray (towards the viewer).
     pub wo: Vec3A,
-    /// Unit normal on the side of `wo` (two-sided shading).
+    /// Unit shading normal on the side of `wo` (two-sided shading): the geometric normal, or
+    /// the interpolated vertex normal of a smooth triangle.
     pub n: Vec3A,
     /// The surface's material.
     pub material: Material,
@@ -28,8 +29,11 @@ impl Interaction {
     #[inline]
     pub fn new(tr: &Tracer, ray: &Ray, hit: Hit) -> Self {
         let wo = -ray.d;
-        let n = if hit.n.dot(wo) < 0.0 { -hit.n } else { hit.n };
         let prim = tr.scene.geometry.prim(hit.prim);
+        let ng = if hit.n.dot(wo) < 0.0 { -hit.n } else { hit.n };
+        // The shading normal stays on the viewer's side of the surface.
+        let ns = tr.scene.geometry.shading_normal(prim, hit.p, ng);
+        let n = if ns.dot(ng) < 0.0 { -ns } else { ns };
         Interaction {
             hit,
             wo,

@@ -1,0 +1,65 @@
+//! Wavefront OBJ through `tobj`.
+
+use super::MeshData;
+use glam::Vec3;
+use std::path::Path;
+
+/// Load every object of an OBJ file into one mesh: positions, normals when every vertex has one,
+/// faces triangulated. Errors are one line, ready to be placed after the scene location.
+pub fn load_obj(path: &Path) -> Result<MeshData, String> {
+    let options = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, _materials) = tobj::load_obj(path, &options)
+        .map_err(|e| format!("cannot load mesh {}: {e}", path.display()))?;
+    let mut mesh = MeshData::default();
+    let mut all_normals = true;
+    for m in &models {
+        let base = mesh.positions.len() as u32;
+        let p = &m.mesh.positions;
+        if p.len() % 3 != 0 || m.mesh.indices.len() % 3 != 0 {
+            return Err(format!(
+                "mesh {}: malformed object `{}`",
+                path.display(),
+                m.name
+            ));
+        }
+        mesh.positions
+            .extend(p.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        let n = &m.mesh.normals;
+        if n.len() == p.len() {
+            mesh.normals.extend(
+                n.chunks_exact(3)
+                    .map(|c| Vec3::new(c[0], c[1], c[2]).normalize_or_zero()),
+            );
+        } else {
+            all_normals = false;
+        }
+        mesh.faces.extend(
+            m.mesh
+                .indices
+                .chunks_exact(3)
+                .map(|f| [base + f[0], base + f[1], base + f[2]]),
+        );
+    }
+    if !all_normals || mesh.normals.contains(&Vec3::ZERO) {
+        mesh.normals.clear();
+    }
+    if let Some(bad) = mesh.positions.iter().find(|p| !p.is_finite()) {
+        return Err(format!("mesh {}: non-finite vertex {bad}", path.display()));
+    }
+    if mesh.faces.is_empty() {
+        return Err(format!("mesh {}: no faces", path.display()));
+    }
+    let n = mesh.positions.len() as u32;
+    if let Some(f) = mesh.faces.iter().find(|f| f.iter().any(|&i| i >= n)) {
+        return Err(format!(
+            "mesh {}: face {f:?} indexes past {n} vertices",
+            path.display()
+        ));
+    }
+    Ok(mesh)
+}
