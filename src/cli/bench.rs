@@ -5,7 +5,14 @@ use clap::Args;
 use rtis::RenderScene;
 use rtis::converge::{reference_shader, with_settings};
 use rtis::render::render;
+use glam::{Vec3, Vec3A};
+use rtis::accel::{FLAT, Geometry, Node, Prim};
+use rtis::geometry::Ray;
+use rtis::mesh::displaced_sphere;
+use rtis::sampling::{Sampler, hemisphere};
 use rtis::scene::load_default;
+use rtis::shape::{Shape, Triangle};
+use std::time::Instant;
 use rtis::shader::{Global, Shader};
 
 /// Arguments of `rtis bench`.
@@ -109,6 +116,87 @@ fn case(name: &str, scene: &RenderScene, runs: usize) {
     );
 }
 
+/// Mrays/s of `rays` run through `f` in parallel (chunks of 4096 rays).
+fn rate(rays: &[Ray], f: impl Fn(&Ray) -> bool + Sync) -> (f64, usize) {
+    use rayon::prelude::*;
+    let start = Instant::now();
+    let hits: usize = rays
+        .par_chunks(4096)
+        .map(|c| c.iter().filter(|r| f(r)).count())
+        .sum();
+    (rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6, hits)
+}
+
+/// BVH build time, memory per triangle and ray rates for procedural meshes of 10k, 100k and
+/// 1M triangles (a displaced sphere of radius 1 at the origin).
+fn meshes_section() {
+    println!("-- meshes: displaced sphere, 1M rays of each kind");
+    println!(
+        "{:>9} {:>9} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12}",
+        "triangles", "build s", "nodes", "BVH B/tri", "prim B", "camera", "shadow", "incoherent"
+    );
+    for n in [10_000usize, 100_000, 1_000_000] {
+        let mesh = displaced_sphere(n, Vec3::ZERO, 1.0, 0.05);
+        let prims: Vec<Prim> = mesh
+            .faces
+            .iter()
+            .filter_map(|f| {
+                let [a, b, c] = f.map(|i| Vec3A::from(mesh.positions[i as usize]));
+                Triangle::new(a, b, c).map(|t| Prim {
+                    shape: Shape::Triangle(t),
+                    material: 0,
+                    smooth: FLAT,
+                })
+            })
+            .collect();
+        let count = prims.len();
+        let start = Instant::now();
+        let g = Geometry::build(prims, Vec::new());
+        let build = start.elapsed().as_secs_f64();
+        let nodes = g.bvh.nodes.len();
+        let bvh_bytes = (nodes * std::mem::size_of::<Node>()) as f64 / count as f64;
+        // Camera rays: a pinhole at z = -3 through a 1000 x 1000 grid covering the sphere.
+        let eye = Vec3A::new(0.0, 0.0, -3.0);
+        let camera: Vec<Ray> = (0..1_000_000)
+            .map(|i| {
+                let (x, y) = ((i % 1000) as f32 / 500.0 - 1.0, (i / 1000) as f32 / 500.0 - 1.0);
+                Ray::new(eye, (Vec3A::new(1.2 * x, 1.2 * y, 3.0)).normalize())
+            })
+            .collect();
+        let (cam_rate, _) = rate(&camera, |r| g.intersect(r).is_some());
+        // Shadow rays from the visible surface towards a light at (2, 3, -3).
+        let light = Vec3A::new(2.0, 3.0, -3.0);
+        let shadow: Vec<Ray> = camera
+            .iter()
+            .filter_map(|r| g.intersect(r))
+            .map(|h| {
+                let to = light - h.p;
+                let w = to.normalize();
+                Ray::segment(h.p + h.n * h.err * if h.n.dot(w) > 0.0 { 1.0 } else { -1.0 }, w, to.length() * 0.9999)
+            })
+            .collect();
+        let (shadow_rate, _) = rate(&shadow, |r| g.occluded(r));
+        // Incoherent rays: random origins in the box [-2, 2]^3, random directions.
+        let mut s = Sampler::new(1, 2, 3);
+        let incoherent: Vec<Ray> = (0..1_000_000)
+            .map(|_| {
+                let o = Vec3A::new(s.next_f32(), s.next_f32(), s.next_f32()) * 4.0 - Vec3A::splat(2.0);
+                let (u, v) = s.next_2d();
+                let mut d = hemisphere::uniform(u, v);
+                if s.next_f32() < 0.5 {
+                    d.z = -d.z;
+                }
+                Ray::new(o, d)
+            })
+            .collect();
+        let (inc_rate, _) = rate(&incoherent, |r| g.intersect(r).is_some());
+        println!(
+            "{count:>9} {build:>9.3} {nodes:>8} {bvh_bytes:>9.1} {:>9} {cam_rate:>7.1} M/s {shadow_rate:>7.1} M/s {inc_rate:>9.1} M/s",
+            std::mem::size_of::<Prim>()
+        );
+    }
+}
+
 /// Run `rtis bench`.
 pub fn run(a: BenchArgs) -> Result<(), CliError> {
     if a.shrink == 0 {
@@ -120,14 +208,17 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         a.runs
     );
-    if a.section != "all" && a.section != "cornell" && a.section != "effects" {
-        return Err(format!("--section {}: use all, cornell or effects", a.section).into());
+    if !["all", "cornell", "effects", "meshes"].contains(&a.section.as_str()) {
+        return Err(format!("--section {}: use all, cornell, effects or meshes", a.section).into());
     }
-    if a.section != "cornell" {
+    if a.section == "all" || a.section == "meshes" {
+        meshes_section();
+    }
+    if a.section == "all" || a.section == "effects" {
         effects_section(&a.scenes, a.runs)?;
-        if a.section == "effects" {
-            return Ok(());
-        }
+    }
+    if a.section != "all" && a.section != "cornell" {
+        return Ok(());
     }
     let mut scene = load_default();
     scene.settings.film.width /= a.shrink;
