@@ -3,7 +3,8 @@
 
 use super::Prim;
 use crate::geometry::{Aabb, Ray};
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
+use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
 /// A flattened node. An interior node's first child follows it; `index` is its second child.
@@ -38,9 +39,28 @@ const STACK: usize = 128;
 /// tree's depth by `MEDIAN_DEPTH + log2(N)`.
 const MEDIAN_DEPTH: usize = 48;
 
+/// A primitive's box and index, 32 bytes, partitioned in place so the build reads memory in
+/// order.
+#[derive(Clone, Copy)]
 struct Item {
-    bounds: Aabb,
-    centroid: Vec3A,
+    min: Vec3,
+    prim: u32,
+    max: Vec3,
+    _pad: u32,
+}
+
+impl Item {
+    #[inline]
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.min.into(),
+            max: self.max.into(),
+        }
+    }
+    #[inline]
+    fn centroid(&self, axis: usize) -> f32 {
+        0.5 * (self.min[axis] + self.max[axis])
+    }
 }
 
 impl Bvh {
@@ -49,23 +69,33 @@ impl Bvh {
         if prims.is_empty() {
             return (Bvh::default(), prims);
         }
-        let items: Vec<Item> = prims
-            .iter()
-            .map(|p| {
-                let bounds = p
+        let mut items: Vec<Item> = prims
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let b = p
                     .shape
                     .bounds()
                     .expect("only bounded primitives go in the BVH");
                 Item {
-                    bounds,
-                    centroid: bounds.centroid(),
+                    min: b.min.into(),
+                    prim: i as u32,
+                    max: b.max.into(),
+                    _pad: 0,
                 }
             })
             .collect();
-        let mut order: Vec<u32> = (0..prims.len() as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * prims.len());
-        build_node(&items, &mut order, 0, 0, &mut nodes);
-        let sorted = order.iter().map(|&i| prims[i as usize]).collect();
+        let empty = Node {
+            min: Vec3::ZERO,
+            index: 0,
+            max: Vec3::ZERO,
+            count: 0,
+        };
+        let mut sparse = vec![empty; 2 * prims.len() - 1];
+        let bounds = fold_bounds(&items);
+        build_node(&mut items, 0, 0, &mut sparse, 0, bounds);
+        let nodes = compact(&sparse);
+        let sorted = items.par_iter().map(|it| prims[it.prim as usize]).collect();
         (Bvh { nodes }, sorted)
     }
 
@@ -180,103 +210,182 @@ impl Bvh {
     }
 }
 
-/// Build the subtree over `order` (indices into `items`); `offset` is where `order` starts in
-/// the final primitive array. Returns the node's index.
+/// Subtrees over more primitives than this are built in parallel.
+const PARALLEL_MIN: usize = 4096;
+
+/// Build the subtree over `order` (indices into `items`) into `slots`, which has room for
+/// `2 * order.len() - 1` nodes (more than a tree with multi-primitive leaves needs; unused slots
+/// stay empty and are compacted away). `offset` is where `order` starts in the final primitive
+/// array, `base` the index of `slots[0]` in the sparse array. The node is written to
+/// `slots[0]`; its left child is `base + 1`, its right child `base + 2 * left.len()`.
+///
+/// `(bounds, cbounds)` are the boxes of the items and of their centroids, passed down from the
+/// split that made this subtree so no pass over the items recomputes them.
 fn build_node(
-    items: &[Item],
-    order: &mut [u32],
+    order: &mut [Item],
     offset: usize,
     depth: usize,
-    nodes: &mut Vec<Node>,
-) -> usize {
-    let bounds = order
-        .iter()
-        .fold(Aabb::EMPTY, |b, &i| b.union(items[i as usize].bounds));
-    let me = nodes.len();
-    nodes.push(Node {
+    slots: &mut [Node],
+    base: usize,
+    (bounds, cbounds): (Aabb, Aabb),
+) {
+    slots[0] = Node {
         min: bounds.min.into(),
         index: offset as u32,
         max: bounds.max.into(),
         count: order.len() as u32,
-    });
+    };
     if order.len() <= 1 {
-        return me;
+        return;
     }
-    let cbounds = order
-        .iter()
-        .fold(Aabb::EMPTY, |b, &i| b.grow(items[i as usize].centroid));
     let extent = cbounds.max - cbounds.min;
     let axis = extent.max_position();
     let split = if extent[axis] > 0.0 && depth < MEDIAN_DEPTH {
-        best_split(items, order, &cbounds, axis, bounds.area())
+        best_split(order, &cbounds, axis, bounds.area())
     } else {
         None
     };
-    let mid = match split {
-        Some(bin) => {
+    let (mid, sides) = match split {
+        Some((bin, left, right)) => {
             let (lo, w) = (cbounds.min[axis], extent[axis]);
-            partition(order, |&i| {
-                bin_of(items[i as usize].centroid[axis], lo, w) <= bin
-            })
+            let scale = BINS as f32 / w;
+            let mid = partition(order, |it| bin_of(it.centroid(axis), lo, scale) <= bin);
+            (mid, Some((left, right)))
         }
         // No split beats a leaf: keep a leaf if it is small enough, else split the middle.
-        None if order.len() <= MAX_LEAF && depth < MEDIAN_DEPTH => return me,
+        None if order.len() <= MAX_LEAF && depth < MEDIAN_DEPTH => return,
         None => {
-            order.sort_by(|&a, &b| {
-                items[a as usize].centroid[axis].total_cmp(&items[b as usize].centroid[axis])
-            });
-            order.len() / 2
+            let k = order.len() / 2;
+            order.select_nth_unstable_by(k, |a, b| a.centroid(axis).total_cmp(&b.centroid(axis)));
+            (k, None)
         }
     };
-    let mid = if mid == 0 || mid == order.len() {
-        order.len() / 2
+    let (mid, sides) = if mid == 0 || mid == order.len() {
+        (order.len() / 2, None)
     } else {
-        mid
+        (mid, sides)
     };
-    let (left, right) = order.split_at_mut(mid);
-    build_node(items, left, offset, depth + 1, nodes);
-    let r = build_node(items, right, offset + mid, depth + 1, nodes);
-    nodes[me].index = r as u32;
-    nodes[me].count = 0;
-    me
+    let (left_bounds, right_bounds) =
+        sides.unwrap_or_else(|| (fold_bounds(&order[..mid]), fold_bounds(&order[mid..])));
+    let right_at = 2 * mid;
+    slots[0].index = (base + right_at) as u32;
+    slots[0].count = 0;
+    let parallel = order.len() > PARALLEL_MIN;
+    let (left_order, right_order) = order.split_at_mut(mid);
+    let (left_slots, right_slots) = slots[1..].split_at_mut(right_at - 1);
+    let mut left = move || {
+        build_node(
+            left_order,
+            offset,
+            depth + 1,
+            left_slots,
+            base + 1,
+            left_bounds,
+        )
+    };
+    let mut right = move || {
+        let at = base + right_at;
+        build_node(
+            right_order,
+            offset + mid,
+            depth + 1,
+            right_slots,
+            at,
+            right_bounds,
+        )
+    };
+    if parallel {
+        rayon::join(left, right);
+    } else {
+        left();
+        right();
+    }
+}
+
+/// Copy the reachable nodes of the sparse array into depth-first order, first child next to
+/// its parent.
+fn compact(sparse: &[Node]) -> Vec<Node> {
+    let mut out = Vec::with_capacity(sparse.len() / 2 + 1);
+    // (sparse index, index of the parent whose right child this is)
+    let mut stack = vec![(0usize, usize::MAX)];
+    while let Some((i, parent)) = stack.pop() {
+        let me = out.len();
+        if parent != usize::MAX {
+            out[parent] = Node {
+                index: me as u32,
+                ..out[parent]
+            };
+        }
+        let n = sparse[i];
+        out.push(n);
+        if n.count == 0 {
+            // Right child later (it patches our index), left child next.
+            stack.push((n.index as usize, me));
+            stack.push((i + 1, usize::MAX));
+        }
+    }
+    out
 }
 
 #[inline]
-fn bin_of(c: f32, lo: f32, w: f32) -> usize {
-    (((c - lo) / w * BINS as f32) as usize).min(BINS - 1)
+fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
+    (((c - lo) * scale) as usize).min(BINS - 1)
 }
 
-/// The bin after which to split along `axis`, if splitting is cheaper than a leaf by the SAH.
-fn best_split(items: &[Item], order: &[u32], cb: &Aabb, axis: usize, area: f32) -> Option<usize> {
-    let (lo, w) = (cb.min[axis], cb.max[axis] - cb.min[axis]);
-    let mut bins = [(Aabb::EMPTY, 0usize); BINS];
-    for &i in order {
-        let it = &items[i as usize];
-        let b = &mut bins[bin_of(it.centroid[axis], lo, w)];
-        b.0 = b.0.union(it.bounds);
-        b.1 += 1;
+/// Boxes of a set of items and of their centroids.
+fn fold_bounds(items: &[Item]) -> (Aabb, Aabb) {
+    items.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), it| {
+        let ib = it.bounds();
+        (b.union(ib), c.grow(ib.centroid()))
+    })
+}
+
+/// The bin after which to split along `axis`, with the item and centroid boxes of both sides,
+/// if splitting is cheaper than a leaf by the SAH.
+#[allow(clippy::type_complexity)]
+fn best_split(
+    order: &[Item],
+    cb: &Aabb,
+    axis: usize,
+    area: f32,
+) -> Option<(usize, (Aabb, Aabb), (Aabb, Aabb))> {
+    let (lo, scale) = (cb.min[axis], BINS as f32 / (cb.max[axis] - cb.min[axis]));
+    // Per bin: item box, centroid box, count.
+    let mut bins = [(Aabb::EMPTY, Aabb::EMPTY, 0usize); BINS];
+    for it in order {
+        let ib = it.bounds();
+        let b = &mut bins[bin_of(it.centroid(axis), lo, scale)];
+        b.0 = b.0.union(ib);
+        b.1 = b.1.grow(ib.centroid());
+        b.2 += 1;
     }
-    // Sweep from the right to get the cost of every right side, then from the left.
-    let mut right = [(0.0f32, 0usize); BINS];
-    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+    // Sweep from the right for every right side, then from the left.
+    let mut right = [((Aabb::EMPTY, Aabb::EMPTY), 0usize); BINS];
+    let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
     for k in (1..BINS).rev() {
-        acc = acc.union(bins[k].0);
-        cnt += bins[k].1;
-        right[k] = (acc.area(), cnt);
+        acc = (
+            acc.0.union(bins[k].0),
+            acc.1.union(bins[k].1),
+            acc.2 + bins[k].2,
+        );
+        right[k] = ((acc.0, acc.1), acc.2);
     }
-    let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-    let mut best = (f32::INFINITY, None);
+    let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
+    let mut best: (f32, Option<(usize, (Aabb, Aabb), (Aabb, Aabb))>) = (f32::INFINITY, None);
     for k in 0..BINS - 1 {
-        acc = acc.union(bins[k].0);
-        cnt += bins[k].1;
-        let (ra, rc) = right[k + 1];
-        if cnt == 0 || rc == 0 {
+        acc = (
+            acc.0.union(bins[k].0),
+            acc.1.union(bins[k].1),
+            acc.2 + bins[k].2,
+        );
+        let (rb, rc) = right[k + 1];
+        if acc.2 == 0 || rc == 0 {
             continue;
         }
         let cost = TRAVERSAL_COST
-            + (acc.area() * cnt as f32 + ra * rc as f32) / area.max(f32::MIN_POSITIVE);
+            + (acc.0.area() * acc.2 as f32 + rb.0.area() * rc as f32) / area.max(f32::MIN_POSITIVE);
         if cost < best.0 {
-            best = (cost, Some(k));
+            best = (cost, Some((k, (acc.0, acc.1), rb)));
         }
     }
     let leaf_cost = order.len() as f32;
@@ -288,7 +397,7 @@ fn best_split(items: &[Item], order: &[u32], cb: &Aabb, axis: usize, area: f32) 
 }
 
 /// Moves the elements for which `pred` holds to the front; returns how many there are.
-fn partition(v: &mut [u32], pred: impl Fn(&u32) -> bool) -> usize {
+fn partition(v: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
     let mut i = 0;
     for j in 0..v.len() {
         if pred(&v[j]) {

@@ -55,12 +55,24 @@ impl Geometry {
             .filter(|p| p.shape.kind() == ShapeKind::Sphere)
             .count();
         let pack_spheres = n_spheres <= PACKED_SPHERES;
-        let (planes, rest): (Vec<_>, Vec<_>) = prims
-            .into_iter()
-            .partition(|p| p.shape.kind() == ShapeKind::Plane);
-        let (spheres, for_bvh): (Vec<_>, Vec<_>) = rest
-            .into_iter()
-            .partition(|p| pack_spheres && p.shape.kind() == ShapeKind::Sphere);
+        let packed = |p: &Prim| match p.shape.kind() {
+            ShapeKind::Plane => true,
+            ShapeKind::Sphere => pack_spheres,
+            ShapeKind::Triangle => false,
+        };
+        // One pass, and none at all (the vector moves as is) when nothing is packed.
+        let (mut planes, mut spheres, mut for_bvh) = (Vec::new(), Vec::new(), Vec::new());
+        if prims.iter().any(packed) {
+            for p in prims {
+                match p.shape.kind() {
+                    ShapeKind::Plane => planes.push(p),
+                    ShapeKind::Sphere if pack_spheres => spheres.push(p),
+                    _ => for_bvh.push(p),
+                }
+            }
+        } else {
+            for_bvh = prims;
+        }
         let (bvh, mut all) = Bvh::build(for_bvh);
         let in_bvh = all.len();
         let sphere_items: Vec<_> = spheres

@@ -2,18 +2,18 @@
 
 use super::CliError;
 use clap::Args;
-use rtis::RenderScene;
-use rtis::converge::{reference_shader, with_settings};
-use rtis::render::render;
 use glam::{Vec3, Vec3A};
+use rtis::RenderScene;
 use rtis::accel::{FLAT, Geometry, Node, Prim};
+use rtis::converge::{reference_shader, with_settings};
 use rtis::geometry::Ray;
 use rtis::mesh::displaced_sphere;
+use rtis::render::render;
 use rtis::sampling::{Sampler, hemisphere};
 use rtis::scene::load_default;
+use rtis::shader::{Global, Shader};
 use rtis::shape::{Shape, Triangle};
 use std::time::Instant;
-use rtis::shader::{Global, Shader};
 
 /// Arguments of `rtis bench`.
 #[derive(Args, Debug)]
@@ -124,7 +124,10 @@ fn rate(rays: &[Ray], f: impl Fn(&Ray) -> bool + Sync) -> (f64, usize) {
         .par_chunks(4096)
         .map(|c| c.iter().filter(|r| f(r)).count())
         .sum();
-    (rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6, hits)
+    (
+        rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6,
+        hits,
+    )
 }
 
 /// BVH build time, memory per triangle and ray rates for procedural meshes of 10k, 100k and
@@ -159,7 +162,10 @@ fn meshes_section() {
         let eye = Vec3A::new(0.0, 0.0, -3.0);
         let camera: Vec<Ray> = (0..1_000_000)
             .map(|i| {
-                let (x, y) = ((i % 1000) as f32 / 500.0 - 1.0, (i / 1000) as f32 / 500.0 - 1.0);
+                let (x, y) = (
+                    (i % 1000) as f32 / 500.0 - 1.0,
+                    (i / 1000) as f32 / 500.0 - 1.0,
+                );
                 Ray::new(eye, (Vec3A::new(1.2 * x, 1.2 * y, 3.0)).normalize())
             })
             .collect();
@@ -172,7 +178,11 @@ fn meshes_section() {
             .map(|h| {
                 let to = light - h.p;
                 let w = to.normalize();
-                Ray::segment(h.p + h.n * h.err * if h.n.dot(w) > 0.0 { 1.0 } else { -1.0 }, w, to.length() * 0.9999)
+                Ray::segment(
+                    h.p + h.n * h.err * if h.n.dot(w) > 0.0 { 1.0 } else { -1.0 },
+                    w,
+                    to.length() * 0.9999,
+                )
             })
             .collect();
         let (shadow_rate, _) = rate(&shadow, |r| g.occluded(r));
@@ -180,7 +190,8 @@ fn meshes_section() {
         let mut s = Sampler::new(1, 2, 3);
         let incoherent: Vec<Ray> = (0..1_000_000)
             .map(|_| {
-                let o = Vec3A::new(s.next_f32(), s.next_f32(), s.next_f32()) * 4.0 - Vec3A::splat(2.0);
+                let o =
+                    Vec3A::new(s.next_f32(), s.next_f32(), s.next_f32()) * 4.0 - Vec3A::splat(2.0);
                 let (u, v) = s.next_2d();
                 let mut d = hemisphere::uniform(u, v);
                 if s.next_f32() < 0.5 {
@@ -209,7 +220,11 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
         a.runs
     );
     if !["all", "cornell", "effects", "meshes"].contains(&a.section.as_str()) {
-        return Err(format!("--section {}: use all, cornell, effects or meshes", a.section).into());
+        return Err(format!(
+            "--section {}: use all, cornell, effects or meshes",
+            a.section
+        )
+        .into());
     }
     if a.section == "all" || a.section == "meshes" {
         meshes_section();
