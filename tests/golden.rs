@@ -29,12 +29,6 @@ struct Golden {
     luminance: Vec<String>,
 }
 
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
-
 fn round4(v: f32) -> f32 {
     (v * 1e4).round() / 1e4
 }
@@ -93,7 +87,7 @@ fn golden_scenes() {
                 }
                 s => format!("{s:?}"),
             },
-            hash: format!("{:016x}", fnv1a(rgb8.as_raw())),
+            hash: format!("{:016x}", rtis::converge::metrics::fnv1a(rgb8.as_raw())),
             mean_rgb: [round4(mean.x), round4(mean.y), round4(mean.z)],
             luminance,
         };
