@@ -45,3 +45,31 @@ impl Material {
         !matches!(self, Material::Phong(_))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The assignment's `getDiffuseCoefficient()`: `kd` for Phong, nothing (and no warning) for
+    /// the others.
+    #[test]
+    fn diffuse_coefficient_of_each_material() {
+        let kd = Vec3A::new(0.7, 0.2, 0.3);
+        let phong = Material::Phong(Phong {
+            kd,
+            ks: Vec3A::splat(0.5),
+            shininess: 10.0,
+        });
+        assert_eq!(phong.diffuse_coefficient(), Some(kd));
+        assert!(!phong.is_specular());
+        let mirror = Material::Mirror(Mirror { color: Vec3A::ONE });
+        let glass = Material::Transmissive(Transmissive {
+            ior: 1.5,
+            color: Vec3A::ONE,
+        });
+        for m in [mirror, glass] {
+            assert_eq!(m.diffuse_coefficient(), None);
+            assert!(m.is_specular());
+        }
+    }
+}
