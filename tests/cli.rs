@@ -157,6 +157,20 @@ fn unwritable_or_unknown_output_fails_before_rendering() {
     let o = rtis(&["render", "--width", "0"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("must be at least 1"), "{}", stderr(&o));
+    let o = rtis(&["render", "--spp", "2000000"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("2000000 samples per pixel: at most 1048576"),
+        "{}",
+        stderr(&o)
+    );
+    let o = rtis(&["render", "--width", "40000", "--height", "1"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("at most 32768 pixels"),
+        "{}",
+        stderr(&o)
+    );
     let o = rtis(&["check", "no/such/scene.ron"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("cannot read scene file"));

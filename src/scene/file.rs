@@ -134,6 +134,15 @@ impl FilmDesc {
         if self.width == 0 || self.height == 0 || self.spp == 0 {
             return Err("film width, height and spp must be at least 1".into());
         }
+        if self.width > MAX_SIDE || self.height > MAX_SIDE {
+            return Err(format!(
+                "film of {}x{}: each side must be at most {MAX_SIDE} pixels",
+                self.width, self.height
+            ));
+        }
+        if self.spp > MAX_SPP {
+            return Err(format!("{} samples per pixel: at most {MAX_SPP}", self.spp));
+        }
         Ok(self)
     }
 }
