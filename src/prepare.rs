@@ -198,10 +198,10 @@ impl RenderScene {
     /// Simulate exactly `effects`: choose the kernel, and zero the ambient term and the
     /// background when they are off.
     pub fn set_effects(&mut self, effects: Effects) {
-        if !effects.ambient {
-            if let Shader::Global(g) = &mut self.shader {
-                g.ambient = Vec3A::ZERO;
-            }
+        if !effects.ambient
+            && let Shader::Global(g) = &mut self.shader
+        {
+            g.ambient = Vec3A::ZERO;
         }
         if !effects.background {
             self.background = Vec3A::ZERO;
