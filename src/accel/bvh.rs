@@ -105,7 +105,8 @@ impl Bvh {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut t_max = ray.t_max;
+        // One working copy of the ray whose `t_max` shrinks with each closer hit.
+        let mut r = *ray;
         let mut best = None;
         let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
         let mut sp = 0usize;
@@ -115,16 +116,15 @@ impl Bvh {
             if n.count > 0 {
                 let first = n.index as usize;
                 for (k, p) in prims[first..first + n.count as usize].iter().enumerate() {
-                    let r = Ray { t_max, ..*ray };
                     if let Some(t) = p.shape.intersect_in::<K>(&r) {
-                        t_max = t;
+                        r.t_max = t;
                         best = Some(((first + k) as u32, t));
                     }
                 }
             } else {
                 let (a, b) = (node + 1, n.index as usize);
-                let ta = self.box_hit(a, ray, t_max);
-                let tb = self.box_hit(b, ray, t_max);
+                let ta = self.box_hit(a, &r, r.t_max);
+                let tb = self.box_hit(b, &r, r.t_max);
                 match (ta, tb) {
                     (Some(ta), Some(tb)) => {
                         let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
@@ -151,7 +151,7 @@ impl Bvh {
             // SAFETY: entries below `sp` were written before `sp` was raised past them.
             node = unsafe { stack[sp].assume_init() } as usize;
             // Skip nodes that a closer hit found meanwhile has made irrelevant.
-            while self.box_hit(node, ray, t_max).is_none() {
+            while self.box_hit(node, &r, r.t_max).is_none() {
                 if sp == 0 {
                     return best;
                 }

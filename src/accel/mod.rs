@@ -55,20 +55,17 @@ impl Geometry {
             .filter(|p| p.shape.kind() == ShapeKind::Sphere)
             .count();
         let pack_spheres = n_spheres <= PACKED_SPHERES;
-        let packed = |p: &Prim| match p.shape.kind() {
-            ShapeKind::Plane => true,
-            ShapeKind::Sphere => pack_spheres,
-            ShapeKind::Triangle => false,
+        // Where each primitive goes: 0 plane packets, 1 sphere packets, 2 the BVH.
+        let bucket = |p: &Prim| match p.shape.kind() {
+            ShapeKind::Plane => 0,
+            ShapeKind::Sphere if pack_spheres => 1,
+            _ => 2,
         };
         // One pass, and none at all (the vector moves as is) when nothing is packed.
         let (mut planes, mut spheres, mut for_bvh) = (Vec::new(), Vec::new(), Vec::new());
-        if prims.iter().any(packed) {
+        if prims.iter().any(|p| bucket(p) != 2) {
             for p in prims {
-                match p.shape.kind() {
-                    ShapeKind::Plane => planes.push(p),
-                    ShapeKind::Sphere if pack_spheres => spheres.push(p),
-                    _ => for_bvh.push(p),
-                }
+                [&mut planes, &mut spheres, &mut for_bvh][bucket(&p)].push(p);
             }
         } else {
             for_bvh = prims;

@@ -130,12 +130,11 @@ pub fn load(path: &Path) -> Result<Image, OutputError> {
     let dynimg = image::open(path).map_err(err)?;
     let is_exr = matches!(format_of(path), Ok(ImageFormat::OpenExr));
     let rgb = dynimg.to_rgb32f();
-    let decode = |v: f32| {
-        if is_exr || v <= 0.040_45 {
-            if is_exr { v } else { v / 12.92 }
-        } else {
-            ((v + 0.055) / 1.055).powf(2.4)
-        }
+    // EXR is linear; PNG values are sRGB-encoded.
+    let decode = |v: f32| match (is_exr, v <= 0.040_45) {
+        (true, _) => v,
+        (false, true) => v / 12.92,
+        (false, false) => ((v + 0.055) / 1.055).powf(2.4),
     };
     Ok(Image {
         width: rgb.width(),

@@ -17,7 +17,7 @@
 //!   by `1 / eta^2`, as pbrt does for radiance.
 
 use super::Tracer;
-use super::surface::{Interaction, direct_light, reflectance};
+use super::surface::{Interaction, direct_light, reflectance, specular_bounce};
 use crate::effects::kernel;
 use crate::geometry::{Frame, Ray};
 use crate::material::{Material, Phong, fresnel_dielectric, reflect};
@@ -74,27 +74,9 @@ pub fn radiance<const K: u32>(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Ve
         if depth >= max_depth {
             break;
         }
-        // Scatter: the next direction wi and the weight g(wi) / pdf(wi).
-        let (wi, weight, next) = match si.material {
-            Material::Mirror(m) => (m.reflect(si.wo, si.n), m.color, RayKind::Reflection),
-            Material::Transmissive(g) => {
-                let r = g.refract(si.wo, si.hit.n);
-                match model {
-                    Model::Course if r.total_internal_reflection => {
-                        (r.wt, g.color, RayKind::Reflection)
-                    }
-                    Model::Course => (r.wt, g.color, RayKind::Refraction),
-                    Model::Physical => {
-                        let f = fresnel_dielectric(r.cos_i.abs(), r.eta);
-                        if tr.sampler.next_f32() < f {
-                            (reflect(si.wo, si.n), Vec3A::ONE, RayKind::Reflection)
-                        } else {
-                            (r.wt, g.color / (r.eta * r.eta), RayKind::Refraction)
-                        }
-                    }
-                }
-            }
-            Material::Phong(phong) => {
+        // Scatter: the next ray, its weight g(wi) / pdf(wi) and its kind.
+        let (next_ray, weight, next) = match (si.material, model) {
+            (Material::Phong(phong), _) => {
                 // Next-event estimation: Eq. 3 under the model.
                 l += beta * direct_light::<K>(tr, &si, &phong);
                 if K & kernel::INDIRECT == 0 {
@@ -103,18 +85,31 @@ pub fn radiance<const K: u32>(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Ve
                 let Some((wi, weight)) = sample_phong(tr, &phong, &si, model, p.sampling) else {
                     break;
                 };
-                (wi, weight, RayKind::Indirect)
+                (si.spawn(wi), weight, RayKind::Indirect)
             }
+            // Fresnel-weighted choice between reflection and refraction.
+            (Material::Transmissive(g), Model::Physical) => {
+                let r = g.refract(si.wo, si.hit.n);
+                let f = fresnel_dielectric(r.cos_i.abs(), r.eta);
+                let (wi, weight, kind, bit) = if tr.sampler.next_f32() < f {
+                    let wr = reflect(si.wo, si.n);
+                    (wr, Vec3A::ONE, RayKind::Reflection, kernel::REFLECTION)
+                } else {
+                    let w = g.color / (r.eta * r.eta);
+                    (r.wt, w, RayKind::Refraction, kernel::REFRACTION)
+                };
+                // An effect the kernel leaves out ends the path.
+                if K & bit == 0 {
+                    break;
+                }
+                (si.spawn(wi), weight, kind)
+            }
+            // Mirrors, and the course's glass: the one scattered ray, as in Direct and Global.
+            _ => match specular_bounce::<K>(&si) {
+                Some(bounce) => bounce,
+                None => break,
+            },
         };
-        // An effect the kernel leaves out ends the path.
-        let bit = match next {
-            RayKind::Reflection => kernel::REFLECTION,
-            RayKind::Refraction => kernel::REFRACTION,
-            _ => kernel::INDIRECT,
-        };
-        if K & bit == 0 {
-            break;
-        }
         beta *= weight;
         depth += 1;
         // Russian roulette: survive with probability q, divide by q to stay unbiased.
@@ -125,7 +120,7 @@ pub fn radiance<const K: u32>(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Ve
             }
             beta /= q;
         }
-        ray = si.spawn(wi);
+        ray = next_ray;
         kind = next;
     }
     l
