@@ -186,11 +186,8 @@ fn embedded_default_scene_is_the_course_cornell_box() {
     )
     .unwrap();
     assert_eq!(d.settings, f.settings);
-    assert!(matches!(
-        d.settings.shader,
-        rtis::scene::ShaderDesc::Global { .. }
-    ));
-    let p = rtis::RenderScene::prepare(&d);
+    assert!(matches!(d.settings.shader, rtis::shader::Shader::Global(_)));
+    let p = rtis::extract(&d);
     use rtis::shape::ShapeKind::*;
     assert_eq!(
         (

@@ -11,7 +11,7 @@ fn small_box() -> RenderScene {
     let mut s = rtis::scene::load_default();
     s.settings.film.width = 24;
     s.settings.film.height = 20;
-    RenderScene::prepare(&s)
+    rtis::extract(&s)
 }
 
 #[test]
@@ -74,7 +74,7 @@ fn course_ladder_sweeps_and_path_converges() {
 #[test]
 fn path_ladder_for_path_scenes() {
     let s = scene("Scene(film: (width: 8, height: 8), shader: Path(), entities: [])");
-    let rungs = converge::ladder(&RenderScene::prepare(&s));
+    let rungs = converge::ladder(&rtis::extract(&s));
     assert!(rungs.iter().all(|r| r.family.starts_with("Path")));
     assert_eq!(rungs.len(), 9);
 }

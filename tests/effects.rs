@@ -1,11 +1,8 @@
-//! Only the effects a scene calls for are simulated, and specialising the kernel on them changes
-//! no pixel.
+//! Only the effects a scene calls for are simulated, and the derived effects change no pixel.
 
 mod common;
 
 use common::{render_scene, scene, scenes_dir};
-use rtis::RenderScene;
-use rtis::effects::kernel;
 use rtis::render::render;
 use rtis::scene::load_path;
 use rtis::shape::Shape;
@@ -21,17 +18,15 @@ fn small(path: &str, w: u32) -> rtis::scene::Scene {
 
 #[test]
 fn derived_effects_of_the_course_scenes() {
-    let e = RenderScene::prepare(&small("cornell.ron", 8)).effects;
+    let e = rtis::extract(&small("cornell.ron", 8)).effects;
     assert!(e.shadows && e.reflection && e.refraction && e.indirect && e.ambient);
     assert!(e.spheres && e.planes && !e.triangles && !e.background);
-    let e = RenderScene::prepare(&small("cornell-direct.ron", 8)).effects;
+    let e = rtis::extract(&small("cornell-direct.ron", 8)).effects;
     assert!(!e.indirect && !e.ambient);
-    let e = RenderScene::prepare(&small("spheres.ron", 8)).effects;
+    let e = rtis::extract(&small("spheres.ron", 8)).effects;
     assert!(e.shadows && !e.reflection && !e.refraction && !e.triangles);
-    assert_eq!(
-        RenderScene::prepare(&small("spheres.ron", 8)).kernel,
-        kernel::SHADOWS | kernel::SPHERES
-    );
+    let e = rtis::extract(&small("spheres.ron", 8)).effects;
+    assert!(e.spheres && e.planes && !e.indirect && !e.ambient && !e.background);
 }
 
 #[test]
@@ -52,8 +47,8 @@ fn rays_follow_the_effects() {
     assert!(r.stats.indirect > 0);
     // Switched off on purpose.
     let mut s = small("cornell-two-bounce.ron", 24);
-    if let rtis::scene::ShaderDesc::Global { samples, .. } = &mut s.settings.shader {
-        samples.0 = 4;
+    if let rtis::shader::Shader::Global(g) = &mut s.settings.shader {
+        g.samples = 4;
     }
     s.settings.effects.shadows = Some(false);
     s.settings.effects.refraction = Some(false);
@@ -88,7 +83,7 @@ fn shadows_off_equals_no_occluders() {
     let bare = scene(&text(false, ""));
     let (r_off, r_on, r_bare) = (render_scene(&off), render_scene(&on), render_scene(&bare));
     assert_eq!(r_off.stats.shadow, 0);
-    let prepared = RenderScene::prepare(&off);
+    let prepared = rtis::extract(&off);
     let (mut floor, mut shadowed) = (0, 0);
     for row in 0..30 {
         for col in 0..40 {
@@ -131,7 +126,7 @@ fn indirect_off_is_the_ambient_shader() {
 #[test]
 fn impossible_requests_warn() {
     let s = scene("Scene(effects: (refraction: true, shadows: true), entities: [])");
-    let p = RenderScene::prepare(&s);
+    let p = rtis::extract(&s);
     assert!(
         p.warnings
             .iter()
@@ -143,11 +138,12 @@ fn impossible_requests_warn() {
     assert!(!p.effects.refraction);
 }
 
-/// Specialisation changes no pixel: every scene in `scenes/` renders bit-identically (and with
-/// the same ray counts) with its specialised kernel and with the all-effects kernel.
+/// The derived effects drop nothing a scene needs: every scene in `scenes/` renders
+/// bit-identically (and with the same ray counts) with its derived effects and with every
+/// effect on; and every scene lacks some effect, so the derivation is exercised.
 #[test]
-fn specialised_kernels_are_bit_identical() {
-    let mut specialised = 0;
+fn derived_effects_change_no_pixel() {
+    let mut derived = 0;
     for entry in std::fs::read_dir(scenes_dir()).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_none_or(|e| e != "ron") {
@@ -155,25 +151,22 @@ fn specialised_kernels_are_bit_identical() {
         }
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         let mut s = small(&name, 48);
-        if let rtis::scene::ShaderDesc::Global { samples, .. } = &mut s.settings.shader {
-            samples.0 = samples.0.min(8);
+        if let rtis::shader::Shader::Global(g) = &mut s.settings.shader {
+            g.samples = g.samples.min(8);
         }
-        let p = RenderScene::prepare(&s);
-        let all = p.unspecialised();
-        assert_eq!(all.kernel, kernel::ALL);
-        if p.kernel != kernel::ALL {
-            specialised += 1;
+        let p = rtis::extract(&s);
+        let all = p.with_every_effect();
+        assert_eq!(all.effects, rtis::effects::Effects::ALL);
+        if p.effects != all.effects {
+            derived += 1;
         }
         let (a, b) = (render(&p, &|| {}), render(&all, &|| {}));
         assert!(
             a.image == b.image,
-            "{name}: kernel {} differs from the unspecialised one",
-            p.kernel
+            "{name}: effects {} differ from every effect on",
+            p.effects
         );
         assert_eq!(a.stats, b.stats, "{name}");
     }
-    assert!(
-        specialised >= 7,
-        "every scene lacks some effect, so each runs a specialised kernel"
-    );
+    assert!(derived >= 7, "every scene lacks some effect");
 }

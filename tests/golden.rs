@@ -7,7 +7,8 @@ mod common;
 
 use common::{render_scene, scenes_dir};
 use rtis::render::output::to_rgb8;
-use rtis::scene::{ShaderDesc, load_path};
+use rtis::scene::load_path;
+use rtis::shader::Shader;
 use serde::Serialize;
 use std::path::Path;
 
@@ -27,6 +28,18 @@ struct Golden {
     mean_rgb: [f32; 3],
     /// Mean luminance per cell, in percent (0-99), one row of cells per string.
     luminance: Vec<String>,
+}
+
+/// The shader's name and its main parameters, as the snapshot shows them.
+fn describe(shader: &Shader) -> String {
+    match shader {
+        Shader::Global(g) => format!("Global(samples: {}, max_depth: {})", g.samples, g.max_depth),
+        Shader::Path(p) => format!(
+            "Path {{ max_depth: {:?}, rr_depth: {}, sampling: {:?} }}",
+            p.max_depth, p.rr_depth, p.sampling
+        ),
+        s => format!("{s:?}"),
+    }
 }
 
 fn round4(v: f32) -> f32 {
@@ -79,14 +92,7 @@ fn golden_scenes() {
             scene: format!("{name}.ron"),
             size: (w, h),
             spp: scene.settings.film.spp,
-            shader: match scene.settings.shader {
-                ShaderDesc::Global {
-                    samples, max_depth, ..
-                } => {
-                    format!("Global(samples: {}, max_depth: {})", samples.0, max_depth.0)
-                }
-                s => format!("{s:?}"),
-            },
+            shader: describe(&scene.settings.shader),
             hash: format!("{:016x}", rtis::converge::metrics::fnv1a(rgb8.as_raw())),
             mean_rgb: [round4(mean.x), round4(mean.y), round4(mean.z)],
             luminance,

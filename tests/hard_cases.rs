@@ -6,9 +6,8 @@ mod common;
 use common::{render_scene, render_str, scene, scenes_dir};
 use glam::{DVec3, Vec3A};
 use rtis::render::Rendered;
-use rtis::scene::file::CameraFields;
-use rtis::scene::values::{Point, Positive};
-use rtis::scene::{LightDesc, Scene, ShapeDesc, load_path};
+use rtis::scene::{Scene, load_path};
+use rtis::world::{WorldLight, WorldShape};
 
 fn finite(r: &Rendered) {
     assert!(r.image.all_finite(), "NaN or Inf in the image");
@@ -41,39 +40,25 @@ fn fraction_differing(a: &Rendered, b: &Rendered, tol: f32) -> f32 {
 /// Apply `x -> s x + t` to every position of the world and the camera: a system over the
 /// scene's components.
 fn transform(scene: &mut Scene, s: f64, t: DVec3) {
-    let f = |p: &mut Point| p.0 = p.0 * s + t;
-    for shape in scene.world.query_mut::<&mut ShapeDesc>() {
-        match shape {
-            ShapeDesc::Sphere { center, radius } => {
-                f(center);
-                *radius = Positive(radius.0 * s);
-            }
-            ShapeDesc::InfinitePlane { point, .. } => f(point),
-            ShapeDesc::Triangle { a, b, c } => [a, b, c].into_iter().for_each(f),
-            ShapeDesc::TriangleMesh { vertices, .. } => vertices.iter_mut().for_each(f),
-            ShapeDesc::Mesh { .. } => unreachable!("the Cornell box has no OBJ meshes"),
+    let f = |p: &mut DVec3| *p = *p * s + t;
+    for shape in scene.world.query_mut::<&mut WorldShape>() {
+        if let WorldShape::Sphere { radius, .. } = shape {
+            *radius *= s;
         }
+        shape.points_mut().into_iter().for_each(f);
     }
-    for light in scene.world.query_mut::<&mut LightDesc>() {
-        let LightDesc::Point {
+    for light in scene.world.query_mut::<&mut WorldLight>() {
+        let WorldLight::Point {
             position,
             intensity,
         } = light;
         f(position);
         // Keep the irradiance I / d^2 the same at the scaled distances.
-        intensity.0 *= s * s;
+        *intensity *= (s * s) as f32;
     }
-    match &mut scene.settings.camera.0 {
-        CameraFields::Perspective {
-            position, look_at, ..
-        }
-        | CameraFields::Orthographic {
-            position, look_at, ..
-        } => {
-            f(position);
-            f(look_at);
-        }
-    }
+    let camera = &mut scene.settings.camera;
+    f(&mut camera.position);
+    f(&mut camera.look_at);
 }
 
 fn small_cornell(file: &str) -> Scene {
@@ -92,8 +77,8 @@ fn small_cornell(file: &str) -> Scene {
 fn cornell_box_is_stable_under_translation_and_scale() {
     for file in ["cornell-direct.ron", "cornell-two-bounce.ron"] {
         let mut base = small_cornell(file);
-        if let rtis::scene::ShaderDesc::Global { samples, .. } = &mut base.settings.shader {
-            samples.0 = 8;
+        if let rtis::shader::Shader::Global(g) = &mut base.settings.shader {
+            g.samples = 8;
         }
         let reference = render_scene(&base);
         finite(&reference);
@@ -235,7 +220,7 @@ fn degenerate_triangle_is_ignored() {
         entities: [(name: "sliver", shape: Triangle(a: (0, 0, 5), b: (1, 1, 5), c: (2, 2, 5)),
                     material: Phong(kd: (1, 1, 1)))])"#,
     );
-    let prepared = rtis::RenderScene::prepare(&s);
+    let prepared = rtis::extract(&s);
     assert!(prepared.geometry.is_empty());
     assert!(
         prepared

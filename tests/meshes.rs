@@ -60,7 +60,7 @@ fn obj_round_trip_and_scene_loading() {
     )
     .unwrap();
     let s = rtis::scene::load_path(&d.join("s.ron")).unwrap();
-    let p = RenderScene::prepare(&s);
+    let p = rtis::extract(&s);
     assert_eq!(
         p.geometry.count(rtis::shape::ShapeKind::Triangle),
         m.faces.len()
@@ -150,7 +150,7 @@ fn transforms_place_shapes() {
         "Scene(entities: [(shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)), material: Mirror(),
                            transform: (rotate: (0, 0, 90), translate: (2, 0, 0)))])",
     );
-    let p = RenderScene::prepare(&s);
+    let p = rtis::extract(&s);
     let rtis::shape::Shape::Plane(pl) = p.geometry.prims[0].shape else {
         panic!()
     };
@@ -170,7 +170,7 @@ fn mesh_scene(n: usize) -> RenderScene {
     )
     .unwrap();
     std::fs::remove_dir_all(&d).unwrap();
-    RenderScene::prepare(&s)
+    rtis::extract(&s)
 }
 
 /// Watertight on a real mesh: 200000 rays from inside a closed mesh, in every direction, all

@@ -8,8 +8,9 @@ use glam::Vec3A;
 use proptest::prelude::*;
 use rtis::geometry::Frame;
 use rtis::material::{Phong, reflect};
+use rtis::sampling::Sampling;
 use rtis::sampling::{Sampler, hemisphere};
-use rtis::shader::{Sampling, path};
+use rtis::shader::path;
 use std::f32::consts::PI;
 
 /// A diffuse sphere filling the view, under a uniform background `b`, seen by the Path shader.

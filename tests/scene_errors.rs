@@ -195,17 +195,17 @@ fn extends_overrides_and_merges() {
     assert_eq!(s.settings.film.width, 10);
     assert!(matches!(
         s.settings.shader,
-        rtis::scene::ShaderDesc::Direct { .. }
+        rtis::shader::Shader::Direct { .. }
     ));
     assert_eq!(s.world.len(), 12);
     let mirrors: Vec<_> = s
         .world
-        .query::<&rtis::scene::MaterialDesc>()
+        .query::<&rtis::world::Material>()
         .iter()
         .filter_map(|m| match m {
-            rtis::scene::MaterialDesc::Mirror { color } => Some(color.0),
+            rtis::world::Material::Mirror(m) => Some(m.color),
             _ => None,
         })
         .collect();
-    assert_eq!(mirrors, vec![glam::DVec3::splat(0.5)]);
+    assert_eq!(mirrors, vec![glam::Vec3A::splat(0.5)]);
 }

@@ -101,7 +101,7 @@ impl Bvh {
 
     /// Nearest primitive hit: its index in `prims` and distance.
     #[inline]
-    pub fn closest<const K: u32>(&self, prims: &[Prim], ray: &Ray) -> Option<(u32, f32)> {
+    pub fn closest(&self, prims: &[Prim], ray: &Ray) -> Option<(u32, f32)> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -116,7 +116,7 @@ impl Bvh {
             if n.count > 0 {
                 let first = n.index as usize;
                 for (k, p) in prims[first..first + n.count as usize].iter().enumerate() {
-                    if let Some(t) = p.shape.intersect_in::<K>(&r) {
+                    if let Some(t) = p.shape.intersect(&r) {
                         r.t_max = t;
                         best = Some(((first + k) as u32, t));
                     }
@@ -165,7 +165,7 @@ impl Bvh {
 
     /// True if any primitive is hit within `(0, ray.t_max]`.
     #[inline]
-    pub fn any<const K: u32>(&self, prims: &[Prim], ray: &Ray) -> bool {
+    pub fn any(&self, prims: &[Prim], ray: &Ray) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
@@ -179,7 +179,7 @@ impl Bvh {
                     let first = n.index as usize;
                     if prims[first..first + n.count as usize]
                         .iter()
-                        .any(|p| p.shape.intersect_in::<K>(ray).is_some())
+                        .any(|p| p.shape.intersect(ray).is_some())
                     {
                         return true;
                     }

@@ -6,7 +6,6 @@ pub mod lanes;
 
 pub use bvh::{Bvh, Node};
 
-use crate::effects::kernel;
 use crate::geometry::{Hit, Ray};
 use crate::shape::{Shape, ShapeKind};
 use lanes::{Lanes, PlaneLanes, RayLanes, SphereLanes};
@@ -44,6 +43,9 @@ pub struct Geometry {
     pub planes: Lanes<PlaneLanes>,
     /// Vertex normals of smooth triangles.
     pub normals: Vec<[glam::Vec3A; 3]>,
+    /// True if the BVH holds triangles: its rays then need the watertight test's shear
+    /// constants.
+    pub has_triangles: bool,
 }
 
 impl Geometry {
@@ -70,6 +72,9 @@ impl Geometry {
         } else {
             for_bvh = prims;
         }
+        let has_triangles = for_bvh
+            .iter()
+            .any(|p| p.shape.kind() == ShapeKind::Triangle);
         let (bvh, mut all) = Bvh::build(for_bvh);
         let in_bvh = all.len();
         let sphere_items: Vec<_> = spheres
@@ -98,6 +103,7 @@ impl Geometry {
             spheres: lanes::pack(&sphere_items, SphereLanes::pack),
             planes: lanes::pack(&plane_items, PlaneLanes::pack),
             normals,
+            has_triangles,
         }
     }
 
@@ -142,22 +148,14 @@ impl Geometry {
     /// The nearest hit along `ray` within `(0, ray.t_max]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.intersect_in::<{ kernel::ALL }>(ray)
-    }
-
-    /// [`Geometry::intersect`] in render kernel `K`.
-    #[inline]
-    pub fn intersect_in<const K: u32>(&self, ray: &Ray) -> Option<Hit> {
         let mut t_max = ray.t_max;
         let mut best: Option<u32> = None;
         let lanes = RayLanes::new(ray.o, ray.d);
-        if K & kernel::SPHERES != 0 {
-            self.spheres
-                .closest(&lanes, &mut t_max, &mut best, SphereLanes::hit);
-        }
+        self.spheres
+            .closest(&lanes, &mut t_max, &mut best, SphereLanes::hit);
         if !self.bvh.nodes.is_empty() {
-            let r = ray.for_bvh(t_max, K & kernel::TRIANGLES != 0);
-            if let Some((i, t)) = self.bvh.closest::<K>(&self.prims[..self.in_bvh], &r) {
+            let r = ray.for_bvh(t_max, self.has_triangles);
+            if let Some((i, t)) = self.bvh.closest(&self.prims[..self.in_bvh], &r) {
                 t_max = t;
                 best = Some(i);
             }
@@ -178,19 +176,13 @@ impl Geometry {
     /// True if anything blocks `ray` within `(0, ray.t_max]` (any-hit query for shadow rays).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.occluded_in::<{ kernel::ALL }>(ray)
-    }
-
-    /// [`Geometry::occluded`] in render kernel `K`.
-    #[inline]
-    pub fn occluded_in<const K: u32>(&self, ray: &Ray) -> bool {
         let lanes = RayLanes::new(ray.o, ray.d);
-        (K & kernel::SPHERES != 0 && self.spheres.any(&lanes, ray.t_max, SphereLanes::hit))
+        self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
             || self.planes.any(&lanes, ray.t_max, PlaneLanes::hit)
             || (!self.bvh.nodes.is_empty()
-                && self.bvh.any::<K>(
+                && self.bvh.any(
                     &self.prims[..self.in_bvh],
-                    &ray.for_bvh(ray.t_max, K & kernel::TRIANGLES != 0),
+                    &ray.for_bvh(ray.t_max, self.has_triangles),
                 ))
     }
 }

@@ -10,7 +10,60 @@ pub use orthographic::Orthographic;
 pub use perspective::Perspective;
 
 use crate::geometry::Ray;
-use glam::Vec3A;
+use glam::{DVec3, Vec3A};
+
+/// How a camera projects: the part of a [`WorldCamera`] that is not its frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Pinhole perspective with vertical field of view `fov` in degrees, in (0, 180).
+    Perspective {
+        /// Vertical field of view, degrees.
+        fov: f64,
+    },
+    /// Parallel projection of an image rectangle `height` scene units tall.
+    Orthographic {
+        /// Vertical extent, scene units, > 0.
+        height: f64,
+    },
+}
+
+/// A camera as the world holds it: scene units, double precision.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldCamera {
+    /// The projection.
+    pub projection: Projection,
+    /// Centre of projection (perspective) or of the image rectangle (orthographic).
+    pub position: DVec3,
+    /// A point the camera looks at, not `position`.
+    pub look_at: DVec3,
+    /// Up hint, not parallel to `look_at - position`.
+    pub up: DVec3,
+}
+
+impl WorldCamera {
+    /// The camera of a render whose origin is this camera's position, for a film of
+    /// `aspect = width / height`.
+    pub fn extract(&self, aspect: f32) -> Camera {
+        let basis = Basis::look(
+            (self.look_at - self.position).as_vec3a(),
+            self.up.as_vec3a(),
+        );
+        match self.projection {
+            Projection::Perspective { fov } => Camera::Perspective(Perspective {
+                origin: Vec3A::ZERO,
+                basis,
+                tan_half_fov: (fov.to_radians() * 0.5).tan() as f32,
+                aspect,
+            }),
+            Projection::Orthographic { height } => Camera::Orthographic(Orthographic {
+                origin: Vec3A::ZERO,
+                basis,
+                height: height as f32,
+                aspect,
+            }),
+        }
+    }
+}
 
 /// The camera's orthonormal basis: `right x up` is `forward` in a left-handed sense, matching
 /// the course (right = up x forward).

@@ -24,8 +24,9 @@ pub struct BenchArgs {
     /// Divide the film size by this (for a quick look; 1 is the course's 720x576).
     #[arg(long, default_value_t = 1)]
     shrink: u32,
-    /// Which figures: `cornell` (the course's box), `effects` (specialised against all-effects
-    /// kernels for every scene in --scenes), or `all`.
+    /// Which figures: `cornell` (the course's box), `effects` (the time and error each effect
+    /// costs, for every scene in --scenes), `meshes` (BVH build and ray rates at 10k to 1M
+    /// triangles), or `all`.
     #[arg(long, default_value = "all")]
     section: String,
     /// Folder of scenes for the effects section.
@@ -33,30 +34,25 @@ pub struct BenchArgs {
     scenes: std::path::PathBuf,
 }
 
-fn median_seconds(scene: &RenderScene, runs: usize) -> (f64, rtis::render::stats::RayStats) {
+fn median_seconds(scene: &RenderScene, runs: usize) -> (f64, rtis::stats::RayStats) {
     let mut results: Vec<_> = (0..runs.max(1)).map(|_| render(scene, &|| {})).collect();
     results.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
     let r = &results[results.len() / 2];
     (r.seconds, r.stats)
 }
 
-/// Specialised kernel against the all-effects kernel for every scene in `dir`, at 360 pixels wide.
-fn effects_section(dir: &std::path::Path, runs: usize) -> Result<(), CliError> {
+/// What each effect costs: for every scene in `dir` at 360 pixels wide, the render with the
+/// effects the scene calls for, then with each of them switched off in turn: seconds, rays,
+/// and the error (RMSE) the saving brings.
+fn effects_section(dir: &std::path::Path, runs: usize, shrink: u32) -> Result<(), CliError> {
+    let width = (360 / shrink).max(1);
     println!(
-        "-- effects: specialised kernel against all-effects kernel, 360 px wide, median of {runs}"
+        "-- effects: the price of each effect, {width} px wide, median of {runs}: time and rays \
+         with it, and with it switched off (RMSE against the full render)"
     );
     println!(
-        "{:<26} {:>7} {:>10} {:>10} {:>7}  {:>8} {:>8} {:>7} {:>7} {:>9}",
-        "scene",
-        "kernel",
-        "special s",
-        "all s",
-        "ratio",
-        "camera",
-        "shadow",
-        "refl",
-        "refr",
-        "indirect"
+        "{:<26} {:<12} {:>9} {:>10} {:>7} {:>9}",
+        "scene", "effect off", "seconds", "Mrays", "speedup", "RMSE"
     );
     let mut paths: Vec<_> = std::fs::read_dir(dir)
         .map_err(|e| format!("{}: {e}", dir.display()))?
@@ -67,25 +63,44 @@ fn effects_section(dir: &std::path::Path, runs: usize) -> Result<(), CliError> {
     for path in paths {
         let mut scene = rtis::scene::load_path(&path)?;
         let f = &mut scene.settings.film;
-        f.height = ((360.0 * f.height as f64 / f.width as f64).round() as u32).max(1);
-        f.width = 360;
-        let special = RenderScene::prepare(&scene);
-        let all = special.unspecialised();
-        let (ts, s) = median_seconds(&special, runs);
-        let (ta, _) = median_seconds(&all, runs);
+        f.height = ((width as f64 * f.height as f64 / f.width as f64).round() as u32).max(1);
+        f.width = width;
+        let full = rtis::extract(&scene);
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        let (t_full, s_full) = median_seconds(&full, runs);
+        let reference = render(&full, &|| {}).image;
         println!(
-            "{:<26} {:>7} {:>10.3} {:>10.3} {:>7.2}  {:>8} {:>8} {:>7} {:>7} {:>9}",
-            path.file_name().unwrap_or_default().to_string_lossy(),
-            format!("{:06b}", special.kernel),
-            ts,
-            ta,
-            ta / ts.max(1e-9),
-            s.camera,
-            s.shadow,
-            s.reflection,
-            s.refraction,
-            s.indirect
+            "{name:<26} {:<12} {t_full:>9.3} {:>10.2} {:>7} {:>9}",
+            "(none)",
+            s_full.total() as f64 / 1e6,
+            "",
+            ""
         );
+        for (effect, on) in full.effects.named().into_iter().take(6) {
+            if !on {
+                continue;
+            }
+            let mut off = full.clone();
+            let mut effects = full.effects;
+            match effect {
+                "shadows" => effects.shadows = false,
+                "reflection" => effects.reflection = false,
+                "refraction" => effects.refraction = false,
+                "indirect" => effects.indirect = false,
+                "ambient" => effects.ambient = false,
+                _ => effects.background = false,
+            }
+            off.set_effects(effects);
+            let (t, st) = median_seconds(&off, runs);
+            let img = render(&off, &|| {}).image;
+            println!(
+                "{:<26} {effect:<12} {t:>9.3} {:>10.2} {:>7.2} {:>9.5}",
+                "",
+                st.total() as f64 / 1e6,
+                t_full / t.max(1e-9),
+                rtis::converge::metrics::rmse(&img, &reference)
+            );
+        }
     }
     Ok(())
 }
@@ -144,7 +159,7 @@ fn meshes_section() {
             .faces
             .iter()
             .filter_map(|f| {
-                let [a, b, c] = f.map(|i| Vec3A::from(mesh.positions[i as usize]));
+                let [a, b, c] = f.map(|i| mesh.positions[i as usize].as_vec3a());
                 Triangle::new(a, b, c).map(|t| Prim {
                     shape: Shape::Triangle(t),
                     material: 0,
@@ -230,7 +245,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
         meshes_section();
     }
     if a.section == "all" || a.section == "effects" {
-        effects_section(&a.scenes, a.runs)?;
+        effects_section(&a.scenes, a.runs, a.shrink)?;
     }
     if a.section != "all" && a.section != "cornell" {
         return Ok(());
@@ -238,7 +253,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     let mut scene = load_default();
     scene.settings.film.width /= a.shrink;
     scene.settings.film.height /= a.shrink;
-    let base = RenderScene::prepare(&scene);
+    let base = rtis::extract(&scene);
     let global = |samples, max_depth| {
         Shader::Global(Global {
             samples,

@@ -1,7 +1,8 @@
 //! `rtis check`.
 
 use super::CliError;
-use rtis::scene::{self, LightDesc, MaterialDesc, ShapeDesc, file::CameraFields};
+use rtis::scene;
+use rtis::world::{Material, MaterialName, Projection, WorldLight, WorldShape};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -14,34 +15,26 @@ pub fn run(path: &Path) -> Result<(), CliError> {
         "  film        {}x{}, {} spp, PNG transfer {:?}",
         s.film.width, s.film.height, s.film.spp, s.film.transfer
     );
-    let (pos, look, up) = s.camera.0.frame();
-    let kind = match s.camera.0 {
-        CameraFields::Perspective { fov, .. } => format!("perspective, fov {} deg", fov.0),
-        CameraFields::Orthographic { height, .. } => format!("orthographic, height {}", height.0),
+    let (pos, look, up) = (s.camera.position, s.camera.look_at, s.camera.up);
+    let kind = match s.camera.projection {
+        Projection::Perspective { fov } => format!("perspective, fov {fov} deg"),
+        Projection::Orthographic { height } => format!("orthographic, height {height}"),
     };
     println!("  camera      {kind}, at {pos} looking at {look}, up {up}");
     println!("  shader      {:?}", s.shader);
     println!("  model       {:?}", s.model);
-    println!("  background  {}", s.background.0);
+    println!("  background  {}", s.background);
     println!("  seed        {}", s.seed);
 
     let mut shapes: BTreeMap<&str, usize> = BTreeMap::new();
     let mut triangles = 0usize;
-    for (shape, mesh) in scene
-        .world
-        .query::<(&ShapeDesc, Option<&scene::LoadedMesh>)>()
-        .iter()
-    {
+    for shape in scene.world.query::<&WorldShape>().iter() {
         let k = match shape {
-            ShapeDesc::Sphere { .. } => "Sphere",
-            ShapeDesc::InfinitePlane { .. } => "InfinitePlane",
-            ShapeDesc::Triangle { .. } => "Triangle",
-            ShapeDesc::TriangleMesh { faces, .. } => {
-                triangles += faces.len();
-                "TriangleMesh"
-            }
-            ShapeDesc::Mesh { .. } => {
-                triangles += mesh.map_or(0, |m| m.0.faces.len());
+            WorldShape::Sphere { .. } => "Sphere",
+            WorldShape::Plane { .. } => "InfinitePlane",
+            WorldShape::Triangle { .. } => "Triangle",
+            WorldShape::Mesh(m) => {
+                triangles += m.faces.len();
                 "Mesh"
             }
         };
@@ -57,15 +50,14 @@ pub fn run(path: &Path) -> Result<(), CliError> {
     let mut materials: BTreeMap<String, (String, usize)> = BTreeMap::new();
     for (m, name) in scene
         .world
-        .query::<(&MaterialDesc, Option<&scene::MaterialName>)>()
+        .query::<(&Material, Option<&MaterialName>)>()
         .iter()
     {
         let key = name.map_or_else(|| "(inline)".to_string(), |n| n.0.clone());
         let kind = match m {
-            MaterialDesc::Phong { .. } => "Phong",
-            MaterialDesc::Mirror { .. } => "Mirror",
-            MaterialDesc::Transmissive { .. } => "Transmissive",
-            MaterialDesc::Named(_) => "Named",
+            Material::Phong(_) => "Phong",
+            Material::Mirror(_) => "Mirror",
+            Material::Transmissive(_) => "Transmissive",
         };
         let e = materials
             .entry(format!("{key} [{kind}]"))
@@ -76,16 +68,16 @@ pub fn run(path: &Path) -> Result<(), CliError> {
     for (k, (_, n)) in &materials {
         println!("    {k}: {n} entities");
     }
-    let lights: Vec<_> = scene.world.query::<&LightDesc>().iter().copied().collect();
+    let lights: Vec<_> = scene.world.query::<&WorldLight>().iter().copied().collect();
     println!("  lights      {}", lights.len());
     for l in lights {
-        let LightDesc::Point {
+        let WorldLight::Point {
             position,
             intensity,
         } = l;
-        println!("    Point at {} intensity {} W/sr", position.0, intensity.0);
+        println!("    Point at {position} intensity {intensity} W/sr");
     }
-    let prepared = rtis::RenderScene::prepare(&scene);
+    let prepared = rtis::extract(&scene);
     println!("  effects     {}", prepared.effects);
     for w in scene.warnings.iter().chain(&prepared.warnings) {
         println!("warning: {w}");

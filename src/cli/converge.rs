@@ -2,7 +2,6 @@
 
 use super::{CliError, load};
 use clap::Args;
-use rtis::RenderScene;
 use rtis::converge::{self, plot};
 use rtis::render::{self, output};
 use std::path::PathBuf;
@@ -47,7 +46,7 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
     }
     std::fs::create_dir_all(&a.out)
         .map_err(|e| format!("{}: cannot create output folder: {e}", a.out.display()))?;
-    let prepared = RenderScene::prepare(&scene);
+    let prepared = rtis::extract(&scene);
 
     let reference = match &a.reference {
         Some(path) => {

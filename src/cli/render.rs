@@ -3,9 +3,8 @@
 use super::{CliError, load};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use rtis::RenderScene;
-use rtis::render::{self, output};
-use rtis::scene::file::{FilmDesc, Transfer};
+use rtis::render::output::Transfer;
+use rtis::render::{self, Film, output};
 use std::path::PathBuf;
 
 /// Arguments of `rtis render`.
@@ -37,10 +36,6 @@ pub struct RenderArgs {
     /// Write the ray statistics as JSON to this file.
     #[arg(long)]
     stats: Option<PathBuf>,
-    /// Debug switch: run the all-effects kernel instead of the one specialised on the scene's
-    /// effects (same image, for measuring what specialisation saves).
-    #[arg(long)]
-    unspecialised: bool,
 }
 
 fn parse_transfer(s: &str) -> Result<Transfer, String> {
@@ -55,7 +50,7 @@ fn parse_transfer(s: &str) -> Result<Transfer, String> {
 pub fn run(a: RenderArgs) -> Result<(), CliError> {
     let mut scene = load(a.scene.as_deref())?;
     let film = &mut scene.settings.film;
-    let overridden = FilmDesc {
+    let overridden = Film {
         width: a.width.unwrap_or(film.width),
         height: a.height.unwrap_or(film.height),
         spp: a.spp.unwrap_or(film.spp),
@@ -81,10 +76,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
 
-    let mut prepared = RenderScene::prepare(&scene);
-    if a.unspecialised {
-        prepared = prepared.unspecialised();
-    }
+    let prepared = rtis::extract(&scene);
     for w in &prepared.warnings {
         eprintln!("warning: {w}");
     }
@@ -117,7 +109,6 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
             "threads": pool.current_num_threads(),
             "rays": result.stats,
             "effects": prepared.effects,
-            "kernel": prepared.kernel,
             "total_rays": result.stats.total(),
             "mrays_per_second": result.mrays_per_second(),
         }))?;

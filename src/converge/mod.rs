@@ -4,10 +4,10 @@
 pub mod metrics;
 pub mod plot;
 
-use crate::prepare::RenderScene;
-use crate::render::{film::Image, render};
-use crate::scene::Model;
-use crate::shader::{Global, Path, Sampling, Shader};
+use crate::material::Model;
+use crate::render::{RenderScene, film::Image, render};
+use crate::sampling::Sampling;
+use crate::shader::{Global, Path, Shader};
 use std::fmt::Write as _;
 
 /// One setting of the ladder.

@@ -1,9 +1,12 @@
-//! Rays, bounding boxes, orthonormal frames and the robust ray-offset rule.
+//! Leaf maths: rays, bounding boxes, orthonormal frames, placements, and the robust ray-offset
+//! rule.
 
 mod aabb;
 mod frame;
+mod placement;
 mod ray;
 
 pub use aabb::Aabb;
 pub use frame::Frame;
+pub use placement::{Placement, Transform};
 pub use ray::{Hit, OFFSET_ULPS, Ray, offset_origin};

@@ -1,10 +1,13 @@
 //! The closed set of lights. Each variant lives in its own file; [`Light`] dispatches by `match`.
+//!
+//! [`WorldLight`] is the ECS component (scene units, double precision); [`WorldLight::extract`]
+//! makes the camera-relative [`Light`] that shaders use.
 
 mod point;
 
 pub use point::PointLight;
 
-use glam::Vec3A;
+use glam::{DVec3, Vec3A};
 
 /// Light arriving at a point from one light: unit direction towards the light, distance to it,
 /// and incident radiance.
@@ -16,6 +19,33 @@ pub struct Incident {
     pub dist: f32,
     /// Incident radiance `L_i` (for a point light `I / d^2`).
     pub li: Vec3A,
+}
+
+/// A light as the world holds it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum WorldLight {
+    /// An isotropic point light.
+    Point {
+        /// Position, scene units.
+        position: DVec3,
+        /// Radiant intensity, W/sr per channel.
+        intensity: Vec3A,
+    },
+}
+
+impl WorldLight {
+    /// The light in render coordinates, whose origin is the world point `origin`.
+    pub fn extract(&self, origin: DVec3) -> Light {
+        match *self {
+            WorldLight::Point {
+                position,
+                intensity,
+            } => Light::Point(PointLight {
+                position: (position - origin).as_vec3a(),
+                intensity,
+            }),
+        }
+    }
 }
 
 /// A prepared light.

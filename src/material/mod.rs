@@ -6,10 +6,12 @@
 //! side of `wo`.
 
 mod mirror;
+mod model;
 pub mod phong;
 mod transmissive;
 
 pub use mirror::Mirror;
+pub use model::Model;
 pub use phong::{Phong, reflect};
 pub use transmissive::{Refraction, Transmissive, fresnel_dielectric};
 

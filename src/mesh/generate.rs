@@ -2,7 +2,7 @@
 //! no committed mesh files.
 
 use super::MeshData;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::f32::consts::{PI, TAU};
 use std::io::Write;
 use std::path::Path;
@@ -28,13 +28,13 @@ pub fn displaced_sphere(triangles: usize, center: Vec3, radius: f32, bump: f32) 
         center + dir * radius * h
     };
     // Poles, then rings 1..rings-1 of `segments` vertices each.
-    mesh.positions.push(vertex(0.0, 0.0));
-    mesh.positions.push(vertex(PI, 0.0));
+    mesh.positions.push(vertex(0.0, 0.0).as_dvec3());
+    mesh.positions.push(vertex(PI, 0.0).as_dvec3());
     for i in 1..rings {
         let theta = PI * i as f32 / rings as f32;
         for j in 0..segments {
             mesh.positions
-                .push(vertex(theta, TAU * j as f32 / segments as f32));
+                .push(vertex(theta, TAU * j as f32 / segments as f32).as_dvec3());
         }
     }
     let at = |i: usize, j: usize| (2 + (i - 1) * segments + j % segments) as u32;
@@ -55,8 +55,8 @@ pub fn displaced_sphere(triangles: usize, center: Vec3, radius: f32, bump: f32) 
 
 /// Area-weighted vertex normals: the sum of the (unnormalised) normals of the faces around each
 /// vertex, normalised.
-pub fn vertex_normals(positions: &[Vec3], faces: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut n = vec![Vec3::ZERO; positions.len()];
+pub fn vertex_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut n = vec![DVec3::ZERO; positions.len()];
     for f in faces {
         let [a, b, c] = f.map(|i| positions[i as usize]);
         let face = (b - a).cross(c - a);
@@ -64,7 +64,7 @@ pub fn vertex_normals(positions: &[Vec3], faces: &[[u32; 3]]) -> Vec<Vec3> {
             n[i as usize] += face;
         }
     }
-    n.into_iter().map(Vec3::normalize_or_zero).collect()
+    n.into_iter().map(DVec3::normalize_or_zero).collect()
 }
 
 /// Write a mesh as Wavefront OBJ (positions, normals if any, 1-based faces).

@@ -1,7 +1,7 @@
 //! Wavefront OBJ through `tobj`.
 
 use super::MeshData;
-use glam::Vec3;
+use glam::DVec3;
 use std::path::Path;
 
 /// Load every object of an OBJ file into one mesh: positions, normals when every vertex has one,
@@ -27,14 +27,16 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
                 m.name
             ));
         }
-        mesh.positions
-            .extend(p.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        mesh.positions.extend(
+            p.chunks_exact(3)
+                .map(|c| DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)),
+        );
         let n = &m.mesh.normals;
         if n.len() == p.len() {
-            mesh.normals.extend(
-                n.chunks_exact(3)
-                    .map(|c| Vec3::new(c[0], c[1], c[2]).normalize_or_zero()),
-            );
+            mesh.normals
+                .extend(n.chunks_exact(3).map(|c| {
+                    DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64).normalize_or_zero()
+                }));
         } else {
             all_normals = false;
         }
@@ -45,7 +47,7 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
                 .map(|f| [base + f[0], base + f[1], base + f[2]]),
         );
     }
-    if !all_normals || mesh.normals.contains(&Vec3::ZERO) {
+    if !all_normals || mesh.normals.contains(&DVec3::ZERO) {
         mesh.normals.clear();
     }
     if let Some(bad) = mesh.positions.iter().find(|p| !p.is_finite()) {

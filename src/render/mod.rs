@@ -1,17 +1,20 @@
-//! Rendering: tiles of pixels traced in parallel with rayon, each pixel with its own random
-//! stream, so the image is bit-identical for any thread count and tile order.
+//! Rendering: the render scene and its effects, tiles of pixels traced in parallel with rayon,
+//! each pixel with its own random stream, so the image is bit-identical for any thread count and
+//! tile order; then the image and its output files.
 
+pub mod effects;
 pub mod film;
 pub mod output;
-pub mod stats;
+mod scene;
 
-use crate::prepare::RenderScene;
+pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};
+
 use crate::sampling::{Sampler, pixel_sample};
-use crate::shader::{Tracer, radiance};
+use crate::shader::radiance;
+use crate::stats::RayStats;
 use film::Image;
 use glam::Vec3A;
 use rayon::prelude::*;
-use stats::RayStats;
 use std::time::Instant;
 
 /// Side of a square tile in pixels.
@@ -35,15 +38,9 @@ impl Rendered {
     }
 }
 
-/// The colour of pixel `(col, row)`: the mean radiance of its `spp` camera samples, traced by
-/// render kernel `K`.
+/// The colour of pixel `(col, row)`: the mean radiance of its `spp` camera samples.
 #[inline]
-pub fn render_pixel<const K: u32>(
-    scene: &RenderScene,
-    col: u32,
-    row: u32,
-    stats: &mut RayStats,
-) -> Vec3A {
+pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStats) -> Vec3A {
     let film = &scene.film;
     let pixel = row as u64 * film.width as u64 + col as u64;
     let mut sum = Vec3A::ZERO;
@@ -53,30 +50,14 @@ pub fn render_pixel<const K: u32>(
         let u = (col as f32 + dx) / film.width as f32;
         let v = (row as f32 + dy) / film.height as f32;
         let ray = scene.camera.ray(u, v);
-        let mut tracer = Tracer {
-            scene,
-            sampler,
-            stats,
-        };
-        sum += radiance::<K>(&mut tracer, &ray);
+        let mut tracer = scene.tracer(sampler, stats);
+        sum += radiance(&scene.shader, &mut tracer, &ray);
     }
     sum / film.spp as f32
 }
 
 /// Render the scene on the current rayon pool; `on_tile` is called after each tile (progress).
-///
-/// The kernel is chosen here, once per render, from `scene.kernel`: each of the 64 effect sets
-/// is its own monomorphised copy of the loop below (see [`crate::effects`]).
 pub fn render(scene: &RenderScene, on_tile: &(dyn Fn() + Sync)) -> Rendered {
-    seq_macro::seq!(K in 0..64 {
-        match scene.kernel {
-            #( K => render_kernel::<K>(scene, on_tile), )*
-            k => unreachable!("render kernels have 6 bits, got {k}"),
-        }
-    })
-}
-
-fn render_kernel<const K: u32>(scene: &RenderScene, on_tile: &(dyn Fn() + Sync)) -> Rendered {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
     let tiles_x = w.div_ceil(TILE);
@@ -90,7 +71,7 @@ fn render_kernel<const K: u32>(scene: &RenderScene, on_tile: &(dyn Fn() + Sync))
             let mut px = Vec::with_capacity((TILE * TILE) as usize);
             for row in y0..(y0 + TILE).min(h) {
                 for col in x0..(x0 + TILE).min(w) {
-                    px.push(render_pixel::<K>(scene, col, row, &mut stats));
+                    px.push(render_pixel(scene, col, row, &mut stats));
                 }
             }
             on_tile();

@@ -2,9 +2,19 @@
 //! through a temporary file renamed into place, so no half-written file is ever left behind.
 
 use super::film::Image;
-use crate::scene::file::Transfer;
 use image::{ImageFormat, Rgb32FImage, RgbImage};
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// How 8-bit PNG values are made from linear radiance (EXR output is always linear float).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+pub enum Transfer {
+    /// The sRGB curve after clamping to [0, 1]: what screens expect.
+    #[default]
+    Srgb,
+    /// `min(v, 1) * 255`, no curve: the course's BMP output.
+    Linear,
+}
 
 /// An image that could not be written.
 #[derive(Debug, thiserror::Error)]

@@ -1,8 +1,10 @@
-//! Random numbers and sample warps.
+//! Random numbers, sample warps and sampling strategies.
 
 pub mod hemisphere;
 mod pixel;
 mod rng;
+mod strategy;
 
 pub use pixel::pixel_sample;
 pub use rng::Sampler;
+pub use strategy::Sampling;

@@ -1,34 +1,48 @@
 //! The scene file format: serde structs read from RON. Every struct rejects unknown fields;
 //! every optional field documents its default. `docs/scene-format.md` is the user's guide.
+//!
+//! The format knows no runtime types: it names only leaf enums (the model, the sampling
+//! strategy, the PNG transfer) and converts each description into the world's own component
+//! type (`to_world`), which `super::load` puts into the world.
 
 use super::values::{Count, Direction, Fov, NonNegative, Point, Positive, Rgb, Scale, UpTo};
+use crate::camera::{Projection, WorldCamera};
+use crate::effects::Switches;
+use crate::geometry::Transform;
+use crate::light::WorldLight;
+use crate::material::{Material, Mirror, Phong, Transmissive};
+use crate::mesh::MeshData;
+use crate::render::{Film, MAX_SIDE, MAX_SPP};
+use crate::shader::{Global, Path, Shader};
+use crate::shape::WorldShape;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
-/// Largest image side in pixels.
-pub const MAX_SIDE: u32 = 1 << 15;
-/// Largest pixel count (8192 x 8192): the film holds 12 bytes per pixel.
-pub const MAX_PIXELS: u64 = 1 << 26;
-/// Largest samples per pixel.
-pub const MAX_SPP: u32 = 1 << 20;
+pub use crate::material::Model;
+pub use crate::render::output::Transfer;
+pub use crate::sampling::Sampling;
+
 /// Largest hemisphere sample count of the Global shader.
 pub const MAX_GLOBAL_SAMPLES: u32 = 1 << 16;
 /// Largest `max_depth` of the Global shader: its rays grow as `n * 2^(D-1)` per pixel.
-pub const MAX_GLOBAL_DEPTH: u32 = 16;
-/// Largest `max_depth` of the Path shader.
-pub const MAX_PATH_DEPTH: u32 = 1024;
+pub const MAX_GLOBAL_DEPTH: u32 = crate::shader::global::MAX_DEPTH;
+/// Largest `max_depth` and `rr_depth` of the Path shader.
+pub const MAX_PATH_DEPTH: u32 = crate::shader::path::MAX_DEPTH;
+/// Largest `max_specular` of the Direct and Global shaders.
+pub const MAX_SPECULAR: u32 = crate::shader::MAX_SPECULAR;
 
 /// One scene file as written. Every field is optional: a file that `extends` a base scene
 /// overrides the base's film, camera, shader, background, seed and model, adds or replaces
 /// materials by name, replaces the base's entities that have the same `name`, and appends the
 /// others.
-#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(rename = "Scene", deny_unknown_fields)]
 pub struct SceneFile {
     /// A base scene to start from, relative to this file's folder.
     #[serde(default)]
     pub extends: Option<String>,
-    /// Image size and sampling. Default: [`FilmDesc::default`].
+    /// Image size and sampling. Default: `Film(width: 720, height: 576, spp: 1, transfer: Srgb)`.
     #[serde(default)]
     pub film: Option<FilmDesc>,
     /// The camera. Default: perspective at the origin looking down +z, fov 60.
@@ -48,40 +62,20 @@ pub struct SceneFile {
     pub model: Option<Model>,
     /// Effects switched off (or asked for) on purpose. Default: all decided from the scene.
     #[serde(default)]
-    pub effects: Option<crate::effects::EffectsDesc>,
+    pub effects: Option<EffectsDesc>,
     /// Named materials that entities refer to with `Named("...")`; a table entry
     /// cannot itself be `Named`.
     #[serde(default)]
-    pub materials: Option<BTreeMap<String, MaterialDesc>>,
+    pub materials: Option<BTreeMap<String, TableMaterial>>,
     /// The scene's entities.
     #[serde(default)]
     pub entities: Option<Vec<EntityDesc>>,
 }
 
-/// Image size and sampling.
+/// Image size and sampling, as written and checked (see [`Film::checked`]).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "FilmFields", into = "FilmFields")]
-pub struct FilmDesc {
-    /// Width in pixels (default 720, the course's).
-    pub width: u32,
-    /// Height in pixels (default 576).
-    pub height: u32,
-    /// Samples per pixel (default 1: one ray through each pixel centre).
-    pub spp: u32,
-    /// How linear radiance becomes 8-bit PNG values (default `Srgb`).
-    pub transfer: Transfer,
-}
-
-impl Default for FilmDesc {
-    fn default() -> Self {
-        FilmDesc {
-            width: 720,
-            height: 576,
-            spp: 1,
-            transfer: Transfer::Srgb,
-        }
-    }
-}
+pub struct FilmDesc(pub Film);
 
 /// The film as written; checked into [`FilmDesc`].
 #[derive(Clone, Copy, Debug, Deserialize, Serialize)]
@@ -110,45 +104,19 @@ fn one<const M: u32>() -> Count<M> {
 impl TryFrom<FilmFields> for FilmDesc {
     type Error = String;
     fn try_from(f: FilmFields) -> Result<Self, String> {
-        FilmDesc {
+        Film {
             width: f.width.0,
             height: f.height.0,
             spp: f.spp.0,
             transfer: f.transfer,
         }
         .checked()
-    }
-}
-
-impl FilmDesc {
-    /// The film if its pixel count is within [`MAX_PIXELS`].
-    pub fn checked(self) -> Result<Self, String> {
-        let pixels = self.width as u64 * self.height as u64;
-        if pixels > MAX_PIXELS {
-            return Err(format!(
-                "film of {}x{} = {pixels} pixels is too large: at most {MAX_PIXELS} pixels \
-                 (8192x8192) are allowed",
-                self.width, self.height
-            ));
-        }
-        if self.width == 0 || self.height == 0 || self.spp == 0 {
-            return Err("film width, height and spp must be at least 1".into());
-        }
-        if self.width > MAX_SIDE || self.height > MAX_SIDE {
-            return Err(format!(
-                "film of {}x{}: each side must be at most {MAX_SIDE} pixels",
-                self.width, self.height
-            ));
-        }
-        if self.spp > MAX_SPP {
-            return Err(format!("{} samples per pixel: at most {MAX_SPP}", self.spp));
-        }
-        Ok(self)
+        .map(FilmDesc)
     }
 }
 
 impl From<FilmDesc> for FilmFields {
-    fn from(f: FilmDesc) -> Self {
+    fn from(FilmDesc(f): FilmDesc) -> Self {
         FilmFields {
             width: Count(f.width),
             height: Count(f.height),
@@ -156,26 +124,6 @@ impl From<FilmDesc> for FilmFields {
             transfer: f.transfer,
         }
     }
-}
-
-/// How 8-bit PNG values are made from linear radiance (EXR output is always linear float).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
-pub enum Transfer {
-    /// The sRGB curve after clamping to [0, 1]: what screens expect.
-    #[default]
-    Srgb,
-    /// `min(v, 1) * 255`, no curve: the course's BMP output.
-    Linear,
-}
-
-/// The light-transport model.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, Serialize)]
-pub enum Model {
-    /// The course's: reflectance `r = kd cos + ks cos^s` (no 1/pi) and the course's weights.
-    #[default]
-    Course,
-    /// Physically based: normalised Phong BRDF, unbiased Monte Carlo weights, Fresnel glass.
-    Physical,
 }
 
 /// A camera as written.
@@ -221,17 +169,6 @@ fn fov60() -> Fov {
     Fov(60.0)
 }
 
-impl Default for CameraDesc {
-    fn default() -> Self {
-        CameraDesc(CameraFields::Perspective {
-            position: Point(glam::DVec3::ZERO),
-            look_at: Point(glam::DVec3::Z),
-            up: y_up(),
-            fov: fov60(),
-        })
-    }
-}
-
 impl CameraFields {
     /// Position, look-at point and up hint.
     pub fn frame(&self) -> (glam::DVec3, glam::DVec3, glam::DVec3) {
@@ -273,6 +210,25 @@ impl TryFrom<CameraFields> for CameraDesc {
     }
 }
 
+impl CameraDesc {
+    /// The world's camera.
+    pub fn to_world(&self) -> WorldCamera {
+        let (position, look_at, up) = self.0.frame();
+        let projection = match self.0 {
+            CameraFields::Perspective { fov, .. } => Projection::Perspective { fov: fov.0 },
+            CameraFields::Orthographic { height, .. } => {
+                Projection::Orthographic { height: height.0 }
+            }
+        };
+        WorldCamera {
+            projection,
+            position,
+            look_at,
+            up,
+        }
+    }
+}
+
 impl From<CameraDesc> for CameraFields {
     fn from(c: CameraDesc) -> Self {
         c.0
@@ -301,9 +257,9 @@ pub enum ShaderDesc {
     Normal,
     /// Direct light from point lights at Phong hits (Eq. 3); mirrors and glass are followed.
     Direct {
-        /// Longest chain of consecutive mirror/glass bounces (default 32).
+        /// Longest chain of consecutive mirror/glass bounces, at most 1024 (default 32).
         #[serde(default = "max_specular")]
-        max_specular: u32,
+        max_specular: UpTo<MAX_SPECULAR>,
     },
     /// The assignment's global shader: Eq. 1 with the ambient (Eq. 2), hemisphere (Eq. 4) and
     /// normal-plus-reflection estimators of the indirect term.
@@ -317,33 +273,33 @@ pub enum ShaderDesc {
         /// Ambient radiance `a_t` (default `(0.3, 0.3, 0.3)`).
         #[serde(default = "ambient")]
         ambient: Rgb,
-        /// Longest chain of consecutive mirror/glass bounces (default 32).
+        /// Longest chain of consecutive mirror/glass bounces, at most 1024 (default 32).
         #[serde(default = "max_specular")]
-        max_specular: u32,
+        max_specular: UpTo<MAX_SPECULAR>,
     },
     /// The reference path tracer under the scene's `model`.
     Path {
         /// Largest number of bounces of any kind (default: none, Russian roulette ends paths).
         #[serde(default)]
         max_depth: Option<UpTo<MAX_PATH_DEPTH>>,
-        /// Bounces before Russian roulette starts (default 5).
+        /// Bounces before Russian roulette starts, at most 1024 (default 5).
         #[serde(default = "rr_depth")]
-        rr_depth: u32,
+        rr_depth: UpTo<MAX_PATH_DEPTH>,
         /// Direction sampling at Phong vertices: `Uniform`, `Cosine` or `Brdf` (default).
         #[serde(default)]
-        sampling: crate::shader::Sampling,
+        sampling: Sampling,
     },
 }
 
-fn rr_depth() -> u32 {
-    5
+fn rr_depth() -> UpTo<MAX_PATH_DEPTH> {
+    UpTo(5)
 }
 
 fn white() -> Rgb {
     Rgb::grey(1.0)
 }
-fn max_specular() -> u32 {
-    32
+fn max_specular() -> UpTo<MAX_SPECULAR> {
+    UpTo(32)
 }
 fn global_samples() -> Count<MAX_GLOBAL_SAMPLES> {
     Count(64)
@@ -355,10 +311,43 @@ fn ambient() -> Rgb {
     Rgb::grey(0.3)
 }
 
-impl Default for ShaderDesc {
-    fn default() -> Self {
-        ShaderDesc::Direct {
-            max_specular: max_specular(),
+impl ShaderDesc {
+    /// The shader with its parameters.
+    pub fn to_world(&self) -> Shader {
+        let rgb = |c: Rgb| c.0.as_vec3a();
+        match *self {
+            ShaderDesc::Intersection { color } => Shader::Intersection { color: rgb(color) },
+            ShaderDesc::Depth {
+                max_distance,
+                color,
+            } => Shader::Depth {
+                max_distance: max_distance.0 as f32,
+                color: rgb(color),
+            },
+            ShaderDesc::Normal => Shader::Normal,
+            ShaderDesc::Direct { max_specular } => Shader::Direct {
+                max_specular: max_specular.0,
+            },
+            ShaderDesc::Global {
+                samples,
+                max_depth,
+                ambient,
+                max_specular,
+            } => Shader::Global(Global {
+                samples: samples.0,
+                max_depth: max_depth.0,
+                ambient: rgb(ambient),
+                max_specular: max_specular.0,
+            }),
+            ShaderDesc::Path {
+                max_depth,
+                rr_depth,
+                sampling,
+            } => Shader::Path(Path {
+                max_depth: max_depth.map(|d| d.0),
+                rr_depth: rr_depth.0,
+                sampling,
+            }),
         }
     }
 }
@@ -394,6 +383,43 @@ pub enum MaterialDesc {
         #[serde(default = "white")]
         color: Rgb,
     },
+}
+
+impl MaterialDesc {
+    /// The material, or `None` for a `Named` reference (resolved by the loader).
+    pub fn to_world(&self) -> Option<Material> {
+        let rgb = |c: &Rgb| c.0.as_vec3a();
+        Some(match self {
+            MaterialDesc::Named(_) => return None,
+            MaterialDesc::Phong { kd, ks, shininess } => Material::Phong(Phong {
+                kd: rgb(kd),
+                ks: rgb(ks),
+                shininess: shininess.0 as f32,
+            }),
+            MaterialDesc::Mirror { color } => Material::Mirror(Mirror { color: rgb(color) }),
+            MaterialDesc::Transmissive { ior, color } => Material::Transmissive(Transmissive {
+                ior: ior.0 as f32,
+                color: rgb(color),
+            }),
+        })
+    }
+}
+
+/// An entry of the `materials` table: any material written inline, never `Named`.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "MaterialDesc")]
+pub struct TableMaterial(pub Material);
+
+impl TryFrom<MaterialDesc> for TableMaterial {
+    type Error = String;
+    fn try_from(m: MaterialDesc) -> Result<Self, String> {
+        match m.to_world() {
+            Some(m) => Ok(TableMaterial(m)),
+            None => Err(format!(
+                "material table entry cannot be {m:?}: write it inline"
+            )),
+        }
+    }
 }
 
 fn black() -> Rgb {
@@ -449,6 +475,37 @@ pub enum ShapeDesc {
     },
 }
 
+impl ShapeDesc {
+    /// The world's shape; `load_mesh` reads the file of a `Mesh` (a path relative to the scene
+    /// file) and says why it cannot.
+    pub fn to_world(
+        &self,
+        load_mesh: impl FnOnce(&str) -> Result<MeshData, String>,
+    ) -> Result<WorldShape, String> {
+        Ok(match self {
+            ShapeDesc::Sphere { center, radius } => WorldShape::Sphere {
+                center: center.0,
+                radius: radius.0,
+            },
+            ShapeDesc::InfinitePlane { point, normal } => WorldShape::Plane {
+                point: point.0,
+                normal: normal.0,
+            },
+            ShapeDesc::Triangle { a, b, c } => WorldShape::Triangle { v: [a.0, b.0, c.0] },
+            ShapeDesc::TriangleMesh {
+                vertices,
+                faces,
+                normals,
+            } => WorldShape::Mesh(Arc::new(MeshData {
+                positions: vertices.iter().map(|p| p.0).collect(),
+                normals: normals.iter().map(|n| n.0).collect(),
+                faces: faces.iter().map(|&(i, j, k)| [i, j, k]).collect(),
+            })),
+            ShapeDesc::Mesh { path } => WorldShape::Mesh(Arc::new(load_mesh(path)?)),
+        })
+    }
+}
+
 /// A transform applied to an entity's shape: scale, then rotate (degrees about x, then y, then
 /// z), then translate. A sphere takes only a uniform scale.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
@@ -473,15 +530,12 @@ fn origin() -> Point {
 }
 
 impl TransformDesc {
-    /// The affine map `translate * Rz * Ry * Rx * scale`.
-    pub fn affine(&self) -> glam::DAffine3 {
-        use glam::DMat3;
-        let r = self.rotate.0 * (std::f64::consts::PI / 180.0);
-        let rot =
-            DMat3::from_rotation_z(r.z) * DMat3::from_rotation_y(r.y) * DMat3::from_rotation_x(r.x);
-        glam::DAffine3 {
-            matrix3: rot * DMat3::from_diagonal(self.scale.0),
-            translation: self.translate.0,
+    /// The world's transform.
+    pub fn to_world(&self) -> Transform {
+        Transform {
+            scale: self.scale.0,
+            rotate: self.rotate.0,
+            translate: self.translate.0,
         }
     }
 }
@@ -497,6 +551,64 @@ pub enum LightDesc {
         /// Radiant intensity, W/sr per channel, >= 0.
         intensity: Rgb,
     },
+}
+
+impl LightDesc {
+    /// The world's light.
+    pub fn to_world(&self) -> WorldLight {
+        match *self {
+            LightDesc::Point {
+                position,
+                intensity,
+            } => WorldLight::Point {
+                position: position.0,
+                intensity: intensity.0.as_vec3a(),
+            },
+        }
+    }
+}
+
+/// Effect switches as written in a scene file: `None` (the default) lets rtis decide from the
+/// scene, `false` switches an effect off to trade accuracy for time, `true` asks for it (a
+/// warning when the scene cannot produce it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename = "Effects", deny_unknown_fields)]
+pub struct EffectsDesc {
+    /// Shadow rays towards point lights. Off: every light reaches every point facing it.
+    #[serde(default)]
+    pub shadows: Option<bool>,
+    /// Mirror reflection (and glass's total internal and Fresnel reflection). Off: those
+    /// directions return black.
+    #[serde(default)]
+    pub reflection: Option<bool>,
+    /// Refraction through glass. Off: glass is opaque black (except its reflection).
+    #[serde(default)]
+    pub refraction: Option<bool>,
+    /// Traced indirect light (Global's hemisphere and two-direction steps, Path's bounces off
+    /// Phong surfaces). Off: Global uses the ambient term at every Phong hit (as with D = 0);
+    /// Path stops after the first Phong vertex's direct light.
+    #[serde(default)]
+    pub indirect: Option<bool>,
+    /// Global's ambient term (Eq. 2). Off: it is zero.
+    #[serde(default)]
+    pub ambient: Option<bool>,
+    /// Background radiance. Off: escaped rays see black.
+    #[serde(default)]
+    pub background: Option<bool>,
+}
+
+impl EffectsDesc {
+    /// The world's effect switches.
+    pub fn to_world(&self) -> Switches {
+        Switches {
+            shadows: self.shadows,
+            reflection: self.reflection,
+            refraction: self.refraction,
+            indirect: self.indirect,
+            ambient: self.ambient,
+            background: self.background,
+        }
+    }
 }
 
 /// An entity as written: a bag of optional components.

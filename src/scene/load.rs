@@ -1,9 +1,14 @@
-//! Reading scene files, resolving `extends`, checking names, and filling the world.
+//! Reading scene files, resolving `extends`, checking names, and filling the world with its
+//! own component types: names resolved, meshes loaded.
 
+use super::SceneError;
 use super::file::{
-    CameraDesc, EntityDesc, FilmDesc, MaterialDesc, SceneFile, ShaderDesc, ShapeDesc,
+    CameraDesc, EffectsDesc, EntityDesc, FilmDesc, MaterialDesc, Model, SceneFile, ShaderDesc,
+    TableMaterial,
 };
-use super::{MaterialName, Name, Scene, SceneError, Settings, values::Rgb};
+use super::values::Rgb;
+use crate::material::Material;
+use crate::world::{MaterialName, Name, Scene, Settings};
 use ron::extensions::Extensions;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -75,9 +80,9 @@ struct Resolved {
     shader: Option<ShaderDesc>,
     background: Option<Rgb>,
     seed: Option<u64>,
-    model: Option<super::Model>,
-    effects: Option<crate::effects::EffectsDesc>,
-    materials: BTreeMap<String, (MaterialDesc, usize)>,
+    model: Option<Model>,
+    effects: Option<EffectsDesc>,
+    materials: BTreeMap<String, (Material, usize)>,
     entities: Vec<(EntityDesc, usize)>,
 }
 
@@ -129,7 +134,7 @@ fn resolve(src: Source, chain: &mut Vec<PathBuf>) -> Result<Resolved, SceneError
     base.seed = file.seed.or(base.seed);
     base.model = file.model.or(base.model);
     base.effects = file.effects.or(base.effects);
-    for (name, m) in file.materials.unwrap_or_default() {
+    for (name, TableMaterial(m)) in file.materials.unwrap_or_default() {
         base.materials.insert(name, (m, idx));
     }
     // An entity named like one of the base's replaces it in place; others are appended.
@@ -171,44 +176,40 @@ impl Resolved {
             let s: &Source = &self.sources[idx];
             SceneError::at_offset(&s.name, &s.text, find_named(&s.text, name), msg)
         };
-        for (m, idx) in self.materials.values() {
-            if let MaterialDesc::Named(n) = m {
-                return Err(located(
-                    *idx,
-                    n,
-                    format!("material table entry cannot be Named(\"{n}\"): write it inline"),
-                ));
-            }
-        }
         let mut world = hecs::World::new();
         let mut warnings = Vec::new();
         for (EntityDesc(e), idx) in &self.entities {
+            let src = &self.sources[*idx];
             let mut b = hecs::EntityBuilder::new();
             if let Some(name) = &e.name {
                 b.add(Name(name.clone()));
             }
             if let Some(shape) = &e.shape {
-                b.add(shape.clone());
-                if let ShapeDesc::Mesh { path } = shape {
-                    let s = &self.sources[*idx];
-                    let file = s.dir.clone().unwrap_or_default().join(path);
-                    let mesh = crate::mesh::load_obj(&file).map_err(|m| {
-                        let off = s.text.find(&format!("\"{path}\"")).unwrap_or(0);
-                        SceneError::at_offset(&s.name, &s.text, off, m)
+                let shape = shape
+                    .to_world(|path| {
+                        let file = src.dir.clone().unwrap_or_default().join(path);
+                        crate::mesh::load_obj(&file)
+                    })
+                    .map_err(|m| {
+                        let path = match shape {
+                            super::file::ShapeDesc::Mesh { path } => path.as_str(),
+                            _ => "",
+                        };
+                        let off = src.text.find(&format!("\"{path}\"")).unwrap_or(0);
+                        SceneError::at_offset(&src.name, &src.text, off, m)
                     })?;
-                    b.add(super::LoadedMesh(std::sync::Arc::new(mesh)));
-                }
+                b.add(shape);
             }
             if let Some(t) = &e.transform {
-                b.add(*t);
+                b.add(t.to_world());
             }
             if let Some(light) = &e.light {
-                b.add(*light);
+                b.add(light.to_world());
             }
             match &e.material {
                 Some(MaterialDesc::Named(n)) => match self.materials.get(n) {
                     Some((m, _)) => {
-                        b.add(m.clone());
+                        b.add(*m);
                         b.add(MaterialName(n.clone()));
                     }
                     None => {
@@ -227,7 +228,9 @@ impl Resolved {
                     }
                 },
                 Some(m) => {
-                    b.add(m.clone());
+                    if let Some(m) = m.to_world() {
+                        b.add(m);
+                    }
                 }
                 None => {}
             }
@@ -236,14 +239,15 @@ impl Resolved {
         if self.entities.is_empty() {
             warnings.push("the scene has no entities: every pixel shows the background".into());
         }
+        let d = Settings::default();
         let settings = Settings {
-            film: self.film.unwrap_or_default(),
-            camera: self.camera.unwrap_or_default(),
-            shader: self.shader.unwrap_or_default(),
-            background: self.background.unwrap_or(Rgb::BLACK),
-            seed: self.seed.unwrap_or(0),
-            model: self.model.unwrap_or_default(),
-            effects: self.effects.unwrap_or_default(),
+            film: self.film.map_or(d.film, |f| f.0),
+            camera: self.camera.map_or(d.camera, |c| c.to_world()),
+            shader: self.shader.map_or(d.shader, |s| s.to_world()),
+            background: self.background.map_or(d.background, |b| b.0.as_vec3a()),
+            seed: self.seed.unwrap_or(d.seed),
+            model: self.model.unwrap_or(d.model),
+            effects: self.effects.map_or(d.effects, |e| e.to_world()),
         };
         Ok(Scene {
             world,

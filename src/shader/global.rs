@@ -17,94 +17,130 @@
 //! uniform sky `b` is `b kd / (4 pi)` where the rendering equation gives `b kd`. The two-direction
 //! step is a deterministic stand-in for the same integral. `docs/transport.md` compares them with
 //! the physically based `Path` integrator.
+//!
+//! No recursion: mirror and glass chains are loops carrying their tint (`follow_specular`), and
+//! the tree of two-direction rays below the first Phong hit is walked with a fixed-size stack
+//! of rays and throughputs (its depth is at most [`MAX_DEPTH`]).
 
 use super::Tracer;
-use super::surface::{Interaction, direct_light, reflectance, specular_bounce};
-use crate::effects::kernel;
+use super::surface::{ChainEnd, Interaction, direct_light, follow_specular, reflectance};
 use crate::geometry::{Frame, Ray};
-use crate::material::Material;
-use crate::material::reflect;
-use crate::render::stats::RayKind;
+use crate::material::{Phong, reflect};
 use crate::sampling::hemisphere;
+use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::PI;
+
+/// Largest `D`: the rays below the first Phong hit number `n 2^(D-1)` per pixel.
+pub const MAX_DEPTH: u32 = 16;
 
 /// Parameters of the global shader.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Global {
     /// Hemisphere samples `n` at the first Phong hit.
     pub samples: u32,
-    /// `D`: the depth at which the ambient term replaces traced indirect light.
+    /// `D`: the depth at which the ambient term replaces traced indirect light, at most
+    /// [`MAX_DEPTH`].
     pub max_depth: u32,
     /// Ambient radiance `a_t`.
     pub ambient: Vec3A,
-    /// Longest chain of consecutive mirror/glass bounces.
+    /// Longest chain of consecutive mirror/glass bounces, at most [`super::MAX_SPECULAR`].
     pub max_specular: u32,
 }
 
 /// Radiance along a camera ray (depth 0).
-pub fn radiance<const K: u32>(tr: &mut Tracer, ray: &Ray, g: &Global) -> Vec3A {
-    li::<K>(tr, g, ray, RayKind::Camera, 0, 0)
+pub fn radiance(tr: &mut Tracer, ray: &Ray, g: &Global) -> Vec3A {
+    // Follow mirrors and glass to the first Phong hit; they keep the depth.
+    match follow_specular(tr, ray, RayKind::Camera, g.max_specular) {
+        ChainEnd::Phong { si, phong, beta } => beta * first_hit(tr, g, &si, &phong),
+        ChainEnd::Escaped { beta } => beta * tr.background,
+        ChainEnd::Absorbed => Vec3A::ZERO,
+    }
 }
 
-/// Radiance arriving along `ray`. `depth` counts Phong hits so far; `chain` counts consecutive
-/// specular bounces (a safety cap, not part of the assignment).
-/// `K` is the render kernel: without indirect light the ambient term stands in at every depth.
-fn li<const K: u32>(
-    tr: &mut Tracer,
-    g: &Global,
-    ray: &Ray,
-    kind: RayKind,
-    depth: u32,
-    chain: u32,
-) -> Vec3A {
-    // A ray that leaves the scene: the background is its radiance.
-    let Some(hit) = tr.trace::<K>(ray, kind) else {
-        return tr.scene.background;
-    };
-    let si = Interaction::new(tr, ray, hit);
-    let phong = match si.material {
-        Material::Phong(p) => p,
-        // Mirror or glass: follow the one scattered ray at the same depth.
-        _ => {
-            if chain >= g.max_specular {
-                return Vec3A::ZERO;
-            }
-            return match specular_bounce::<K>(&si) {
-                Some((next, tint, kind)) => tint * li::<K>(tr, g, &next, kind, depth, chain + 1),
-                None => Vec3A::ZERO,
-            };
-        }
-    };
-    let (wo, n, model) = (si.wo, si.n, tr.scene.model);
+/// Eq. 1 at the first Phong hit (depth 0).
+fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Vec3A {
+    let (wo, n, model) = (si.wo, si.n, tr.model);
 
     // Eq. 3: direct light from the point lights.
-    let l_dir = direct_light::<K>(tr, &si, &phong);
+    let l_dir = direct_light(tr, si, phong);
 
     // Indirect light.
-    let l_ind = if depth == g.max_depth || K & kernel::INDIRECT == 0 {
-        // Eq. 2: the ambient term.
+    let l_ind = if g.max_depth == 0 || !tr.effects.indirect {
+        // Eq. 2: the ambient term (D = 0, section 2).
         g.ambient * phong.kd
-    } else if depth == 0 {
-        // Eq. 4: n uniform directions on the hemisphere around the normal.
+    } else {
+        // Eq. 4: n uniform directions on the hemisphere around the normal, each traced at
+        // depth 1.
         let frame = Frame::from_normal(n);
         let mut sum = Vec3A::ZERO;
         for _ in 0..g.samples {
             let (u1, u2) = tr.sampler.next_2d();
             let wj = frame.to_world(hemisphere::uniform(u1, u2));
-            let l_i = li::<K>(tr, g, &si.spawn(wj), RayKind::Indirect, depth + 1, 0);
-            sum += l_i * reflectance(model, &phong, wj, wo, n);
+            let l_i = incident(tr, g, si.spawn(wj));
+            sum += l_i * reflectance(model, phong, wj, wo, n);
         }
         sum / (2.0 * PI * g.samples as f32)
-    } else {
-        // Task 2: Eq. 4 with the directions fixed to the normal w_n and the reflection w_r.
-        let (wn, wr) = (n, reflect(wo, n));
-        let l_n = li::<K>(tr, g, &si.spawn(wn), RayKind::Indirect, depth + 1, 0);
-        let l_r = li::<K>(tr, g, &si.spawn(wr), RayKind::Indirect, depth + 1, 0);
-        (l_n * reflectance(model, &phong, wn, wo, n) + l_r * reflectance(model, &phong, wr, wo, n))
-            / (4.0 * PI)
     };
 
     // Eq. 1.
     l_dir + l_ind
+}
+
+/// A ray still to be traced below the first Phong hit, with the weight `beta` its radiance
+/// carries into the pixel's estimate and the depth it is traced at.
+#[derive(Clone, Copy)]
+struct Pending {
+    ray: Ray,
+    beta: Vec3A,
+    depth: u32,
+}
+
+/// `L_i` along `ray`, an indirect ray leaving the first Phong hit (traced at depth 1).
+///
+/// Each Phong hit at `0 < depth < D` adds its direct light and sends two rays (task 2); at
+/// depth `D` the ambient term stands in for the rest (Eq. 2). The tree is walked depth first:
+/// each step pops one ray and pushes at most two, so the stack never holds more than `D + 1`.
+fn incident(tr: &mut Tracer, g: &Global, ray: Ray) -> Vec3A {
+    let mut stack = [Pending {
+        ray,
+        beta: Vec3A::ONE,
+        depth: 1,
+    }; MAX_DEPTH as usize + 2];
+    let mut len = 1;
+    let mut l = Vec3A::ZERO;
+    let model = tr.model;
+    while len > 0 {
+        len -= 1;
+        let Pending { ray, beta, depth } = stack[len];
+        // Mirrors and glass keep the depth.
+        let (si, phong, beta) = match follow_specular(tr, &ray, RayKind::Indirect, g.max_specular) {
+            ChainEnd::Phong { si, phong, beta: b } => (si, phong, beta * b),
+            ChainEnd::Escaped { beta: b } => {
+                l += beta * b * tr.background;
+                continue;
+            }
+            ChainEnd::Absorbed => continue,
+        };
+        // Eq. 3 at this hit.
+        let l_dir = direct_light(tr, &si, &phong);
+        if depth >= g.max_depth || !tr.effects.indirect {
+            // Eq. 2: the ambient term ends the path.
+            l += beta * (l_dir + g.ambient * phong.kd);
+            continue;
+        }
+        l += beta * l_dir;
+        // Task 2: Eq. 4 with the directions fixed to the normal w_n and the reflection w_r,
+        // weighted by 1 / (4 pi).
+        let (wo, n) = (si.wo, si.n);
+        for w in [reflect(wo, n), n] {
+            stack[len] = Pending {
+                ray: si.spawn(w),
+                beta: beta * reflectance(model, &phong, w, wo, n) / (4.0 * PI),
+                depth: depth + 1,
+            };
+            len += 1;
+        }
+    }
+    l
 }

@@ -2,13 +2,13 @@
 
 use super::Tracer;
 use crate::geometry::Ray;
-use crate::render::stats::RayKind;
+use crate::stats::RayKind;
 use glam::Vec3A;
 
 /// `color` if the camera ray hits anything, the background otherwise.
-pub fn radiance<const K: u32>(tr: &mut Tracer, ray: &Ray, color: Vec3A) -> Vec3A {
-    match tr.trace::<K>(ray, RayKind::Camera) {
+pub fn radiance(tr: &mut Tracer, ray: &Ray, color: Vec3A) -> Vec3A {
+    match tr.trace(ray, RayKind::Camera) {
         Some(_) => color,
-        None => tr.scene.background,
+        None => tr.background,
     }
 }

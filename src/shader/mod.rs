@@ -1,7 +1,9 @@
 //! The closed set of shaders: what the colour of a camera ray means. Each variant lives in its
-//! own file as one function over the [`RenderScene`]; [`radiance`] dispatches by `match`.
+//! own file as one function over a [`Tracer`]; [`radiance`] dispatches by `match`.
 //!
-//! Nothing here knows about RON or hecs.
+//! A shader is given only the parts it reads (geometry, materials, lights, background, model,
+//! effects, its random numbers and counters), as pbrt's integrators are built from their parts
+//! rather than from a scene object. Nothing here knows about RON or hecs.
 
 mod depth;
 mod direct;
@@ -12,14 +14,19 @@ pub mod path;
 pub mod surface;
 
 pub use global::Global;
-pub use path::{Path, Sampling};
+pub use path::Path;
 
+use crate::accel::Geometry;
+use crate::effects::Effects;
 use crate::geometry::{Hit, Ray};
-use crate::prepare::RenderScene;
-use crate::render::stats::{RayKind, RayStats};
+use crate::light::Light;
+use crate::material::{Material, Model};
 use crate::sampling::Sampler;
-use crate::scene::ShaderDesc;
+use crate::stats::{RayKind, RayStats};
 use glam::Vec3A;
+
+/// Longest chain of consecutive mirror/glass bounces any shader follows.
+pub const MAX_SPECULAR: u32 = 1024;
 
 /// A prepared shader with its parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,7 +47,7 @@ pub enum Shader {
     Normal,
     /// Direct light (Eq. 3) at Phong hits; mirrors and glass followed.
     Direct {
-        /// Longest chain of consecutive specular bounces.
+        /// Longest chain of consecutive specular bounces, at most [`MAX_SPECULAR`].
         max_specular: u32,
     },
     /// The assignment's global shader (Eq. 1-4).
@@ -49,50 +56,21 @@ pub enum Shader {
     Path(Path),
 }
 
-impl Shader {
-    /// Convert the scene file's description.
-    pub fn from_desc(d: &ShaderDesc) -> Shader {
-        match *d {
-            ShaderDesc::Intersection { color } => Shader::Intersection {
-                color: color.0.as_vec3a(),
-            },
-            ShaderDesc::Depth {
-                max_distance,
-                color,
-            } => Shader::Depth {
-                max_distance: max_distance.0 as f32,
-                color: color.0.as_vec3a(),
-            },
-            ShaderDesc::Normal => Shader::Normal,
-            ShaderDesc::Direct { max_specular } => Shader::Direct { max_specular },
-            ShaderDesc::Global {
-                samples,
-                max_depth,
-                ambient,
-                max_specular,
-            } => Shader::Global(Global {
-                samples: samples.0,
-                max_depth: max_depth.0,
-                ambient: ambient.0.as_vec3a(),
-                max_specular,
-            }),
-            ShaderDesc::Path {
-                max_depth,
-                rr_depth,
-                sampling,
-            } => Shader::Path(Path {
-                max_depth: max_depth.map(|d| d.0),
-                rr_depth,
-                sampling,
-            }),
-        }
-    }
-}
-
-/// What one camera sample needs while it is traced: the scene, its random numbers and counters.
+/// What one camera sample needs while it is traced: the parts of the scene it reads, its
+/// random numbers and its counters.
 pub struct Tracer<'a> {
-    /// The prepared scene.
-    pub scene: &'a RenderScene,
+    /// Primitives and their acceleration structures.
+    pub geometry: &'a Geometry,
+    /// Materials, indexed by `Prim::material`.
+    pub materials: &'a [Material],
+    /// Lights.
+    pub lights: &'a [Light],
+    /// Radiance of escaped rays.
+    pub background: Vec3A,
+    /// Light-transport model.
+    pub model: Model,
+    /// The effects this render simulates.
+    pub effects: Effects,
     /// Random numbers of this (pixel, sample).
     pub sampler: Sampler,
     /// Rays traced so far, by kind.
@@ -100,34 +78,33 @@ pub struct Tracer<'a> {
 }
 
 impl Tracer<'_> {
-    /// Nearest hit of a ray of the given kind (counted), in render kernel `K`.
+    /// Nearest hit of a ray of the given kind (counted).
     #[inline]
-    pub fn trace<const K: u32>(&mut self, ray: &Ray, kind: RayKind) -> Option<Hit> {
+    pub fn trace(&mut self, ray: &Ray, kind: RayKind) -> Option<Hit> {
         self.stats.count(kind);
-        self.scene.geometry.intersect_in::<K>(ray)
+        self.geometry.intersect(ray)
     }
 
-    /// True if nothing blocks the shadow ray (counted), in render kernel `K`.
+    /// True if nothing blocks the shadow ray (counted).
     #[inline]
-    pub fn unoccluded<const K: u32>(&mut self, ray: &Ray) -> bool {
+    pub fn unoccluded(&mut self, ray: &Ray) -> bool {
         self.stats.count(RayKind::Shadow);
-        !self.scene.geometry.occluded_in::<K>(ray)
+        !self.geometry.occluded(ray)
     }
 }
 
-/// Radiance arriving at the camera along the camera ray `ray`, in render kernel `K`
-/// (see [`crate::effects`]).
+/// Radiance arriving at the camera along the camera ray `ray` under `shader`.
 #[inline]
-pub fn radiance<const K: u32>(tr: &mut Tracer, ray: &Ray) -> Vec3A {
-    match tr.scene.shader {
-        Shader::Intersection { color } => intersection::radiance::<K>(tr, ray, color),
+pub fn radiance(shader: &Shader, tr: &mut Tracer, ray: &Ray) -> Vec3A {
+    match *shader {
+        Shader::Intersection { color } => intersection::radiance(tr, ray, color),
         Shader::Depth {
             max_distance,
             color,
-        } => depth::radiance::<K>(tr, ray, max_distance, color),
-        Shader::Normal => normal::radiance::<K>(tr, ray),
-        Shader::Direct { max_specular } => direct::radiance::<K>(tr, ray, max_specular),
-        Shader::Global(g) => global::radiance::<K>(tr, ray, &g),
-        Shader::Path(p) => path::radiance::<K>(tr, ray, &p),
+        } => depth::radiance(tr, ray, max_distance, color),
+        Shader::Normal => normal::radiance(tr, ray),
+        Shader::Direct { max_specular } => direct::radiance(tr, ray, max_specular),
+        Shader::Global(g) => global::radiance(tr, ray, &g),
+        Shader::Path(p) => path::radiance(tr, ray, &p),
     }
 }

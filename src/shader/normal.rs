@@ -2,12 +2,12 @@
 
 use super::Tracer;
 use crate::geometry::Ray;
-use crate::render::stats::RayKind;
+use crate::stats::RayKind;
 use glam::Vec3A;
 
 /// `(n + 1) / 2` with `n` the unit normal on the side facing the camera; background on a miss.
-pub fn radiance<const K: u32>(tr: &mut Tracer, ray: &Ray) -> Vec3A {
-    match tr.trace::<K>(ray, RayKind::Camera) {
+pub fn radiance(tr: &mut Tracer, ray: &Ray) -> Vec3A {
+    match tr.trace(ray, RayKind::Camera) {
         Some(hit) => {
             let n = if hit.n.dot(ray.d) > 0.0 {
                 -hit.n
@@ -16,6 +16,6 @@ pub fn radiance<const K: u32>(tr: &mut Tracer, ray: &Ray) -> Vec3A {
             };
             0.5 * (n + Vec3A::ONE)
         }
-        None => tr.scene.background,
+        None => tr.background,
     }
 }

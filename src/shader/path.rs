@@ -18,26 +18,12 @@
 
 use super::Tracer;
 use super::surface::{Interaction, direct_light, reflectance, specular_bounce};
-use crate::effects::kernel;
 use crate::geometry::{Frame, Ray};
-use crate::material::{Material, Phong, fresnel_dielectric, reflect};
-use crate::render::stats::RayKind;
-use crate::sampling::hemisphere;
-use crate::scene::Model;
+use crate::material::{Material, Model, Phong, fresnel_dielectric, reflect};
+use crate::sampling::{Sampling, hemisphere};
+use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::{PI, TAU};
-
-/// How the Path integrator picks the next direction at a Phong vertex.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-pub enum Sampling {
-    /// Uniform on the hemisphere (the course's sampler).
-    Uniform,
-    /// Proportional to `cos(theta)`.
-    Cosine,
-    /// A mixture of the cosine lobe and the Phong lobe, weighted by `kd` and `ks`.
-    #[default]
-    Brdf,
-}
 
 /// Parameters of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,15 +36,14 @@ pub struct Path {
     pub sampling: Sampling,
 }
 
-/// Hard cap on bounces even without `max_depth` (two perfect mirrors facing each other).
-const MAX_BOUNCES: u32 = 1024;
+/// Hard cap on bounces even without `max_depth` (two perfect mirrors facing each other), and
+/// the largest `max_depth` and `rr_depth` a scene may ask for.
+pub const MAX_DEPTH: u32 = 1024;
 
-/// Radiance along a camera ray.
-///
-/// `K` is the render kernel: scattering into an effect it leaves out ends the path.
-pub fn radiance<const K: u32>(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
-    let model = tr.scene.model;
-    let max_depth = p.max_depth.unwrap_or(MAX_BOUNCES).min(MAX_BOUNCES);
+/// Radiance along a camera ray. Scattering into an effect that is off ends the path.
+pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
+    let model = tr.model;
+    let max_depth = p.max_depth.unwrap_or(MAX_DEPTH).min(MAX_DEPTH);
     let mut l = Vec3A::ZERO;
     let mut beta = Vec3A::ONE;
     let mut ray = *camera_ray;
@@ -66,8 +51,8 @@ pub fn radiance<const K: u32>(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Ve
     let mut depth = 0;
     loop {
         // Escaped rays see the background.
-        let Some(hit) = tr.trace::<K>(&ray, kind) else {
-            l += beta * tr.scene.background;
+        let Some(hit) = tr.trace(&ray, kind) else {
+            l += beta * tr.background;
             break;
         };
         let si = Interaction::new(tr, &ray, hit);
@@ -78,8 +63,8 @@ pub fn radiance<const K: u32>(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Ve
         let (next_ray, weight, next) = match (si.material, model) {
             (Material::Phong(phong), _) => {
                 // Next-event estimation: Eq. 3 under the model.
-                l += beta * direct_light::<K>(tr, &si, &phong);
-                if K & kernel::INDIRECT == 0 {
+                l += beta * direct_light(tr, &si, &phong);
+                if !tr.effects.indirect {
                     break;
                 }
                 let Some((wi, weight)) = sample_phong(tr, &phong, &si, model, p.sampling) else {
@@ -91,21 +76,21 @@ pub fn radiance<const K: u32>(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Ve
             (Material::Transmissive(g), Model::Physical) => {
                 let r = g.refract(si.wo, si.hit.n);
                 let f = fresnel_dielectric(r.cos_i.abs(), r.eta);
-                let (wi, weight, kind, bit) = if tr.sampler.next_f32() < f {
+                let (wi, weight, kind, on) = if tr.sampler.next_f32() < f {
                     let wr = reflect(si.wo, si.n);
-                    (wr, Vec3A::ONE, RayKind::Reflection, kernel::REFLECTION)
+                    (wr, Vec3A::ONE, RayKind::Reflection, tr.effects.reflection)
                 } else {
                     let w = g.color / (r.eta * r.eta);
-                    (r.wt, w, RayKind::Refraction, kernel::REFRACTION)
+                    (r.wt, w, RayKind::Refraction, tr.effects.refraction)
                 };
-                // An effect the kernel leaves out ends the path.
-                if K & bit == 0 {
+                // An effect that is off ends the path.
+                if !on {
                     break;
                 }
                 (si.spawn(wi), weight, kind)
             }
             // Mirrors, and the course's glass: the one scattered ray, as in Direct and Global.
-            _ => match specular_bounce::<K>(&si) {
+            _ => match specular_bounce(&si, tr.effects) {
                 Some(bounce) => bounce,
                 None => break,
             },

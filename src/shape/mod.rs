@@ -1,7 +1,13 @@
 //! The closed set of shapes. Each variant lives in its own file; [`Shape`] dispatches by `match`.
 //!
-//! Adding a shape touches three places: its file here, the [`Shape`] enum (the compiler then
-//! names every `match` that lacks it), and the scene-file enum `scene::file::ShapeDesc`.
+//! A shape has two forms: [`WorldShape`], the ECS component in scene units and double
+//! precision, and [`Shape`], the camera-relative single-precision form that rays are tested
+//! against. [`WorldShape::extract`] turns one into the other.
+//!
+//! Adding a shape touches three places: its file here (its render form, with `intersect`,
+//! `surface`, `bounds` and a constructor from scene units), this file (a variant of both enums;
+//! the compiler then names every `match` here that lacks it), and the scene file's `ShapeDesc`
+//! with its conversion (`scene/file.rs`, whose exhaustive `match` the compiler also names).
 
 mod plane;
 mod sphere;
@@ -11,9 +17,93 @@ pub use plane::Plane;
 pub use sphere::Sphere;
 pub use triangle::Triangle;
 
-use crate::effects::kernel;
-use crate::geometry::{Aabb, Ray};
-use glam::Vec3A;
+use crate::geometry::{Aabb, Placement, Ray};
+use crate::mesh::MeshData;
+use glam::{DVec3, Vec3A};
+use std::sync::Arc;
+
+/// A shape as the world holds it: scene units, double precision, before its transform.
+#[derive(Clone, Debug, PartialEq)]
+pub enum WorldShape {
+    /// A sphere of `radius > 0` around `center`.
+    Sphere {
+        /// Centre.
+        center: DVec3,
+        /// Radius, > 0.
+        radius: f64,
+    },
+    /// The infinite two-sided plane through `point` with normal `normal` (non-zero).
+    Plane {
+        /// Any point of the plane.
+        point: DVec3,
+        /// Normal, non-zero (normalised when extracted).
+        normal: DVec3,
+    },
+    /// A two-sided triangle.
+    Triangle {
+        /// Vertices; the normal follows the winding `(v1 - v0) x (v2 - v0)`.
+        v: [DVec3; 3],
+    },
+    /// Indexed triangles with optional vertex normals (loaded from a file or written inline).
+    Mesh(Arc<MeshData>),
+}
+
+impl WorldShape {
+    /// Every point that describes this shape, for systems that move shapes around.
+    pub fn points_mut(&mut self) -> Vec<&mut DVec3> {
+        match self {
+            WorldShape::Sphere { center, .. } => vec![center],
+            WorldShape::Plane { point, .. } => vec![point],
+            WorldShape::Triangle { v } => v.iter_mut().collect(),
+            WorldShape::Mesh(m) => Arc::make_mut(m).positions.iter_mut().collect(),
+        }
+    }
+
+    /// Number of render shapes this becomes (a mesh: its faces).
+    pub fn count(&self) -> usize {
+        match self {
+            WorldShape::Mesh(m) => m.faces.len(),
+            _ => 1,
+        }
+    }
+
+    /// The render shapes of this shape placed by `at`, each with its vertex normals when
+    /// smooth, passed to `push`; returns how many zero-area triangles were dropped (they can
+    /// never be hit).
+    pub fn extract(
+        &self,
+        at: &Placement,
+        push: &mut dyn FnMut(Shape, Option<[Vec3A; 3]>),
+    ) -> usize {
+        let mut dropped = 0;
+        let mut triangle =
+            |v: [Vec3A; 3], n: Option<[Vec3A; 3]>| match Triangle::new(v[0], v[1], v[2]) {
+                Some(t) => push(Shape::Triangle(t), n),
+                None => dropped += 1,
+            };
+        match self {
+            WorldShape::Sphere { center, radius } => {
+                push(Shape::Sphere(Sphere::placed(*center, *radius, at)), None)
+            }
+            WorldShape::Plane { point, normal } => {
+                push(Shape::Plane(Plane::placed(*point, *normal, at)), None)
+            }
+            WorldShape::Triangle { v } => triangle(v.map(|p| at.point(p)), None),
+            WorldShape::Mesh(m) => {
+                let v: Vec<Vec3A> = m.positions.iter().map(|p| at.point(*p)).collect();
+                let n: Vec<Vec3A> = m.normals.iter().map(|d| at.normal(*d)).collect();
+                for f in &m.faces {
+                    let idx = f.map(|i| i as usize);
+                    triangle(
+                        idx.map(|i| v[i]),
+                        (!n.is_empty()).then(|| idx.map(|i| n[i])),
+                    );
+                }
+            }
+        }
+        dropped
+    }
+}
 
 /// A prepared, camera-relative shape in single precision, ready for intersection.
 #[derive(Clone, Copy, Debug)]
@@ -56,20 +146,12 @@ pub(crate) fn point_error(scale: f32) -> f32 {
 
 impl Shape {
     /// Distance to the nearest intersection in `(0, ray.t_max]`, if any.
-    #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<f32> {
-        self.intersect_in::<{ kernel::ALL }>(ray)
-    }
-
-    /// [`Shape::intersect`] in render kernel `K`: the tests of shape kinds the kernel leaves
-    /// out are not compiled in (the scene has none of them).
     #[inline(always)]
-    pub fn intersect_in<const K: u32>(&self, ray: &Ray) -> Option<f32> {
+    pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         match self {
-            Shape::Sphere(s) if K & kernel::SPHERES != 0 => s.intersect(ray),
+            Shape::Sphere(s) => s.intersect(ray),
             Shape::Plane(p) => p.intersect(ray),
-            Shape::Triangle(t) if K & kernel::TRIANGLES != 0 => t.intersect(ray),
-            _ => None,
+            Shape::Triangle(t) => t.intersect(ray),
         }
     }
 

@@ -1,7 +1,7 @@
 //! Infinite planes.
 
 use super::{Surface, point_error};
-use crate::geometry::Ray;
+use crate::geometry::{Placement, Ray};
 use glam::Vec3A;
 
 /// The two-sided plane `{p : n.p = dist}` with unit normal `n`.
@@ -14,6 +14,11 @@ pub struct Plane {
 }
 
 impl Plane {
+    /// The plane through `point` with normal `normal` (scene units) placed by `at`.
+    pub fn placed(point: glam::DVec3, normal: glam::DVec3, at: &Placement) -> Self {
+        Plane::through(at.point(point), at.normal(normal))
+    }
+
     /// The plane through `point` with unit normal `n`.
     pub fn through(point: Vec3A, n: Vec3A) -> Self {
         Plane {

@@ -1,7 +1,7 @@
 //! Spheres.
 
 use super::{Surface, point_error};
-use crate::geometry::{Aabb, Ray};
+use crate::geometry::{Aabb, Placement, Ray};
 use glam::Vec3A;
 
 /// A sphere of centre `c` and radius `r > 0`.
@@ -14,6 +14,14 @@ pub struct Sphere {
 }
 
 impl Sphere {
+    /// The sphere of `radius` around `center` (scene units) placed by `at`.
+    pub fn placed(center: glam::DVec3, radius: f64, at: &Placement) -> Self {
+        Sphere {
+            c: at.point(center),
+            r: at.length(radius),
+        }
+    }
+
     /// Nearest root of `|o + t d - c|^2 = r^2` in `(0, t_max]`.
     ///
     /// Uses the cancellation-free form of Haines et al. (Ray Tracing Gems, ch. 7): the

@@ -2,9 +2,9 @@
 #![allow(dead_code)]
 
 use glam::Vec3A;
+use rtis::render;
 use rtis::render::Rendered;
 use rtis::scene::{self, Scene};
-use rtis::{RenderScene, render};
 use std::path::{Path, PathBuf};
 
 /// The repository's `scenes/` folder.
@@ -19,7 +19,7 @@ pub fn scene(text: &str) -> Scene {
 
 /// Prepare and render a loaded scene on the global pool.
 pub fn render_scene(s: &Scene) -> Rendered {
-    render(&RenderScene::prepare(s), &|| {})
+    render(&rtis::extract(s), &|| {})
 }
 
 /// Parse and render scene text.

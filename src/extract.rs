@@ -1,0 +1,101 @@
+//! The extraction step, in the spirit of Bevy's extract phase: the only code that knows both
+//! the ECS world and the render data. It queries the world once, derives the effects from the
+//! parts, and assembles the flat, camera-relative, single-precision [`RenderScene`].
+//!
+//! Scene coordinates are doubles. Extraction subtracts the camera position (in double precision)
+//! before rounding to `f32`, so a scene far from the origin renders as precisely as one at it.
+
+use crate::accel::{FLAT, Geometry, Prim};
+use crate::geometry::Placement;
+use crate::material::Material;
+use crate::render::{RenderScene, effects};
+use crate::world::{Name, Scene, Transform, WorldLight, WorldShape};
+
+/// Build the render data of a loaded scene.
+pub fn extract(scene: &Scene) -> RenderScene {
+    let s = &scene.settings;
+    // The camera is the origin of the render coordinates.
+    let origin = s.camera.position;
+    let camera = s.camera.extract(s.film.width as f32 / s.film.height as f32);
+
+    // Shapes with their materials (each distinct material stored once).
+    let mut warnings = Vec::new();
+    let mut materials: Vec<Material> = Vec::new();
+    let mut prims = Vec::new();
+    let mut normals = Vec::new();
+    for (entity, shape, m, name, transform) in scene
+        .world
+        .query::<(
+            hecs::Entity,
+            &WorldShape,
+            &Material,
+            Option<&Name>,
+            Option<&Transform>,
+        )>()
+        .iter()
+    {
+        let material = match materials.iter().position(|x| x == m) {
+            Some(i) => i as u32,
+            None => {
+                materials.push(*m);
+                (materials.len() - 1) as u32
+            }
+        };
+        let place = Placement::new(transform, origin);
+        let dropped = shape.extract(&place, &mut |shape, vertex_normals| {
+            let smooth = match vertex_normals {
+                Some(n) => {
+                    normals.push(n);
+                    (normals.len() - 1) as u32
+                }
+                None => FLAT,
+            };
+            prims.push(Prim {
+                shape,
+                material,
+                smooth,
+            })
+        });
+        if dropped > 0 {
+            let label = name.map_or_else(|| format!("entity {}", entity.id()), |n| n.0.clone());
+            warnings.push(format!(
+                "{label}: {dropped} zero-area triangle(s) ignored (they can never be hit)"
+            ));
+        }
+    }
+    let lights: Vec<_> = scene
+        .world
+        .query::<&WorldLight>()
+        .iter()
+        .map(|l| l.extract(origin))
+        .collect();
+    let geometry = Geometry::build(prims, normals);
+
+    // The effects, derived once from the parts, before the render scene is assembled.
+    let derived = effects::derive(
+        &s.shader,
+        &geometry,
+        &materials,
+        &lights,
+        s.background,
+        &s.effects,
+    );
+    warnings.extend(derived.warnings);
+    let mut render = RenderScene {
+        camera,
+        geometry,
+        materials,
+        lights,
+        background: s.background,
+        shader: s.shader,
+        model: s.model,
+        film: s.film,
+        seed: s.seed,
+        origin,
+        effects: derived.effects,
+        switched_off: derived.switched_off,
+        warnings,
+    };
+    render.set_effects(derived.effects);
+    render
+}
