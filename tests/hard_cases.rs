@@ -305,3 +305,46 @@ fn huge_intensity_exr_keeps_png_clamps() {
     assert_eq!(png8.get_pixel(1, 1).0, [255, 255, 255]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Depth-like settings are bounded with a located error, and the largest allowed chain runs as
+/// a loop: two facing mirrors at `max_specular: 1024` trace exactly 1024 reflections per pixel
+/// and return black, with no stack to overflow.
+#[test]
+fn specular_chains_are_capped_and_loop() {
+    let text = |max: u32| {
+        format!(
+            r#"Scene(
+        film: (width: 4, height: 4),
+        camera: Orthographic(position: (0, 0, 0), look_at: (0, 0, 1), height: 0.1),
+        shader: Global(samples: 1, max_depth: 1, max_specular: {max}),
+        background: (1, 1, 1),
+        entities: [
+            (shape: InfinitePlane(point: (0, 0, 1), normal: (0, 0, -1)), material: Mirror(color: (0.9, 0.9, 0.9))),
+            (shape: InfinitePlane(point: (0, 0, -1), normal: (0, 0, 1)), material: Mirror(color: (0.9, 0.9, 0.9))),
+        ])"#
+        )
+    };
+    let r = render_str(&text(1024));
+    finite(&r);
+    assert!(r.image.pixels.iter().all(|p| *p == Vec3A::ZERO));
+    assert_eq!(r.stats.reflection, 16 * 1024);
+    let err = rtis::scene::load_str(&text(100_000), "mirrors.ron", None)
+        .err()
+        .expect("max_specular beyond its cap is refused");
+    let msg = err.to_string();
+    assert!(
+        msg.starts_with("mirrors.ron:4:64:") && msg.contains("at most 1024, got 100000"),
+        "{msg}"
+    );
+    for bad in [
+        "Path(rr_depth: 5000)",
+        "Path(max_depth: 5000)",
+        "Global(max_depth: 17)",
+        "Direct(max_specular: 1025)",
+    ] {
+        let e = rtis::scene::load_str(&format!("Scene(shader: {bad})"), "s.ron", None)
+            .err()
+            .unwrap_or_else(|| panic!("{bad} is refused"));
+        assert!(e.to_string().contains("at most"), "{bad}: {e}");
+    }
+}

@@ -19,8 +19,8 @@
 //! the physically based `Path` integrator.
 //!
 //! No recursion: mirror and glass chains are loops carrying their tint (`follow_specular`), and
-//! the tree of two-direction rays below the first Phong hit is walked with a fixed-size stack
-//! of rays and throughputs (its depth is at most [`MAX_DEPTH`]).
+//! the tree of two-direction rays below the first Phong hit is walked with an explicit stack of
+//! rays and throughputs (at most `D + 1` deep, `D` at most [`MAX_DEPTH`]).
 
 use super::Tracer;
 use super::surface::{ChainEnd, Interaction, direct_light, follow_specular, reflectance};
@@ -74,10 +74,11 @@ fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Ve
         // depth 1.
         let frame = Frame::from_normal(n);
         let mut sum = Vec3A::ZERO;
+        let mut stack = Vec::with_capacity(g.max_depth as usize + 1);
         for _ in 0..g.samples {
             let (u1, u2) = tr.sampler.next_2d();
             let wj = frame.to_world(hemisphere::uniform(u1, u2));
-            let l_i = incident(tr, g, si.spawn(wj));
+            let l_i = incident(tr, g, si.spawn(wj), &mut stack);
             sum += l_i * reflectance(model, phong, wj, wo, n);
         }
         sum / (2.0 * PI * g.samples as f32)
@@ -90,7 +91,7 @@ fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Ve
 /// A ray still to be traced below the first Phong hit, with the weight `beta` its radiance
 /// carries into the pixel's estimate and the depth it is traced at.
 #[derive(Clone, Copy)]
-struct Pending {
+pub struct Pending {
     ray: Ray,
     beta: Vec3A,
     depth: u32,
@@ -99,20 +100,18 @@ struct Pending {
 /// `L_i` along `ray`, an indirect ray leaving the first Phong hit (traced at depth 1).
 ///
 /// Each Phong hit at `0 < depth < D` adds its direct light and sends two rays (task 2); at
-/// depth `D` the ambient term stands in for the rest (Eq. 2). The tree is walked depth first:
-/// each step pops one ray and pushes at most two, so the stack never holds more than `D + 1`.
-fn incident(tr: &mut Tracer, g: &Global, ray: Ray) -> Vec3A {
-    let mut stack = [Pending {
+/// depth `D` the ambient term stands in for the rest (Eq. 2). The tree is walked depth first
+/// with `stack` (empty on entry and on return): each step pops one ray and pushes at most two,
+/// so it never holds more than `D + 1`.
+fn incident(tr: &mut Tracer, g: &Global, ray: Ray, stack: &mut Vec<Pending>) -> Vec3A {
+    stack.push(Pending {
         ray,
         beta: Vec3A::ONE,
         depth: 1,
-    }; MAX_DEPTH as usize + 2];
-    let mut len = 1;
+    });
     let mut l = Vec3A::ZERO;
     let model = tr.model;
-    while len > 0 {
-        len -= 1;
-        let Pending { ray, beta, depth } = stack[len];
+    while let Some(Pending { ray, beta, depth }) = stack.pop() {
         // Mirrors and glass keep the depth.
         let (si, phong, beta) = match follow_specular(tr, &ray, RayKind::Indirect, g.max_specular) {
             ChainEnd::Phong { si, phong, beta: b } => (si, phong, beta * b),
@@ -134,12 +133,11 @@ fn incident(tr: &mut Tracer, g: &Global, ray: Ray) -> Vec3A {
         // weighted by 1 / (4 pi).
         let (wo, n) = (si.wo, si.n);
         for w in [reflect(wo, n), n] {
-            stack[len] = Pending {
+            stack.push(Pending {
                 ray: si.spawn(w),
                 beta: beta * reflectance(model, &phong, w, wo, n) / (4.0 * PI),
                 depth: depth + 1,
-            };
-            len += 1;
+            });
         }
     }
     l
