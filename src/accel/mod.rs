@@ -27,6 +27,17 @@ pub const FLAT: u32 = u32::MAX;
 /// Scenes with at most this many spheres test them in packets instead of a BVH.
 pub const PACKED_SPHERES: usize = 16;
 
+/// Append packed primitives to `all`; returns each shape with its index there.
+fn append<T>(all: &mut Vec<Prim>, packed: Vec<(Prim, T)>) -> Vec<(u32, T)> {
+    packed
+        .into_iter()
+        .map(|(p, shape)| {
+            all.push(p);
+            ((all.len() - 1) as u32, shape)
+        })
+        .collect()
+}
+
 /// All of a scene's primitives, ready for ray queries.
 #[derive(Clone, Debug, Default)]
 pub struct Geometry {
@@ -57,45 +68,30 @@ impl Geometry {
             .filter(|p| p.shape.kind() == ShapeKind::Sphere)
             .count();
         let pack_spheres = n_spheres <= PACKED_SPHERES;
-        // Where each primitive goes: 0 plane packets, 1 sphere packets, 2 the BVH.
-        let bucket = |p: &Prim| match p.shape.kind() {
-            ShapeKind::Plane => 0,
-            ShapeKind::Sphere if pack_spheres => 1,
-            _ => 2,
-        };
-        // One pass, and none at all (the vector moves as is) when nothing is packed.
-        let (mut planes, mut spheres, mut for_bvh) = (Vec::new(), Vec::new(), Vec::new());
-        if prims.iter().any(|p| bucket(p) != 2) {
-            for p in prims {
-                [&mut planes, &mut spheres, &mut for_bvh][bucket(&p)].push(p);
-            }
-        } else {
-            for_bvh = prims;
-        }
+        // One pass: planes to their packets, spheres to theirs in small scenes, the rest to
+        // the BVH. The packets keep each shape with its primitive, so no kind is lost.
+        let (mut planes, mut spheres) = (Vec::new(), Vec::new());
+        let for_bvh: Vec<Prim> = prims
+            .into_iter()
+            .filter(|p| match p.shape {
+                Shape::Plane(pl) => {
+                    planes.push((*p, pl));
+                    false
+                }
+                Shape::Sphere(s) if pack_spheres => {
+                    spheres.push((*p, s));
+                    false
+                }
+                _ => true,
+            })
+            .collect();
         let has_triangles = for_bvh
             .iter()
             .any(|p| p.shape.kind() == ShapeKind::Triangle);
         let (bvh, mut all) = Bvh::build(for_bvh);
         let in_bvh = all.len();
-        let sphere_items: Vec<_> = spheres
-            .iter()
-            .enumerate()
-            .map(|(i, p)| match p.shape {
-                Shape::Sphere(s) => ((in_bvh + i) as u32, s),
-                _ => unreachable!("partitioned spheres"),
-            })
-            .collect();
-        all.extend(spheres);
-        let base = all.len();
-        let plane_items: Vec<_> = planes
-            .iter()
-            .enumerate()
-            .map(|(i, p)| match p.shape {
-                Shape::Plane(pl) => ((base + i) as u32, pl),
-                _ => unreachable!("partitioned planes"),
-            })
-            .collect();
-        all.extend(planes);
+        let sphere_items = append(&mut all, spheres);
+        let plane_items = append(&mut all, planes);
         Geometry {
             prims: all,
             in_bvh,
