@@ -366,3 +366,67 @@ fn cornell_box_matches_mitsuba() {
         "mean {ma} vs Mitsuba {mr}"
     );
 }
+
+/// Mean and standard error of the mean over an image's pixels (first channel).
+fn mean_and_se(r: &rtis::render::Rendered) -> (f64, f64) {
+    let v: Vec<f64> = r.image.pixels.iter().map(|p| p.x as f64).collect();
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// Physical glass carries radiance across an interface by `(n_wo / n_wi)^2`. A camera in air
+/// looks straight down at a glass half-space (an infinite plane of index `n`) under a uniform
+/// background of 1: each sample reflects with probability F and sees 1, or refracts and sees
+/// `1 / n^2`, so the pixel's expectation is `F + (1 - F) / n^2` with `F = ((n - 1)/(n + 1))^2`
+/// (Mitsuba 3 gives 0.468 for n = 1.5). Tolerance: 5 standard errors of the per-pixel means
+/// (one sample per pixel, 4096 pixels), which also checks that reflection is chosen with
+/// probability F.
+#[test]
+fn physical_glass_half_space_from_air() {
+    for n in [1.2f64, 1.5, 2.4] {
+        let r = render_str(&format!(
+            r#"Scene(film: (width: 64, height: 64), model: Physical, background: (1, 1, 1),
+            camera: Orthographic(position: (0, 1, 0), look_at: (0, 0, 0), up: (0, 0, 1), height: 0.5),
+            shader: Path(),
+            entities: [(shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)), material: Transmissive(ior: {n}))])"#
+        ));
+        let f = ((n - 1.0) / (n + 1.0)).powi(2);
+        let expected = f + (1.0 - f) / (n * n);
+        let (mean, se) = mean_and_se(&r);
+        let reflected =
+            r.stats.reflection as f64 / (r.stats.reflection + r.stats.refraction) as f64;
+        assert!(
+            (mean - expected).abs() < 5.0 * se.max(1e-6),
+            "n = {n}: {mean} +- {se}, expected {expected}"
+        );
+        let se_f = (f * (1.0 - f) / 4096.0).sqrt();
+        assert!(
+            (reflected - f).abs() < 5.0 * se_f,
+            "n = {n}: reflected {reflected}, F = {f}"
+        );
+    }
+}
+
+/// A camera at the centre of a glass ball of index `n` under a uniform background of 1: every
+/// path leaves the ball through one refraction (after any number of reflections inside), so
+/// every sample is `n^2` (Mitsuba 3 gives 2.25 for n = 1.5). Paths that Russian roulette ends
+/// are rare (normal incidence, F = 0.04): tolerance 1e-3 relative.
+#[test]
+fn physical_glass_ball_from_inside() {
+    for n in [1.2f64, 1.5, 2.4] {
+        let r = render_str(&format!(
+            r#"Scene(film: (width: 32, height: 32), model: Physical, background: (1, 1, 1),
+            camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), fov: 90),
+            shader: Path(),
+            entities: [(shape: Sphere(center: (0, 0, 0), radius: 1), material: Transmissive(ior: {n}))])"#
+        ));
+        let (mean, _) = mean_and_se(&r);
+        assert!(
+            (mean / (n * n) - 1.0).abs() < 1e-3,
+            "n = {n}: {mean}, expected {}",
+            n * n
+        );
+    }
+}

@@ -14,7 +14,7 @@
 //!   ambient term and the two-direction rule cost.
 //! - `Physical`: `g = f(wi, wo) cos(theta_i)` with the normalised Phong BRDF: the rendering
 //!   equation, unbiased; glass reflects with Fresnel probability and scales transmitted radiance
-//!   by `1 / eta^2`, as pbrt does for radiance.
+//!   by `eta^2 = (n_wo / n_wi)^2`, as radiance does (`docs/transport.md`).
 
 use super::Tracer;
 use super::surface::{Interaction, direct_light, reflectance, specular_bounce};
@@ -80,7 +80,8 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                     let wr = reflect(si.wo, si.n);
                     (wr, Vec3A::ONE, RayKind::Reflection, tr.effects.reflection)
                 } else {
-                    let w = g.color / (r.eta * r.eta);
+                    // Radiance crossing into the wo side is scaled by (n_wo / n_wi)^2 = eta^2.
+                    let w = g.color * (r.eta * r.eta);
                     (r.wt, w, RayKind::Refraction, tr.effects.refraction)
                 };
                 // An effect that is off ends the path.
