@@ -7,7 +7,7 @@
 
 use crate::accel::{FLAT, Geometry, Prim};
 use crate::geometry::Placement;
-use crate::material::Material;
+use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
 use crate::world::{Name, Scene, Transform, WorldLight, WorldShape};
 
@@ -61,6 +61,21 @@ pub fn extract(scene: &Scene) -> RenderScene {
             warnings.push(format!(
                 "{label}: {dropped} zero-area triangle(s) ignored (they can never be hit)"
             ));
+        }
+    }
+    // Under the physically based model a Phong surface reflects at most what it receives.
+    if s.model == Model::Physical {
+        for m in &mut materials {
+            if let Material::Phong(p) = m
+                && let Some(scaled) = p.energy_conserving()
+            {
+                warnings.push(format!(
+                    "Phong material with kd {} + ks {} above 1 reflects more light than it \
+                     receives: scaled to kd {}, ks {} under the Physical model",
+                    p.kd, p.ks, scaled.kd, scaled.ks
+                ));
+                *p = scaled;
+            }
         }
     }
     let lights: Vec<_> = scene

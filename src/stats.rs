@@ -31,6 +31,9 @@ pub struct RayStats {
     pub refraction: u64,
     /// Indirect rays.
     pub indirect: u64,
+    /// Camera samples whose radiance came out NaN, infinite or negative: dropped (counted as
+    /// zero), never averaged into a pixel. Zero for every valid scene; not a ray count.
+    pub dropped: u64,
 }
 
 impl RayStats {
@@ -59,5 +62,6 @@ impl AddAssign for RayStats {
         self.reflection += o.reflection;
         self.refraction += o.refraction;
         self.indirect += o.indirect;
+        self.dropped += o.dropped;
     }
 }

@@ -348,3 +348,32 @@ fn specular_chains_are_capped_and_loop() {
         assert!(e.to_string().contains("at most"), "{bad}: {e}");
     }
 }
+
+/// The last line of defence: a sample that comes out non-finite or negative is dropped and
+/// counted, and the pixel stays finite. Validation keeps such values out of scene files, so the
+/// render scene is edited directly: one light made infinite, one negative.
+#[test]
+fn non_finite_and_negative_samples_are_dropped_and_counted() {
+    let s = scene(
+        r#"Scene(film: (width: 8, height: 8), shader: Direct(),
+        entities: [
+            (shape: InfinitePlane(point: (0, -1, 0), normal: (0, 1, 0)), material: Phong(kd: (0.5, 0.5, 0.5))),
+            (light: Point(position: (0, 1, 2), intensity: (1, 1, 1))),
+        ])"#,
+    );
+    let mut p = rtis::extract(&s);
+    let clean = rtis::render(&p, &|| {});
+    assert_eq!(clean.stats.dropped, 0);
+    for bad in [f32::INFINITY, -1.0] {
+        let rtis::light::Light::Point(l) = &mut p.lights[0];
+        l.intensity = Vec3A::splat(bad);
+        let r = rtis::render(&p, &|| {});
+        assert!(r.stats.dropped > 10, "{bad}: {} dropped", r.stats.dropped);
+        assert!(
+            r.image
+                .pixels
+                .iter()
+                .all(|q| q.is_finite() && q.min_element() >= 0.0)
+        );
+    }
+}

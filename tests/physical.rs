@@ -430,3 +430,41 @@ fn physical_glass_ball_from_inside() {
         );
     }
 }
+
+/// Albedo above one: under the Physical model a Phong surface with `kd + ks > 1` would create
+/// energy and a path tracer would diverge in a closed scene; extraction scales it so that
+/// `kd + ks = 1` (with a warning), and the render equals the scaled material's exactly. Under
+/// the Course model the material stays as written.
+#[test]
+fn physical_albedo_above_one_is_scaled() {
+    let text = |model: &str, kd: f32, ks: f32| {
+        format!(
+            r#"Scene(film: (width: 16, height: 16), model: {model}, background: (1, 1, 1),
+            camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1)), shader: Path(),
+            entities: [(shape: Sphere(center: (0, 0, 0), radius: 3), material: Phong(kd: ({kd}, {kd}, {kd}), ks: ({ks}, {ks}, {ks}), shininess: 10))])"#
+        )
+    };
+    let over = scene(&text("Physical", 1.0, 0.6));
+    let p = rtis::extract(&over);
+    assert!(
+        p.warnings.iter().any(|w| w.contains("scaled")),
+        "{:?}",
+        p.warnings
+    );
+    let rtis::material::Material::Phong(m) = p.materials[0] else {
+        panic!("a Phong material")
+    };
+    assert!(((m.kd + m.ks) - Vec3A::ONE).abs().max_element() < 1e-6);
+    let a = common::render_scene(&over);
+    let b = render_str(&text("Physical", 0.625, 0.375));
+    let worst = a
+        .image
+        .pixels
+        .iter()
+        .zip(&b.image.pixels)
+        .map(|(x, y)| (*x - *y).abs().max_element())
+        .fold(0.0, f32::max);
+    assert!(worst < 1e-5, "{worst}");
+    let course = rtis::extract(&scene(&text("Course", 1.0, 0.6)));
+    assert!(course.warnings.is_empty(), "{:?}", course.warnings);
+}

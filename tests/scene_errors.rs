@@ -29,6 +29,40 @@ const CASES: &[(&str, &str)] = &[
         "Scene(entities: [(shape: Sphere(center: (0, inf, 5), radius: 1), material: Mirror())])",
     ),
     ("NaN", "Scene(background: (NaN, 0, 0))"),
+    // Finite as doubles, beyond what single-precision render data holds.
+    (
+        "shininess beyond f32",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Phong(kd: (0.5, 0.5, 0.5), ks: (0.5, 0.5, 0.5), shininess: 3.4e38))])",
+    ),
+    (
+        "kd beyond f32",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Phong(kd: (3.4e38, 0.5, 0.5)))])",
+    ),
+    (
+        "reflectance above one",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Mirror(color: (1.5, 1, 1)))])",
+    ),
+    (
+        "intensity beyond f32",
+        "Scene(entities: [(light: Point(position: (0, 2, 0), intensity: (3.4e38, 1, 1)))])",
+    ),
+    ("background beyond range", "Scene(background: (1e31, 0, 0))"),
+    (
+        "coordinate beyond range",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 1e12), radius: 1), material: Mirror())])",
+    ),
+    (
+        "radius beyond range",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1e10), material: Mirror())])",
+    ),
+    (
+        "scale beyond range",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Mirror(), transform: (scale: (1e7, 1e7, 1e7)))])",
+    ),
+    (
+        "ior beyond range",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Transmissive(ior: 1000))])",
+    ),
     (
         "radius zero",
         "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 0), material: Mirror())])",

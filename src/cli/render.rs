@@ -116,9 +116,16 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
             .map_err(|e| format!("{}: cannot write stats: {e}", path.display()))?;
     }
     let s = &result.stats;
+    if s.dropped > 0 {
+        eprintln!(
+            "warning: {} sample(s) came out NaN, infinite or negative and were dropped \
+             (counted as black); the scene has a numerical problem worth reporting",
+            s.dropped
+        );
+    }
     eprintln!(
         "{}x{} at {} spp in {:.2} s on {} threads: {} rays (camera {}, shadow {}, reflection {}, \
-         refraction {}, indirect {}), {:.1} Mrays/s -> {}",
+         refraction {}, indirect {}), {} dropped samples, {:.1} Mrays/s -> {}",
         prepared.film.width,
         prepared.film.height,
         prepared.film.spp,
@@ -130,6 +137,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         s.reflection,
         s.refraction,
         s.indirect,
+        s.dropped,
         result.mrays_per_second(),
         out.display()
     );

@@ -39,6 +39,24 @@ impl Phong {
         self.kd * cos_i + self.ks * cos_r.powf(self.shininess)
     }
 
+    /// This material scaled so that `kd + ks <= 1` in every channel, or `None` if it already
+    /// is. The normalised Phong BRDF reflects at most `kd + ks` of the light it receives, so
+    /// under the physically based model a sum above one would create energy, and a path tracer
+    /// would diverge in a closed scene. Like pbrt, which clamps reflectances to [0, 1], rtis
+    /// makes the material physical rather than refuse it.
+    pub fn energy_conserving(&self) -> Option<Phong> {
+        let sum = self.kd + self.ks;
+        if sum.max_element() <= 1.0 {
+            return None;
+        }
+        let k = Vec3A::ONE / sum.max(Vec3A::ONE);
+        Some(Phong {
+            kd: self.kd * k,
+            ks: self.ks * k,
+            ..*self
+        })
+    }
+
     /// The energy-conserving normalised Phong BRDF
     /// `f(wi, wo) = kd / pi + ks (s + 2) / (2 pi) (wo.wr)^s` (Lafortune and Willems 1994),
     /// zero when either direction is below the surface. Multiply by `wi.n` for the integrand.

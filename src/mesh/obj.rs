@@ -50,8 +50,15 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
     if !all_normals || mesh.normals.contains(&DVec3::ZERO) {
         mesh.normals.clear();
     }
-    if let Some(bad) = mesh.positions.iter().find(|p| !p.is_finite()) {
-        return Err(format!("mesh {}: non-finite vertex {bad}", path.display()));
+    if let Some(bad) = mesh
+        .positions
+        .iter()
+        .find(|p| !p.is_finite() || p.abs().max_element() > 1e9)
+    {
+        return Err(format!(
+            "mesh {}: vertex {bad} is not finite or beyond +-1e9 scene units",
+            path.display()
+        ));
     }
     if mesh.faces.is_empty() {
         return Err(format!("mesh {}: no faces", path.display()));

@@ -39,6 +39,10 @@ impl Rendered {
 }
 
 /// The colour of pixel `(col, row)`: the mean radiance of its `spp` camera samples.
+///
+/// The last line of defence against numerical failure: a sample whose radiance is NaN,
+/// infinite or negative is dropped (it adds zero) and counted in `stats.dropped`, so one bad
+/// sample can never poison a pixel, and the count says that it happened.
 #[inline]
 pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStats) -> Vec3A {
     let film = &scene.film;
@@ -51,7 +55,12 @@ pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStat
         let v = (row as f32 + dy) / film.height as f32;
         let ray = scene.camera.ray(u, v);
         let mut tracer = scene.tracer(sampler, stats);
-        sum += radiance(&scene.shader, &mut tracer, &ray);
+        let l = radiance(&scene.shader, &mut tracer, &ray);
+        if l.is_finite() && l.min_element() >= 0.0 {
+            sum += l;
+        } else {
+            stats.dropped += 1;
+        }
     }
     sum / film.spp as f32
 }

@@ -5,7 +5,9 @@
 //! strategy, the PNG transfer) and converts each description into the world's own component
 //! type (`to_world`), which `super::load` puts into the world.
 
-use super::values::{Count, Direction, Fov, NonNegative, Point, Positive, Rgb, Scale, UpTo};
+use super::values::{
+    Count, Direction, Fov, Ior, NonNegative, Point, Positive, Reflectance, Rgb, Scale, UpTo,
+};
 use crate::camera::{Projection, WorldCamera};
 use crate::effects::Switches;
 use crate::geometry::Transform;
@@ -360,35 +362,35 @@ pub enum MaterialDesc {
     Named(String),
     /// Diffuse plus glossy: `r(wi, wo) = kd (wi.n) + ks (wo.wr)^shininess`.
     Phong {
-        /// Diffuse coefficient, unitless RGB.
-        kd: Rgb,
-        /// Specular coefficient, unitless RGB (default black).
+        /// Diffuse coefficient, a reflectance in [0, 1] per channel.
+        kd: Reflectance,
+        /// Specular coefficient, a reflectance in [0, 1] per channel (default black).
         #[serde(default = "black")]
-        ks: Rgb,
-        /// Phong exponent, >= 0 (default 1).
+        ks: Reflectance,
+        /// Phong exponent, from 0 to 1e6 (default 1).
         #[serde(default = "shininess")]
         shininess: NonNegative,
     },
     /// A perfect mirror tinted by `color`.
     Mirror {
-        /// Tint, unitless RGB (default white).
-        #[serde(default = "white")]
-        color: Rgb,
+        /// Tint, a reflectance in [0, 1] per channel (default white).
+        #[serde(default = "unit")]
+        color: Reflectance,
     },
     /// A perfect refractor (inside index `ior`, outside air) tinted by `color`.
     Transmissive {
-        /// Index of refraction, > 0.
-        ior: Positive,
-        /// Tint, unitless RGB (default white).
-        #[serde(default = "white")]
-        color: Rgb,
+        /// Index of refraction, from 0.01 to 100.
+        ior: Ior,
+        /// Tint, a reflectance in [0, 1] per channel (default white).
+        #[serde(default = "unit")]
+        color: Reflectance,
     },
 }
 
 impl MaterialDesc {
     /// The material, or `None` for a `Named` reference (resolved by the loader).
     pub fn to_world(&self) -> Option<Material> {
-        let rgb = |c: &Rgb| c.0.as_vec3a();
+        let rgb = |c: &Reflectance| c.0.as_vec3a();
         Some(match self {
             MaterialDesc::Named(_) => return None,
             MaterialDesc::Phong { kd, ks, shininess } => Material::Phong(Phong {
@@ -422,8 +424,11 @@ impl TryFrom<MaterialDesc> for TableMaterial {
     }
 }
 
-fn black() -> Rgb {
-    Rgb::BLACK
+fn black() -> Reflectance {
+    Reflectance(glam::DVec3::ZERO)
+}
+fn unit() -> Reflectance {
+    Reflectance(glam::DVec3::ONE)
 }
 fn shininess() -> NonNegative {
     NonNegative(1.0)

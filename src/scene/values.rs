@@ -1,21 +1,56 @@
 //! Validated value types of the scene format. Each rejects bad input while it is parsed, so the
 //! error carries the line and column of the offending value.
+//!
+//! Every number is checked against the range the renderer computes in: render data is single
+//! precision (largest value about 3.4e38), and intersection tests square coordinates and
+//! lengths, so coordinates and lengths stay within 1e9 scene units, radiances within 1e30,
+//! reflectances within [0, 1]. A value that is finite as a double but would overflow a float
+//! is refused here, with its location, rather than turning into NaN pixels later.
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+
+/// Largest coordinate magnitude, and largest length, in scene units.
+pub const MAX_COORD: f64 = 1e9;
+/// Smallest length (radius, height, distance) in scene units.
+pub const MIN_LENGTH: f64 = 1e-9;
+/// Largest radiance or intensity per channel.
+pub const MAX_RADIANCE: f64 = 1e30;
+/// Smallest and largest index of refraction.
+pub const IOR_RANGE: (f64, f64) = (0.01, 100.0);
+/// Largest Phong exponent.
+pub const MAX_SHININESS: f64 = 1e6;
+/// Smallest and largest magnitude of a scale factor.
+pub const SCALE_RANGE: (f64, f64) = (1e-6, 1e6);
+
+/// A number as a person would write it: plain in [1e-4, 1e6), scientific beyond.
+pub fn show(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e6).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// A triple as `(x, y, z)` with [`show`]n numbers.
+fn show3(v: [f64; 3]) -> String {
+    format!("({}, {}, {})", show(v[0]), show(v[1]), show(v[2]))
+}
 
 fn finite3(v: [f64; 3]) -> Result<DVec3, String> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(DVec3::from_array(v))
     } else {
         Err(format!(
-            "non-finite number in ({}, {}, {}): every coordinate must be finite",
-            v[0], v[1], v[2]
+            "non-finite number in {}: every coordinate must be finite",
+            show3(v)
         ))
     }
 }
 
-/// A point or offset `(x, y, z)`, in scene units. Every coordinate finite.
+/// A point or offset `(x, y, z)`, in scene units. Every coordinate finite and at most
+/// [`MAX_COORD`] in magnitude.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "[f64; 3]", into = "[f64; 3]")]
 pub struct Point(pub DVec3);
@@ -23,7 +58,14 @@ pub struct Point(pub DVec3);
 impl TryFrom<[f64; 3]> for Point {
     type Error = String;
     fn try_from(v: [f64; 3]) -> Result<Self, String> {
-        finite3(v).map(Point)
+        let p = finite3(v)?;
+        if p.abs().max_element() > MAX_COORD {
+            return Err(format!(
+                "coordinate out of range in {}: each must be within +-1e9 scene units",
+                show3(v)
+            ));
+        }
+        Ok(Point(p))
     }
 }
 impl From<Point> for [f64; 3] {
@@ -44,8 +86,8 @@ impl TryFrom<[f64; 3]> for Direction {
         let len = d.length();
         if len == 0.0 || !len.is_finite() {
             return Err(format!(
-                "zero-length direction ({}, {}, {}): a normal or up vector needs a direction",
-                v[0], v[1], v[2]
+                "zero-length direction {}: a normal or up vector needs a direction",
+                show3(v)
             ));
         }
         Ok(Direction(d))
@@ -57,8 +99,8 @@ impl From<Direction> for [f64; 3] {
     }
 }
 
-/// A linear RGB triple `(r, g, b)`: finite and non-negative. Depending on where it is used it is
-/// a reflectance (unitless), a radiance (W/(m^2 sr)) or an intensity (W/sr).
+/// A linear RGB triple `(r, g, b)` of radiance (W/(m^2 sr)) or intensity (W/sr): each channel
+/// in [0, [`MAX_RADIANCE`]].
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "[f64; 3]", into = "[f64; 3]")]
 pub struct Rgb(pub DVec3);
@@ -78,8 +120,14 @@ impl TryFrom<[f64; 3]> for Rgb {
         let c = finite3(v)?;
         if c.min_element() < 0.0 {
             return Err(format!(
-                "negative colour ({}, {}, {}): colours and intensities must be >= 0",
-                v[0], v[1], v[2]
+                "negative colour {}: colours and intensities must be >= 0",
+                show3(v)
+            ));
+        }
+        if c.max_element() > MAX_RADIANCE {
+            return Err(format!(
+                "colour {} out of range: radiances and intensities must be at most 1e30",
+                show3(v)
             ));
         }
         Ok(Rgb(c))
@@ -91,7 +139,33 @@ impl From<Rgb> for [f64; 3] {
     }
 }
 
-/// A finite number greater than 0.
+/// A reflectance `(r, g, b)`: the fraction of light a surface sends on, each channel in [0, 1]
+/// (unitless).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "[f64; 3]", into = "[f64; 3]")]
+pub struct Reflectance(pub DVec3);
+
+impl TryFrom<[f64; 3]> for Reflectance {
+    type Error = String;
+    fn try_from(v: [f64; 3]) -> Result<Self, String> {
+        let c = finite3(v)?;
+        if c.min_element() < 0.0 || c.max_element() > 1.0 {
+            return Err(format!(
+                "reflectance {} out of range: each channel must be in [0, 1]",
+                show3(v)
+            ));
+        }
+        Ok(Reflectance(c))
+    }
+}
+impl From<Reflectance> for [f64; 3] {
+    fn from(p: Reflectance) -> Self {
+        p.0.to_array()
+    }
+}
+
+/// A length in scene units (radius, image height, distance): from [`MIN_LENGTH`] to
+/// [`MAX_COORD`].
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "f64", into = "f64")]
 pub struct Positive(pub f64);
@@ -99,11 +173,38 @@ pub struct Positive(pub f64);
 impl TryFrom<f64> for Positive {
     type Error = String;
     fn try_from(v: f64) -> Result<Self, String> {
-        if v.is_finite() && v > 0.0 {
+        if (MIN_LENGTH..=MAX_COORD).contains(&v) {
             Ok(Positive(v))
         } else {
-            Err(format!("must be a finite number greater than 0, got {v}"))
+            Err(format!(
+                "must be a length from 1e-9 to 1e9 scene units, got {}",
+                show(v)
+            ))
         }
+    }
+}
+
+/// An index of refraction, in [`IOR_RANGE`].
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct Ior(pub f64);
+
+impl TryFrom<f64> for Ior {
+    type Error = String;
+    fn try_from(v: f64) -> Result<Self, String> {
+        if (IOR_RANGE.0..=IOR_RANGE.1).contains(&v) {
+            Ok(Ior(v))
+        } else {
+            Err(format!(
+                "index of refraction must be from 0.01 to 100, got {}",
+                show(v)
+            ))
+        }
+    }
+}
+impl From<Ior> for f64 {
+    fn from(p: Ior) -> Self {
+        p.0
     }
 }
 impl From<Positive> for f64 {
@@ -112,7 +213,7 @@ impl From<Positive> for f64 {
     }
 }
 
-/// A finite number greater than or equal to 0.
+/// A Phong exponent, from 0 to [`MAX_SHININESS`].
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "f64", into = "f64")]
 pub struct NonNegative(pub f64);
@@ -120,10 +221,10 @@ pub struct NonNegative(pub f64);
 impl TryFrom<f64> for NonNegative {
     type Error = String;
     fn try_from(v: f64) -> Result<Self, String> {
-        if v.is_finite() && v >= 0.0 {
+        if (0.0..=MAX_SHININESS).contains(&v) {
             Ok(NonNegative(v))
         } else {
-            Err(format!("must be a finite number >= 0, got {v}"))
+            Err(format!("must be a number from 0 to 1e6, got {}", show(v)))
         }
     }
 }
@@ -141,11 +242,12 @@ pub struct Fov(pub f64);
 impl TryFrom<f64> for Fov {
     type Error = String;
     fn try_from(v: f64) -> Result<Self, String> {
-        if v.is_finite() && v > 0.0 && v < 180.0 {
+        if (0.001..=179.999).contains(&v) {
             Ok(Fov(v))
         } else {
             Err(format!(
-                "field of view must be between 0 and 180 degrees (exclusive), got {v}"
+                "field of view must be from 0.001 to 179.999 degrees, got {}",
+                show(v)
             ))
         }
     }
@@ -200,7 +302,7 @@ impl<const MAX: u32> From<UpTo<MAX>> for u32 {
     }
 }
 
-/// A scale `(sx, sy, sz)`: finite, no component zero (negative mirrors).
+/// A scale `(sx, sy, sz)`: each component's magnitude in [`SCALE_RANGE`] (negative mirrors).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "[f64; 3]", into = "[f64; 3]")]
 pub struct Scale(pub DVec3);
@@ -211,8 +313,16 @@ impl TryFrom<[f64; 3]> for Scale {
         let s = finite3(v)?;
         if s.x == 0.0 || s.y == 0.0 || s.z == 0.0 {
             return Err(format!(
-                "zero scale ({}, {}, {}): every component must be non-zero",
-                v[0], v[1], v[2]
+                "zero scale {}: every component must be non-zero",
+                show3(v)
+            ));
+        }
+        let m = s.abs();
+        if m.min_element() < SCALE_RANGE.0 || m.max_element() > SCALE_RANGE.1 {
+            return Err(format!(
+                "scale {} out of range: each component's magnitude must be from \
+                 1e-6 to 1e6",
+                show3(v)
             ));
         }
         Ok(Scale(s))

@@ -17,9 +17,22 @@ pub fn scene(text: &str) -> Scene {
     scene::load_str(text, "test.ron", Some(&scenes_dir())).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Prepare and render a loaded scene on the global pool.
+/// Extract and render a loaded scene on the global pool; asserts that no sample was dropped
+/// as NaN, infinite or negative, and that every pixel is finite and non-negative.
 pub fn render_scene(s: &Scene) -> Rendered {
-    render(&rtis::extract(s), &|| {})
+    let r = render(&rtis::extract(s), &|| {});
+    assert_eq!(
+        r.stats.dropped, 0,
+        "samples dropped as non-finite or negative"
+    );
+    assert!(
+        r.image
+            .pixels
+            .iter()
+            .all(|p| p.is_finite() && p.min_element() >= 0.0),
+        "a pixel is NaN, infinite or negative"
+    );
+    r
 }
 
 /// Parse and render scene text.
