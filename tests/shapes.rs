@@ -2,7 +2,8 @@
 
 use glam::Vec3A;
 use proptest::prelude::*;
-use rtis::geometry::{Hit, Ray, offset_origin};
+use rtis::accel::{FLAT, Geometry, Prim};
+use rtis::geometry::{Hit, Ray};
 use rtis::shape::{Plane, Shape, Sphere, Triangle};
 
 fn unit() -> impl Strategy<Value = Vec3A> {
@@ -28,6 +29,7 @@ fn hit_of(shape: &Shape, ray: &Ray) -> Option<Hit> {
             p: s.p,
             n: s.n,
             err: s.err,
+            err_along: s.err_along,
             prim: 0,
         }
     })
@@ -71,7 +73,7 @@ proptest! {
             let n = if hit.n.dot(d) < 0.0 { hit.n } else { -hit.n };
             let w = if w.dot(n) > 0.0 { w } else { -w };
             if w.dot(n) > 1e-3 {
-                let back = Ray::new(offset_origin(&hit, w), w);
+                let back = Ray::spawn(&hit, w, f32::INFINITY);
                 match shape {
                     Shape::Sphere(sp) => {
                         // A ray leaving a sphere outward cannot meet it again; leaving inward
@@ -177,4 +179,92 @@ fn grazing_sphere_rays_are_finite() {
             assert!(t.is_finite() && surf.p.is_finite() && surf.n.is_finite());
         }
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+
+    /// Every path that intersects spheres and planes agrees: the scalar shape test, the SIMD
+    /// packets (a scene of at most 16 spheres), and the BVH (a scene of more), for camera rays
+    /// and for rays spawned off a first hit (the start rule included).
+    #[test]
+    fn scalar_packets_and_bvh_agree(
+        (s, spheres, o, d, w) in scale().prop_flat_map(|s| (
+            Just(s),
+            proptest::collection::vec((point(s), 0.05f32..1.0), 1..4),
+            point(3.0 * s),
+            unit(),
+            unit(),
+        ))
+    ) {
+        let shapes: Vec<Shape> = spheres
+            .iter()
+            .map(|&(c, r)| Shape::Sphere(Sphere { c, r: r * s }))
+            .chain([Shape::Plane(Plane::through(Vec3A::new(0.0, -2.0 * s, 0.0), Vec3A::Y))])
+            .collect();
+        let prims = |shapes: &[Shape]| -> Vec<Prim> {
+            shapes.iter().map(|&shape| Prim { shape, material: 0, smooth: FLAT }).collect()
+        };
+        let packed = Geometry::build(prims(&shapes), Vec::new());
+        // Padding the scene to 17 spheres (far away) sends its spheres to the BVH.
+        let mut many = shapes.clone();
+        for i in 0..17 {
+            many.push(Shape::Sphere(Sphere { c: Vec3A::new(1e3 * s, i as f32 * s, 0.0), r: 0.01 * s }));
+        }
+        let bvh = Geometry::build(prims(&many), Vec::new());
+        prop_assert!(packed.spheres.packs.len() > 0 && bvh.in_bvh > 0);
+        let scalar = |ray: &Ray| -> Option<(usize, f32)> {
+            shapes.iter().enumerate().filter_map(|(i, sh)| sh.intersect(ray).map(|t| (i, t)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+        };
+        let camera = Ray::new(o, d);
+        let mut rays = vec![camera];
+        if let Some(h) = packed.intersect(&camera) {
+            let w = if w.dot(h.n) * h.n.dot(-d) >= 0.0 { w } else { -w };
+            rays.push(Ray::spawn(&h, w, f32::INFINITY));
+        }
+        for ray in rays {
+            let want = scalar(&ray).map(|(_, t)| t);
+            let got_packed = packed.intersect(&ray).map(|h| h.t);
+            let got_bvh = bvh.intersect(&ray).map(|h| h.t);
+            prop_assert_eq!(want, got_packed, "packets");
+            prop_assert_eq!(want.is_some(), got_bvh.is_some(), "BVH");
+            if let (Some(a), Some(b)) = (want, got_bvh) {
+                prop_assert!((a - b).abs() <= 1e-6 * a.abs().max(s), "BVH t {} vs {}", b, a);
+            }
+        }
+    }
+}
+
+/// A ray from (0, 0, -5) along +z meets the unit sphere at the origin at t = 4 exactly, in the
+/// scalar test, the SIMD packets and the BVH; and the near root, not the far one.
+#[test]
+fn unit_sphere_is_hit_at_four_in_every_path() {
+    let sphere = Shape::Sphere(Sphere {
+        c: Vec3A::ZERO,
+        r: 1.0,
+    });
+    let ray = Ray::new(Vec3A::new(0.0, 0.0, -5.0), Vec3A::Z);
+    assert_eq!(sphere.intersect(&ray), Some(4.0));
+    let prim = Prim {
+        shape: sphere,
+        material: 0,
+        smooth: FLAT,
+    };
+    let packed = Geometry::build(vec![prim], Vec::new());
+    assert_eq!(packed.intersect(&ray).map(|h| h.t), Some(4.0));
+    let far = |i: usize| Prim {
+        shape: Shape::Sphere(Sphere {
+            c: Vec3A::new(100.0, i as f32, 0.0),
+            r: 0.1,
+        }),
+        material: 0,
+        smooth: FLAT,
+    };
+    let bvh = Geometry::build(
+        std::iter::once(prim).chain((0..20).map(far)).collect(),
+        Vec::new(),
+    );
+    assert!(bvh.in_bvh > 0);
+    assert_eq!(bvh.intersect(&ray).map(|h| h.t), Some(4.0));
 }

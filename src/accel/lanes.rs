@@ -1,26 +1,37 @@
 //! Primitives four to a packet in structure-of-arrays lanes, tested together with SSE
 //! (`glam::Vec4`). Planes always live here; spheres too when a scene has few of them, where a
 //! BVH costs more than it saves. The arithmetic is the scalar tests' (`shape::Sphere`,
-//! `shape::Plane`) operation for operation, so a packet finds exactly the hits the scalar
-//! code would.
+//! `shape::Plane`), including their rule for a ray that starts on the surface, so a packet
+//! finds the hits the scalar code would (`tests/shapes.rs` checks that they agree).
 
+use crate::geometry::{Ray, gamma};
 use crate::shape::{Plane, Sphere};
-use glam::{BVec4A, Vec3A, Vec4};
+use glam::{BVec4A, Vec4};
 
 /// A ray splatted across four lanes.
 #[derive(Clone, Copy)]
 pub struct RayLanes {
     o: [Vec4; 3],
     d: [Vec4; 3],
+    /// `|o|` per coordinate.
+    o_abs: [Vec4; 3],
+    /// `max |o_i|`.
+    o_abs_max: Vec4,
+    /// The origin's error bound.
+    o_err: Vec4,
 }
 
 impl RayLanes {
-    /// Splat origin and direction.
+    /// Splat a ray's origin, direction and origin error.
     #[inline(always)]
-    pub fn new(o: Vec3A, d: Vec3A) -> Self {
+    pub fn new(ray: &Ray) -> Self {
+        let (o, d, a) = (ray.o, ray.d, ray.o.abs());
         RayLanes {
             o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
+            o_abs: [Vec4::splat(a.x), Vec4::splat(a.y), Vec4::splat(a.z)],
+            o_abs_max: Vec4::splat(a.max_element()),
+            o_err: Vec4::splat(ray.o_err),
         }
     }
 }
@@ -34,7 +45,10 @@ fn dot(a: [Vec4; 3], b: [Vec4; 3]) -> Vec4 {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SphereLanes {
     c: [Vec4; 3],
+    r: Vec4,
     r2: Vec4,
+    /// `max |c_i|`.
+    c_abs_max: Vec4,
 }
 
 /// Up to four planes; unused lanes have a zero normal and never hit.
@@ -42,6 +56,10 @@ pub struct SphereLanes {
 pub struct PlaneLanes {
     n: [Vec4; 3],
     dist: Vec4,
+    /// `|n|` per coordinate.
+    n_abs: [Vec4; 3],
+    /// `sum |n_i|`.
+    n_abs_sum: Vec4,
 }
 
 impl SphereLanes {
@@ -58,7 +76,9 @@ impl SphereLanes {
         };
         SphereLanes {
             c: [v(|s| s.c.x, 0.0), v(|s| s.c.y, 0.0), v(|s| s.c.z, 0.0)],
+            r: v(|s| s.r, 0.0),
             r2: v(|s| s.r * s.r, -1.0),
+            c_abs_max: v(|s| s.c.abs().max_element(), 0.0),
         }
     }
 
@@ -70,7 +90,8 @@ impl SphereLanes {
         let b = -dot(f, r.d);
         let l = [f[0] + b * r.d[0], f[1] + b * r.d[1], f[2] + b * r.d[2]];
         let disc = self.r2 - dot(l, l);
-        let c = dot(f, f) - self.r2;
+        let f2 = dot(f, f);
+        let c = f2 - self.r2;
         let q = b + disc.sqrt().copysign(b);
         let a = c / q;
         let first = a.cmple(q);
@@ -78,10 +99,19 @@ impl SphereLanes {
         let t1 = Vec4::select(first, q, a);
         let zero = Vec4::ZERO;
         let tm = Vec4::splat(t_max);
+        // The scalar test's band: an origin on the sphere only meets the root away from zero.
+        let fl = f2.sqrt();
+        let e_f = r.o_err + Vec4::splat(gamma(1)) * (r.o_abs_max + self.c_abs_max);
+        let band = Vec4::splat(gamma(5)) * (f2 + self.r2) + Vec4::splat(4.0) * fl * e_f;
+        let t_min = band / (fl + self.r);
+        let on = c.abs().cmple(band);
+        let other = Vec4::select(t0.abs().cmple(t1.abs()), t1, t0);
+        let ok_on = other.cmpgt(t_min) & other.cmple(tm);
         let ok0 = t0.cmpgt(zero) & t0.cmple(tm);
         let ok1 = t1.cmpgt(zero) & t1.cmple(tm);
-        let t = Vec4::select(ok0, t0, t1);
-        (t, disc.cmpge(zero) & q.cmpne(zero) & (ok0 | ok1))
+        let t = Vec4::select(on, other, Vec4::select(ok0, t0, t1));
+        let ok = (on & ok_on) | (!on & (ok0 | ok1));
+        (t, disc.cmpge(zero) & q.cmpne(zero) & ok)
     }
 }
 
@@ -93,6 +123,8 @@ impl PlaneLanes {
         PlaneLanes {
             n: [v(|p| p.n.x), v(|p| p.n.y), v(|p| p.n.z)],
             dist: v(|p| p.dist),
+            n_abs: [v(|p| p.n.x.abs()), v(|p| p.n.y.abs()), v(|p| p.n.z.abs())],
+            n_abs_sum: v(|p| p.n.abs().element_sum()),
         }
     }
 
@@ -100,8 +132,12 @@ impl PlaneLanes {
     #[inline(always)]
     pub fn hit(&self, r: &RayLanes, t_max: f32) -> (Vec4, BVec4A) {
         let denom = dot(self.n, r.d);
-        let t = (self.dist - dot(self.n, r.o)) / denom;
-        let ok = denom.cmpne(Vec4::ZERO) & t.cmpgt(Vec4::ZERO) & t.cmple(Vec4::splat(t_max));
+        let s = self.dist - dot(self.n, r.o);
+        let band = Vec4::splat(gamma(4)) * (dot(self.n_abs, r.o_abs) + self.dist.abs())
+            + self.n_abs_sum * r.o_err;
+        let t = s / denom;
+        let beyond = (s * denom.signum()).cmpgt(band);
+        let ok = denom.cmpne(Vec4::ZERO) & beyond & t.cmple(Vec4::splat(t_max));
         (t, ok)
     }
 }

@@ -146,7 +146,7 @@ impl Geometry {
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut t_max = ray.t_max;
         let mut best: Option<u32> = None;
-        let lanes = RayLanes::new(ray.o, ray.d);
+        let lanes = RayLanes::new(ray);
         self.spheres
             .closest(&lanes, &mut t_max, &mut best, SphereLanes::hit);
         if !self.bvh.nodes.is_empty() {
@@ -165,6 +165,7 @@ impl Geometry {
             p: s.p,
             n: s.n,
             err: s.err,
+            err_along: s.err_along,
             prim,
         })
     }
@@ -172,7 +173,7 @@ impl Geometry {
     /// True if anything blocks `ray` within `(0, ray.t_max]` (any-hit query for shadow rays).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let lanes = RayLanes::new(ray.o, ray.d);
+        let lanes = RayLanes::new(ray);
         self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
             || self.planes.any(&lanes, ray.t_max, PlaneLanes::hit)
             || (!self.bvh.nodes.is_empty()

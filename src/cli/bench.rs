@@ -193,11 +193,7 @@ fn meshes_section() {
             .map(|h| {
                 let to = light - h.p;
                 let w = to.normalize();
-                Ray::segment(
-                    h.p + h.n * h.err * if h.n.dot(w) > 0.0 { 1.0 } else { -1.0 },
-                    w,
-                    to.length() * 0.9999,
-                )
+                Ray::spawn(&h, w, to.length() * 0.9999)
             })
             .collect();
         let (shadow_rate, _) = rate(&shadow, |r| g.occluded(r));

@@ -64,6 +64,12 @@ impl Placement {
         (self.affine.transform_point3(p) - self.origin).as_vec3a()
     }
 
+    /// A point, transformed and made camera-relative, still in double precision.
+    #[inline]
+    pub fn point_f64(&self, p: DVec3) -> DVec3 {
+        self.affine.transform_point3(p) - self.origin
+    }
+
     /// A normal, transformed by the inverse transpose and normalised.
     #[inline]
     pub fn normal(&self, n: DVec3) -> Vec3A {

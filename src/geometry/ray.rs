@@ -1,6 +1,28 @@
-//! A ray with precomputed data for watertight triangle tests, and the surface hit record.
+//! A ray with precomputed data for watertight triangle tests, the surface hit record, and the
+//! rounding-error bounds that place spawned rays (pbrt-v4's approach, "Managing Rounding
+//! Error", section 6.8 of the 4th edition).
+//!
+//! Every hit point carries a bound on its error, derived from the operations that computed it
+//! ([`gamma`]). A spawned ray starts off the surface by that bound along the normal and carries
+//! the bound on its own origin's error (`o_err`). Shape tests then apply one rule: a ray whose
+//! origin lies within the error band of a surface starts *on* it, and does not meet it at its
+//! start. That is what keeps a shadow ray from a crease between two walls from being blocked by
+//! the neighbouring wall (seam acne), and a ray from re-hitting the surface it left, without any
+//! epsilon.
 
 use glam::Vec3A;
+
+/// The unit roundoff of `f32`: half of machine epsilon. Every correctly rounded operation has
+/// a relative error of at most this.
+pub const UNIT_ROUNDOFF: f32 = f32::EPSILON * 0.5;
+
+/// `gamma(n) = n u / (1 - n u)`: a bound on the relative error accumulated by `n` successive
+/// rounded operations (Higham; pbrt-v4's `gamma`).
+#[inline]
+pub const fn gamma(n: u32) -> f32 {
+    let nu = n as f32 * UNIT_ROUNDOFF;
+    nu / (1.0 - nu)
+}
 
 /// A half-line `o + t d` for `t` in `(0, t_max]`.
 ///
@@ -20,6 +42,9 @@ pub struct Ray {
     pub k: [usize; 3],
     /// Shear constants `(-dx/dz, -dy/dz, 1/dz)` in the permuted frame.
     pub shear: [f32; 3],
+    /// Bound on the error of `o` in each coordinate, against the exact point it stands for
+    /// (0 for camera rays, whose origin is exact).
+    pub o_err: f32,
 }
 
 impl Ray {
@@ -46,6 +71,7 @@ impl Ray {
             inv_d: d.recip(),
             k: [kx, ky, kz],
             shear: [d[kx] * sz, d[ky] * sz, sz],
+            o_err: 0.0,
         }
     }
 
@@ -61,6 +87,18 @@ impl Ray {
             inv_d: Vec3A::ZERO,
             k: [0, 1, 2],
             shear: [0.0; 3],
+            o_err: 0.0,
+        }
+    }
+
+    /// A ray leaving the surface of `hit` in unit direction `w` and stopping at `t_max`: it
+    /// starts at [`spawn_origin`] and carries that origin's error bound.
+    #[inline]
+    pub fn spawn(hit: &Hit, w: Vec3A, t_max: f32) -> Self {
+        let (o, o_err) = spawn_origin(hit, w);
+        Ray {
+            o_err,
+            ..Ray::bare(o, w, t_max)
         }
     }
 
@@ -69,7 +107,10 @@ impl Ray {
     #[inline]
     pub fn for_bvh(&self, t_max: f32, triangles: bool) -> Ray {
         if triangles {
-            Ray::segment(self.o, self.d, t_max)
+            Ray {
+                o_err: self.o_err,
+                ..Ray::segment(self.o, self.d, t_max)
+            }
         } else {
             Ray {
                 t_max,
@@ -96,29 +137,49 @@ pub struct Hit {
     /// Unit geometric normal as the shape defines it (outward for spheres, the declared normal
     /// for planes, the winding normal for triangles). Shaders orient it towards the viewer.
     pub n: Vec3A,
-    /// Absolute bound on the error of `p` in every coordinate; secondary rays start
-    /// this far off the surface (see [`offset_origin`]).
+    /// Bound on the error of `p` in each coordinate across the surface (how far off the
+    /// surface it can be); spawned rays start off the surface by it (see [`spawn_origin`]).
     pub err: f32,
+    /// Bound on the error of `p` along the surface (how far from the ray's exact crossing).
+    pub err_along: f32,
     /// Index of the primitive in the prepared scene.
     pub prim: u32,
 }
 
-/// How many machine epsilons of the hit point's magnitude a secondary ray is pushed off the
-/// surface. Sized from the error analysis of the sphere, plane and triangle tests (each within a
-/// few tens of ulps of the largest coordinate involved) with a safety factor.
-pub const OFFSET_ULPS: f32 = 128.0;
-
-/// The start of a secondary ray that leaves `hit` in direction `w`: the hit point moved off the
-/// surface along the geometric normal, to the side `w` points to, by the hit's error bound.
+/// The start of a ray that leaves `hit` in direction `w`, and the bound on its error.
 ///
-/// The push is relative to the size of the coordinates, so it works at any scene scale (the
-/// tests render the Cornell box scaled by 1e-3 and translated by 1e5). No fixed epsilon.
+/// The hit point is moved along the geometric normal, to the side `w` points to, by the
+/// projection of its error box onto the normal (`sum |n_i| err`), so the origin is off the
+/// surface whatever the rounding; each coordinate is then rounded away from the surface, so
+/// that the offset survives the addition (pbrt-v4's `OffsetRayOrigin`). The origin's error
+/// against the exact surface point is at most the point's error plus the offset plus that last
+/// rounding.
 #[inline]
-pub fn offset_origin(hit: &Hit, w: Vec3A) -> Vec3A {
-    let push = hit.n * hit.err;
-    if hit.n.dot(w) >= 0.0 {
-        hit.p + push
+pub fn spawn_origin(hit: &Hit, w: Vec3A) -> (Vec3A, f32) {
+    let d = hit.n.abs().element_sum() * hit.err;
+    let offset = if hit.n.dot(w) >= 0.0 {
+        d * hit.n
     } else {
-        hit.p - push
-    }
+        -d * hit.n
+    };
+    let away = |v: f32, dir: f32| {
+        if dir > 0.0 {
+            v.next_up()
+        } else if dir < 0.0 {
+            v.next_down()
+        } else {
+            v
+        }
+    };
+    let p = hit.p + offset;
+    let o = Vec3A::new(
+        away(p.x, offset.x),
+        away(p.y, offset.y),
+        away(p.z, offset.z),
+    );
+    // Against the exact crossing point: the error across and along the surface (twice: the
+    // nearest-hit choice between two surfaces within error of each other can add as much
+    // again), the offset, and the last rounding.
+    let o_err = hit.err + d + 2.0 * hit.err_along + 2.0 * UNIT_ROUNDOFF * o.abs().max_element();
+    (o, o_err)
 }

@@ -4,7 +4,7 @@
 
 use super::Tracer;
 use crate::effects::Effects;
-use crate::geometry::{Hit, Ray, offset_origin};
+use crate::geometry::{Hit, Ray};
 use crate::material::{Material, Model, Phong};
 use crate::stats::RayKind;
 use glam::Vec3A;
@@ -44,7 +44,7 @@ impl Interaction {
     /// A ray leaving the surface in unit direction `w`, started off the surface on `w`'s side.
     #[inline]
     pub fn spawn(&self, w: Vec3A) -> Ray {
-        Ray::bare(offset_origin(&self.hit, w), w, f32::INFINITY)
+        Ray::spawn(&self.hit, w, f32::INFINITY)
     }
 }
 
@@ -76,8 +76,7 @@ pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
         // Shadow ray V^s: stop just short of the light, so that a surface the light sits on
         // does not block it.
         let visible = !tr.effects.shadows || {
-            let o = offset_origin(&si.hit, inc.wi);
-            tr.unoccluded(&Ray::bare(o, inc.wi, inc.dist * SHADOW_END))
+            tr.unoccluded(&Ray::spawn(&si.hit, inc.wi, inc.dist * SHADOW_END))
         };
         if visible {
             l_dir += inc.li * reflectance(model, phong, inc.wi, si.wo, si.n);

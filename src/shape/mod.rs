@@ -134,14 +134,12 @@ pub struct Surface {
     pub p: Vec3A,
     /// Unit geometric normal (outward for spheres, as declared for planes, winding for triangles).
     pub n: Vec3A,
-    /// Absolute error bound on `p`.
+    /// Bound on the error of `p` in each coordinate, across the surface: how far the point can
+    /// be off the surface. Spawned rays start off the surface by it.
     pub err: f32,
-}
-
-/// Error bound of a refined hit point whose coordinates are at most `scale` in magnitude.
-#[inline]
-pub(crate) fn point_error(scale: f32) -> f32 {
-    crate::geometry::OFFSET_ULPS * f32::EPSILON * scale.max(f32::MIN_POSITIVE)
+    /// Bound on the error of `p` along the surface, from the error of `t`: how far the point
+    /// can be from where the ray truly crosses the surface. Only the start rule reads it.
+    pub err_along: f32,
 }
 
 impl Shape {

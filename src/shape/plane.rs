@@ -1,7 +1,7 @@
 //! Infinite planes.
 
-use super::{Surface, point_error};
-use crate::geometry::{Placement, Ray};
+use super::Surface;
+use crate::geometry::{Placement, Ray, gamma};
 use glam::Vec3A;
 
 /// The two-sided plane `{p : n.p = dist}` with unit normal `n`.
@@ -16,7 +16,13 @@ pub struct Plane {
 impl Plane {
     /// The plane through `point` with normal `normal` (scene units) placed by `at`.
     pub fn placed(point: glam::DVec3, normal: glam::DVec3, at: &Placement) -> Self {
-        Plane::through(at.point(point), at.normal(normal))
+        // The distance is taken in double precision and rounded once, so the plane is the one
+        // through `point` for the rounded normal, to one rounding.
+        let n = at.normal(normal);
+        Plane {
+            n,
+            dist: n.as_dvec3().dot(at.point_f64(point)) as f32,
+        }
     }
 
     /// The plane through `point` with unit normal `n`.
@@ -27,26 +33,50 @@ impl Plane {
         }
     }
 
-    /// Distance to the plane in `(0, t_max]`; `None` for rays parallel to it.
+    /// Distance to the plane in `(0, t_max]`; `None` for rays parallel to it, and for a ray
+    /// that starts on it.
+    ///
+    /// `s = dist - n.o` is the signed distance from the origin to the plane. Its rounding error
+    /// is at most `gamma(4) (|n|.|o| + |dist|)`, and the origin's own error moves it by at most
+    /// `(sum |n_i|) o_err`. Within that band the origin is on the plane: a ray that starts on a
+    /// plane never meets it again.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         let denom = self.n.dot(ray.d);
         if denom == 0.0 {
             return None;
         }
-        let t = (self.dist - self.n.dot(ray.o)) / denom;
-        (t > 0.0 && t <= ray.t_max).then_some(t)
+        let s = self.dist - self.n.dot(ray.o);
+        let band = self.band(ray);
+        let t = s / denom;
+        // `s` on the side `d` goes to, and beyond the band: equivalent to `t > band / |denom|`.
+        (s * denom.signum() > band && t <= ray.t_max).then_some(t)
     }
 
-    /// Hit point projected onto the plane, its normal, error bound.
+    /// The error band of the origin's signed distance to the plane (see [`Plane::intersect`]).
+    #[inline]
+    pub fn band(&self, ray: &Ray) -> f32 {
+        let an = self.n.abs();
+        gamma(4) * (an.dot(ray.o.abs()) + self.dist.abs()) + an.element_sum() * ray.o_err
+    }
+
+    /// Hit point projected onto the plane, its normal, and its error bounds.
+    ///
+    /// The projection puts the point on the plane up to the roundings of `n.p - dist`, the
+    /// product and the subtraction: `gamma(6) (|p| + |dist|)` across the plane. Along the plane
+    /// the point keeps the error of `t`: the rounding of `s` (`gamma(4) (|n|.|o| + |dist|)`)
+    /// divided by `|n.d|`, and a few roundings of `o + t d`.
     #[inline]
     pub fn surface(&self, ray: &Ray, t: f32) -> Surface {
         let p = ray.at(t);
         let p = p - (self.n.dot(p) - self.dist) * self.n;
+        let an = self.n.abs();
+        let dt = gamma(4) * (an.dot(ray.o.abs()) + self.dist.abs()) / self.n.dot(ray.d).abs();
         Surface {
             p,
             n: self.n,
-            err: point_error(p.abs().max_element().max(self.dist.abs())),
+            err: gamma(6) * (p.abs().max_element() + self.dist.abs()),
+            err_along: dt + gamma(3) * (ray.o.abs().max_element() + t.abs()),
         }
     }
 }

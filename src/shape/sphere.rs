@@ -1,7 +1,7 @@
 //! Spheres.
 
-use super::{Surface, point_error};
-use crate::geometry::{Aabb, Placement, Ray};
+use super::Surface;
+use crate::geometry::{Aabb, Placement, Ray, gamma};
 use glam::Vec3A;
 
 /// A sphere of centre `c` and radius `r > 0`.
@@ -22,11 +22,18 @@ impl Sphere {
         }
     }
 
-    /// Nearest root of `|o + t d - c|^2 = r^2` in `(0, t_max]`.
+    /// Nearest root of `|o + t d - c|^2 = r^2` in `(0, t_max]`, not counting the start of a
+    /// ray that starts on the sphere.
     ///
     /// Uses the cancellation-free form of Haines et al. (Ray Tracing Gems, ch. 7): the
     /// discriminant is `r^2 - |f - (f.d) d|^2` and the two roots are `c/q` and `q`, so grazing
     /// rays and far-away spheres stay accurate.
+    ///
+    /// `c = |f|^2 - r^2` says where the origin is: its rounding error is at most
+    /// `gamma(5) (|f|^2 + r^2)`, and the error of `f` (the origin's `o_err` and the rounding of
+    /// `o - c`) moves it by at most `4 |f| e_f`. Within that band the origin is on the sphere,
+    /// and the root nearer zero is the ray's own start: only the other root can be a hit, and
+    /// only beyond the band's distance (a ray tangent at its start meets nothing).
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         let f = ray.o - self.c;
@@ -37,7 +44,8 @@ impl Sphere {
         if disc < 0.0 {
             return None;
         }
-        let c = f.length_squared() - r2;
+        let f2 = f.length_squared();
+        let c = f2 - r2;
         let q = b + disc.sqrt().copysign(b);
         if q == 0.0 {
             // Origin at the centre of a zero-size configuration: no usable root.
@@ -47,6 +55,12 @@ impl Sphere {
             let (a, b) = (c / q, q);
             if a <= b { (a, b) } else { (b, a) }
         };
+        let (band, t_min) = self.band(ray, f2);
+        if c.abs() <= band {
+            // The origin is on the sphere: the root nearer zero is where the ray starts.
+            let t = if t0.abs() <= t1.abs() { t1 } else { t0 };
+            return (t > t_min && t <= ray.t_max).then_some(t);
+        }
         if t0 > 0.0 && t0 <= ray.t_max {
             Some(t0)
         } else if t1 > 0.0 && t1 <= ray.t_max {
@@ -56,15 +70,40 @@ impl Sphere {
         }
     }
 
-    /// Hit point projected back onto the sphere, outward normal, error bound.
+    /// The error band of `c = |f|^2 - r^2` for a ray whose `|f|^2` is `f2`, and the distance it
+    /// stands for (see [`Sphere::intersect`]).
+    #[inline]
+    pub fn band(&self, ray: &Ray, f2: f32) -> (f32, f32) {
+        let fl = f2.sqrt();
+        let e_f = ray.o_err + gamma(1) * (ray.o.abs().max_element() + self.c.abs().max_element());
+        let band = gamma(5) * (f2 + self.r * self.r) + 4.0 * fl * e_f;
+        (band, band / (fl + self.r))
+    }
+
+    /// Hit point projected back onto the sphere, outward normal, and its error bounds.
+    ///
+    /// The reprojection `c + r normalize(o + t d - c)` puts the point on the sphere up to the
+    /// roundings of the normalisation, the scaling and the sum: `gamma(6) (|c| + r)` across
+    /// the surface. Along it the point keeps the error of `t`: the rounding of
+    /// `c = |f|^2 - r^2`, divided by the rate `2 r |cos|` at which `c` changes along the ray
+    /// (large for grazing rays, where the root is ill-conditioned; at most the diameter).
     #[inline]
     pub fn surface(&self, ray: &Ray, t: f32) -> Surface {
         let n = (ray.at(t) - self.c).normalize();
         let p = self.c + self.r * n;
+        let f = ray.o - self.c;
+        let ec = gamma(5) * (f.length_squared() + self.r * self.r);
+        let rate = 2.0 * self.r * n.dot(ray.d).abs();
+        let dt = if ec < rate * 2.0 * self.r {
+            ec / rate
+        } else {
+            2.0 * self.r
+        };
         Surface {
             p,
             n,
-            err: point_error(self.c.abs().max_element() + self.r),
+            err: gamma(6) * (self.c.abs().max_element() + self.r),
+            err_along: dt + gamma(3) * (ray.o.abs().max_element() + t.abs()),
         }
     }
 

@@ -1,7 +1,7 @@
 //! Triangles with the watertight test of Woop, Benthin and Wald (JCGT 2013).
 
-use super::{Surface, point_error};
-use crate::geometry::{Aabb, Ray};
+use super::Surface;
+use crate::geometry::{Aabb, Ray, gamma};
 use glam::Vec3A;
 
 /// A two-sided triangle with vertices `v0, v1, v2` and unit winding normal
@@ -76,10 +76,19 @@ impl Triangle {
         let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
         let t_scaled = u * az + v * bz + w * cz;
         let t = t_scaled / det;
-        (t > 0.0 && t <= ray.t_max).then_some(t)
+        if t <= 0.0 || t > ray.t_max {
+            return None;
+        }
+        // A ray that starts on the triangle's plane (within the error band of the origin's
+        // signed distance `n.(v0 - o)`, as for planes) does not meet it at its start.
+        let an = self.n.abs();
+        let band = gamma(5) * an.dot(self.v[0].abs() + ray.o.abs()) + an.element_sum() * ray.o_err;
+        (t * self.n.dot(ray.d).abs() > band).then_some(t)
     }
 
-    /// Hit point projected onto the triangle's plane, the winding normal, error bound.
+    /// Hit point projected onto the triangle's plane, the winding normal, and its error
+    /// bounds, as for a plane: `gamma(7)` of the coordinates involved across the plane (one
+    /// more rounding for `p - v0`), and the error of `t` along it.
     #[inline]
     pub fn surface(&self, ray: &Ray, t: f32) -> Surface {
         let p = ray.at(t);
@@ -90,10 +99,13 @@ impl Triangle {
             .max(self.v[2].abs())
             .max(p.abs())
             .max_element();
+        let an = self.n.abs();
+        let dt = gamma(5) * an.dot(self.v[0].abs() + ray.o.abs()) / self.n.dot(ray.d).abs();
         Surface {
             p,
             n: self.n,
-            err: point_error(scale),
+            err: gamma(7) * scale,
+            err_along: dt + gamma(3) * (ray.o.abs().max_element() + t.abs()),
         }
     }
 
