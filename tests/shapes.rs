@@ -212,7 +212,7 @@ proptest! {
             many.push(Shape::Sphere(Sphere { c: Vec3A::new(1e3 * s, i as f32 * s, 0.0), r: 0.01 * s }));
         }
         let bvh = Geometry::build(prims(&many), Vec::new());
-        prop_assert!(packed.spheres.packs.len() > 0 && bvh.in_bvh > 0);
+        prop_assert!(!packed.spheres.packs.is_empty() && bvh.in_bvh > 0);
         let scalar = |ray: &Ray| -> Option<(usize, f32)> {
             shapes.iter().enumerate().filter_map(|(i, sh)| sh.intersect(ray).map(|t| (i, t)))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
