@@ -13,25 +13,23 @@ use glam::{BVec4A, Vec4};
 pub struct RayLanes {
     o: [Vec4; 3],
     d: [Vec4; 3],
-    /// `|o|` per coordinate.
-    o_abs: [Vec4; 3],
-    /// `max |o_i|`.
-    o_abs_max: Vec4,
-    /// The origin's error bound.
-    o_err: Vec4,
+    /// The origin's share of a plane's band per unit of `sum |n_i|`:
+    /// `gamma(4) max |o_i| + o_err`.
+    plane_k: Vec4,
+    /// The error of `o` before the sphere's centre is subtracted: `o_err + gamma(1) max |o_i|`.
+    sphere_k: Vec4,
 }
 
 impl RayLanes {
     /// Splat a ray's origin, direction and origin error.
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
-        let (o, d, a) = (ray.o, ray.d, ray.o.abs());
+        let (o, d, a) = (ray.o, ray.d, ray.o.abs().max_element());
         RayLanes {
             o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
-            o_abs: [Vec4::splat(a.x), Vec4::splat(a.y), Vec4::splat(a.z)],
-            o_abs_max: Vec4::splat(a.max_element()),
-            o_err: Vec4::splat(ray.o_err),
+            plane_k: Vec4::splat(gamma(4) * a + ray.o_err),
+            sphere_k: Vec4::splat(ray.o_err + gamma(1) * a),
         }
     }
 }
@@ -47,8 +45,10 @@ pub struct SphereLanes {
     c: [Vec4; 3],
     r: Vec4,
     r2: Vec4,
-    /// `max |c_i|`.
-    c_abs_max: Vec4,
+    /// `1 / r` (0 in unused lanes).
+    inv_r: Vec4,
+    /// `gamma(1) max |c_i|`: the rounding of `o - c` due to the centre.
+    c_err: Vec4,
 }
 
 /// Up to four planes; unused lanes have a zero normal and never hit.
@@ -56,10 +56,10 @@ pub struct SphereLanes {
 pub struct PlaneLanes {
     n: [Vec4; 3],
     dist: Vec4,
-    /// `|n|` per coordinate.
-    n_abs: [Vec4; 3],
     /// `sum |n_i|`.
     n_abs_sum: Vec4,
+    /// `gamma(4) |dist|`.
+    dist_err: Vec4,
 }
 
 impl SphereLanes {
@@ -78,7 +78,8 @@ impl SphereLanes {
             c: [v(|s| s.c.x, 0.0), v(|s| s.c.y, 0.0), v(|s| s.c.z, 0.0)],
             r: v(|s| s.r, 0.0),
             r2: v(|s| s.r * s.r, -1.0),
-            c_abs_max: v(|s| s.c.abs().max_element(), 0.0),
+            inv_r: v(|s| 1.0 / s.r, 0.0),
+            c_err: v(|s| gamma(1) * s.c.abs().max_element(), 0.0),
         }
     }
 
@@ -99,18 +100,22 @@ impl SphereLanes {
         let t1 = Vec4::select(first, q, a);
         let zero = Vec4::ZERO;
         let tm = Vec4::splat(t_max);
-        // The scalar test's band: an origin on the sphere only meets the root away from zero.
-        let fl = f2.sqrt();
-        let e_f = r.o_err + Vec4::splat(gamma(1)) * (r.o_abs_max + self.c_abs_max);
-        let band = Vec4::splat(gamma(5)) * (f2 + self.r2) + Vec4::splat(4.0) * fl * e_f;
-        let t_min = band / (fl + self.r);
-        let on = c.abs().cmple(band);
-        let other = Vec4::select(t0.abs().cmple(t1.abs()), t1, t0);
-        let ok_on = other.cmpgt(t_min) & other.cmple(tm);
         let ok0 = t0.cmpgt(zero) & t0.cmple(tm);
         let ok1 = t1.cmpgt(zero) & t1.cmple(tm);
-        let t = Vec4::select(on, other, Vec4::select(ok0, t0, t1));
-        let ok = (on & ok_on) | (!on & (ok0 | ok1));
+        let mut t = Vec4::select(ok0, t0, t1);
+        let mut ok = ok0 | ok1;
+        // The scalar test's band: an origin on the sphere only meets the root away from zero.
+        let e_f = r.sphere_k + self.c_err;
+        let band = Vec4::splat(gamma(5)) * (f2 + self.r2)
+            + Vec4::splat(2.0) * e_f * (f2 * self.inv_r + self.r);
+        let on = c.abs().cmple(band);
+        if on.any() {
+            let t_min = band / (f2.sqrt() + self.r);
+            let other = Vec4::select(t0.abs().cmple(t1.abs()), t1, t0);
+            let ok_on = other.cmpgt(t_min) & other.cmple(tm);
+            t = Vec4::select(on, other, t);
+            ok = (on & ok_on) | (!on & ok);
+        }
         (t, disc.cmpge(zero) & q.cmpne(zero) & ok)
     }
 }
@@ -123,8 +128,8 @@ impl PlaneLanes {
         PlaneLanes {
             n: [v(|p| p.n.x), v(|p| p.n.y), v(|p| p.n.z)],
             dist: v(|p| p.dist),
-            n_abs: [v(|p| p.n.x.abs()), v(|p| p.n.y.abs()), v(|p| p.n.z.abs())],
             n_abs_sum: v(|p| p.n.abs().element_sum()),
+            dist_err: v(|p| gamma(4) * p.dist.abs()),
         }
     }
 
@@ -133,11 +138,9 @@ impl PlaneLanes {
     pub fn hit(&self, r: &RayLanes, t_max: f32) -> (Vec4, BVec4A) {
         let denom = dot(self.n, r.d);
         let s = self.dist - dot(self.n, r.o);
-        let band = Vec4::splat(gamma(4)) * (dot(self.n_abs, r.o_abs) + self.dist.abs())
-            + self.n_abs_sum * r.o_err;
+        let band = self.n_abs_sum * r.plane_k + self.dist_err;
         let t = s / denom;
-        let beyond = (s * denom.signum()).cmpgt(band);
-        let ok = denom.cmpne(Vec4::ZERO) & beyond & t.cmple(Vec4::splat(t_max));
+        let ok = (s * denom).cmpgt(Vec4::ZERO) & s.abs().cmpgt(band) & t.cmple(Vec4::splat(t_max));
         (t, ok)
     }
 }

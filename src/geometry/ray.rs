@@ -95,11 +95,7 @@ impl Ray {
     /// starts at [`spawn_origin`] and carries that origin's error bound.
     #[inline]
     pub fn spawn(hit: &Hit, w: Vec3A, t_max: f32) -> Self {
-        let (o, o_err) = spawn_origin(hit, w);
-        Ray {
-            o_err,
-            ..Ray::bare(o, w, t_max)
-        }
+        Origins::new(hit).ray(w, t_max)
     }
 
     /// This ray, limited to `t_max`, with the reciprocal direction for box tests and, if
@@ -146,40 +142,64 @@ pub struct Hit {
     pub prim: u32,
 }
 
-/// The start of a ray that leaves `hit` in direction `w`, and the bound on its error.
+/// The starts of rays leaving a hit on either side of its surface, and their error bound.
 ///
-/// The hit point is moved along the geometric normal, to the side `w` points to, by the
+/// The hit point is moved along the geometric normal, to the side a ray leaves by, by the
 /// projection of its error box onto the normal (`sum |n_i| err`), so the origin is off the
-/// surface whatever the rounding; each coordinate is then rounded away from the surface, so
-/// that the offset survives the addition (pbrt-v4's `OffsetRayOrigin`). The origin's error
-/// against the exact surface point is at most the point's error plus the offset plus that last
-/// rounding.
+/// surface whatever the error of the point (pbrt-v4's `OffsetRayOrigin`). Rounding the sum
+/// `p + offset` could take back up to `u max |p_i|` per coordinate; pbrt rounds each coordinate
+/// away from the surface instead, rtis adds twice that to the offset, which needs no branch.
+/// Both sides are computed once per hit; every ray leaving it picks one.
+#[derive(Clone, Copy, Debug)]
+pub struct Origins {
+    /// Start of rays leaving on the side the normal points to.
+    pub front: Vec3A,
+    /// Start of rays leaving on the other side.
+    pub back: Vec3A,
+    /// The geometric normal that tells the sides apart.
+    pub n: Vec3A,
+    /// Bound on either start's error against the exact crossing point: the point's error
+    /// across and along the surface (along it twice: the nearest-hit choice between two
+    /// surfaces within error of each other can add as much again), the offset, and the
+    /// rounding of the sum.
+    pub o_err: f32,
+}
+
+impl Origins {
+    /// The starts of rays leaving `hit`.
+    #[inline]
+    pub fn new(hit: &Hit) -> Self {
+        let d =
+            hit.n.abs().element_sum() * hit.err + 2.0 * UNIT_ROUNDOFF * hit.p.abs().max_element();
+        let (front, back) = (hit.p + d * hit.n, hit.p - d * hit.n);
+        let o_max = front.abs().max(back.abs()).max_element();
+        Origins {
+            front,
+            back,
+            n: hit.n,
+            o_err: hit.err + d + 2.0 * hit.err_along + UNIT_ROUNDOFF * o_max,
+        }
+    }
+
+    /// The ray leaving in unit direction `w`, stopping at `t_max`.
+    #[inline]
+    pub fn ray(&self, w: Vec3A, t_max: f32) -> Ray {
+        let o = if self.n.dot(w) >= 0.0 {
+            self.front
+        } else {
+            self.back
+        };
+        Ray {
+            o_err: self.o_err,
+            ..Ray::bare(o, w, t_max)
+        }
+    }
+}
+
+/// The start of a ray that leaves `hit` in direction `w`, and the bound on its error (see
+/// [`Origins`]).
 #[inline]
 pub fn spawn_origin(hit: &Hit, w: Vec3A) -> (Vec3A, f32) {
-    let d = hit.n.abs().element_sum() * hit.err;
-    let offset = if hit.n.dot(w) >= 0.0 {
-        d * hit.n
-    } else {
-        -d * hit.n
-    };
-    let away = |v: f32, dir: f32| {
-        if dir > 0.0 {
-            v.next_up()
-        } else if dir < 0.0 {
-            v.next_down()
-        } else {
-            v
-        }
-    };
-    let p = hit.p + offset;
-    let o = Vec3A::new(
-        away(p.x, offset.x),
-        away(p.y, offset.y),
-        away(p.z, offset.z),
-    );
-    // Against the exact crossing point: the error across and along the surface (twice: the
-    // nearest-hit choice between two surfaces within error of each other can add as much
-    // again), the offset, and the last rounding.
-    let o_err = hit.err + d + 2.0 * hit.err_along + 2.0 * UNIT_ROUNDOFF * o.abs().max_element();
-    (o, o_err)
+    let r = Origins::new(hit).ray(w, f32::INFINITY);
+    (r.o, r.o_err)
 }

@@ -4,7 +4,7 @@
 
 use super::Tracer;
 use crate::effects::Effects;
-use crate::geometry::{Hit, Ray};
+use crate::geometry::{Hit, Origins, Ray};
 use crate::material::{Material, Model, Phong};
 use crate::stats::RayKind;
 use glam::Vec3A;
@@ -21,6 +21,8 @@ pub struct Interaction {
     pub n: Vec3A,
     /// The surface's material.
     pub material: Material,
+    /// Where rays leaving the hit start.
+    pub origins: Origins,
 }
 
 impl Interaction {
@@ -38,13 +40,14 @@ impl Interaction {
             wo,
             n,
             material: tr.materials[prim.material as usize],
+            origins: Origins::new(&hit),
         }
     }
 
     /// A ray leaving the surface in unit direction `w`, started off the surface on `w`'s side.
     #[inline]
     pub fn spawn(&self, w: Vec3A) -> Ray {
-        Ray::spawn(&self.hit, w, f32::INFINITY)
+        self.origins.ray(w, f32::INFINITY)
     }
 }
 
@@ -76,7 +79,7 @@ pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
         // Shadow ray V^s: stop just short of the light, so that a surface the light sits on
         // does not block it.
         let visible = !tr.effects.shadows || {
-            tr.unoccluded(&Ray::spawn(&si.hit, inc.wi, inc.dist * SHADOW_END))
+            tr.unoccluded(&si.origins.ray(inc.wi, inc.dist * SHADOW_END))
         };
         if visible {
             l_dir += inc.li * reflectance(model, phong, inc.wi, si.wo, si.n);
@@ -121,6 +124,11 @@ pub fn specular_bounce(si: &Interaction, effects: Effects) -> Option<(Ray, Vec3A
 
 /// Where a chain of mirror and glass bounces ends.
 #[derive(Clone, Copy, Debug)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "returned by value and matched at once by the caller; boxing the Phong variant \
+              would allocate once per chain"
+)]
 pub enum ChainEnd {
     /// At a Phong surface, reached with throughput `beta` (the product of the tints).
     Phong {

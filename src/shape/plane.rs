@@ -38,26 +38,26 @@ impl Plane {
     ///
     /// `s = dist - n.o` is the signed distance from the origin to the plane. Its rounding error
     /// is at most `gamma(4) (|n|.|o| + |dist|)`, and the origin's own error moves it by at most
-    /// `(sum |n_i|) o_err`. Within that band the origin is on the plane: a ray that starts on a
+    /// `(sum |n_i|) o_err`; with `|n|.|o| <= (sum |n_i|) max |o_i|` both fit in
+    /// [`Plane::band`]. Within that band the origin is on the plane: a ray that starts on a
     /// plane never meets it again.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         let denom = self.n.dot(ray.d);
-        if denom == 0.0 {
+        let s = self.dist - self.n.dot(ray.o);
+        // `s` on the side `d` goes to (t > 0), and beyond the band.
+        if s * denom <= 0.0 || s.abs() <= self.band(ray) {
             return None;
         }
-        let s = self.dist - self.n.dot(ray.o);
-        let band = self.band(ray);
         let t = s / denom;
-        // `s` on the side `d` goes to, and beyond the band: equivalent to `t > band / |denom|`.
-        (s * denom.signum() > band && t <= ray.t_max).then_some(t)
+        (t <= ray.t_max).then_some(t)
     }
 
     /// The error band of the origin's signed distance to the plane (see [`Plane::intersect`]).
     #[inline]
     pub fn band(&self, ray: &Ray) -> f32 {
-        let an = self.n.abs();
-        gamma(4) * (an.dot(ray.o.abs()) + self.dist.abs()) + an.element_sum() * ray.o_err
+        let k = gamma(4) * ray.o.abs().max_element() + ray.o_err;
+        self.n.abs().element_sum() * k + gamma(4) * self.dist.abs()
     }
 
     /// Hit point projected onto the plane, its normal, and its error bounds.

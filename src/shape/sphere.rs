@@ -30,10 +30,11 @@ impl Sphere {
     /// rays and far-away spheres stay accurate.
     ///
     /// `c = |f|^2 - r^2` says where the origin is: its rounding error is at most
-    /// `gamma(5) (|f|^2 + r^2)`, and the error of `f` (the origin's `o_err` and the rounding of
-    /// `o - c`) moves it by at most `4 |f| e_f`. Within that band the origin is on the sphere,
-    /// and the root nearer zero is the ray's own start: only the other root can be a hit, and
-    /// only beyond the band's distance (a ray tangent at its start meets nothing).
+    /// `gamma(5) (|f|^2 + r^2)`, and the error `e_f` of `f` (the origin's `o_err` and the
+    /// rounding of `o - c`) moves it by at most `4 |f| e_f <= 2 e_f (|f|^2 / r + r)`. Within
+    /// that band the origin is on the sphere, and the root nearer zero is the ray's own start:
+    /// only the other root can be a hit, and only beyond the band's distance (a ray tangent at
+    /// its start meets nothing).
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         let f = ray.o - self.c;
@@ -55,10 +56,11 @@ impl Sphere {
             let (a, b) = (c / q, q);
             if a <= b { (a, b) } else { (b, a) }
         };
-        let (band, t_min) = self.band(ray, f2);
+        let band = self.band(ray, f2);
         if c.abs() <= band {
             // The origin is on the sphere: the root nearer zero is where the ray starts.
             let t = if t0.abs() <= t1.abs() { t1 } else { t0 };
+            let t_min = band / (f2.sqrt() + self.r);
             return (t > t_min && t <= ray.t_max).then_some(t);
         }
         if t0 > 0.0 && t0 <= ray.t_max {
@@ -70,14 +72,14 @@ impl Sphere {
         }
     }
 
-    /// The error band of `c = |f|^2 - r^2` for a ray whose `|f|^2` is `f2`, and the distance it
-    /// stands for (see [`Sphere::intersect`]).
+    /// The error band of `c = |f|^2 - r^2` for a ray whose `|f|^2` is `f2` (see
+    /// [`Sphere::intersect`]).
     #[inline]
-    pub fn band(&self, ray: &Ray, f2: f32) -> (f32, f32) {
-        let fl = f2.sqrt();
-        let e_f = ray.o_err + gamma(1) * (ray.o.abs().max_element() + self.c.abs().max_element());
-        let band = gamma(5) * (f2 + self.r * self.r) + 4.0 * fl * e_f;
-        (band, band / (fl + self.r))
+    pub fn band(&self, ray: &Ray, f2: f32) -> f32 {
+        let e_f = ray.o_err
+            + gamma(1) * ray.o.abs().max_element()
+            + gamma(1) * self.c.abs().max_element();
+        gamma(5) * (f2 + self.r * self.r) + 2.0 * e_f * (f2 * (1.0 / self.r) + self.r)
     }
 
     /// Hit point projected back onto the sphere, outward normal, and its error bounds.
