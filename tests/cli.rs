@@ -198,3 +198,85 @@ fn embedded_default_scene_is_the_course_cornell_box() {
         (5, 3, 3)
     );
 }
+
+#[test]
+fn ruinous_estimate_is_refused_without_force() {
+    let d = tmp("ruinous");
+    let s = d.join("deep.ron");
+    let cornell = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+    std::fs::write(
+        &s,
+        format!("Scene(extends: {cornell:?}, shader: Global(samples: 64, max_depth: 16))"),
+    )
+    .unwrap();
+    let out = d.join("deep.png");
+    let o = rtis(&["render", s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("estimate: 6.6") && e.contains(" h on "), "{e}");
+    assert!(e.contains("--force"), "{e}");
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn force_and_threads_cap_are_accepted() {
+    let d = tmp("threads");
+    let out = d.join("c.png");
+    let o = rtis(&[
+        "render",
+        "--width",
+        "16",
+        "--height",
+        "12",
+        "--threads",
+        "100000",
+        "--force",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let e = stderr(&o);
+    assert!(o.status.success(), "{e}");
+    assert!(
+        e.contains("warning: --threads 100000 is more than 4 per core"),
+        "{e}"
+    );
+    assert!(out.exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn width_alone_keeps_the_aspect_ratio() {
+    let d = tmp("aspect");
+    for (args, size) in [
+        (["--width", "90"], (90, 72)),
+        (["--height", "36"], (45, 36)),
+    ] {
+        let out = d.join("a.png");
+        let o = rtis(&["render", args[0], args[1], "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let img = image::open(&out).unwrap();
+        assert_eq!((img.width(), img.height()), size);
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn stats_path_is_checked_before_rendering() {
+    let d = tmp("stats");
+    let out = d.join("c.png");
+    let stats = d.join("missing-folder").join("s.json");
+    let o = rtis(&[
+        "render",
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("s.json: cannot write output"), "{e}");
+    // It failed before the render: no estimate, no image.
+    assert!(!e.contains("estimate:") && !out.exists(), "{e}");
+    std::fs::remove_dir_all(&d).unwrap();
+}

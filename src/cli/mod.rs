@@ -3,6 +3,7 @@
 mod bench;
 mod check;
 mod converge;
+pub mod interrupt;
 mod render;
 
 use clap::{Parser, Subcommand};
@@ -34,6 +35,11 @@ enum Command {
 
 /// Any error the CLI reports: already formatted for the user.
 pub type CliError = Box<dyn std::error::Error>;
+
+/// A render stopped by Ctrl-C after writing its partial image: exit 130, like a shell.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted")]
+pub struct Interrupted;
 
 /// Run one subcommand.
 pub fn run(cli: Cli) -> Result<(), CliError> {

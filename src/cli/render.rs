@@ -1,11 +1,13 @@
 //! `rtis render`.
 
-use super::{CliError, load};
+use super::interrupt::{self, Graceful};
+use super::{CliError, Interrupted, load};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use rtis::render::estimate::{self, MAX_RAYS_UNFORCED, human_seconds};
 use rtis::render::output::Transfer;
 use rtis::render::{self, Film, output};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `rtis render`.
 #[derive(Args, Debug)]
@@ -36,6 +38,55 @@ pub struct RenderArgs {
     /// Write the ray statistics as JSON to this file.
     #[arg(long)]
     stats: Option<PathBuf>,
+    /// Render even when the estimate is beyond 2e11 rays (about an hour on 2 cores).
+    #[arg(long)]
+    force: bool,
+}
+
+/// Film size from the scene's and the command line's: a side given alone keeps the scene's
+/// aspect ratio.
+pub fn film_size(scene: (u32, u32), width: Option<u32>, height: Option<u32>) -> (u32, u32) {
+    let (w, h) = scene;
+    let keep = |side: u32, num: u32, den: u32| {
+        ((side as f64 * num as f64 / den as f64).round() as u32).max(1)
+    };
+    match (width, height) {
+        (Some(w2), Some(h2)) => (w2, h2),
+        (Some(w2), None) => (w2, keep(w2, h, w)),
+        (None, Some(h2)) => (keep(h2, w, h), h2),
+        (None, None) => (w, h),
+    }
+}
+
+/// Most worker threads per core: more only add overhead.
+pub const THREADS_PER_CORE: usize = 4;
+
+/// The thread count to use for `--threads`, capped at [`THREADS_PER_CORE`] per core.
+pub fn thread_count(asked: Option<usize>) -> Result<usize, CliError> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match asked {
+        None => Ok(cores),
+        Some(0) => Err("--threads must be at least 1".into()),
+        Some(t) if t > THREADS_PER_CORE * cores => {
+            let cap = THREADS_PER_CORE * cores;
+            eprintln!(
+                "warning: --threads {t} is more than {THREADS_PER_CORE} per core on this                  machine's {cores} cores; using {cap}"
+            );
+            Ok(cap)
+        }
+        Some(t) => Ok(t),
+    }
+}
+
+/// Where a stopped render writes its image: `NAME.partial.EXT` beside the output.
+pub fn partial_path(out: &Path) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map_or_else(|| "out".into(), |s| s.to_string_lossy().into_owned());
+    let ext = out
+        .extension()
+        .map_or_else(|| "png".into(), |e| e.to_string_lossy().into_owned());
+    out.with_file_name(format!("{stem}.partial.{ext}"))
 }
 
 fn parse_transfer(s: &str) -> Result<Transfer, String> {
@@ -50,9 +101,10 @@ fn parse_transfer(s: &str) -> Result<Transfer, String> {
 pub fn run(a: RenderArgs) -> Result<(), CliError> {
     let mut scene = load(a.scene.as_deref())?;
     let film = &mut scene.settings.film;
+    let (width, height) = film_size((film.width, film.height), a.width, a.height);
     let overridden = Film {
-        width: a.width.unwrap_or(film.width),
-        height: a.height.unwrap_or(film.height),
+        width,
+        height,
         spp: a.spp.unwrap_or(film.spp),
         transfer: a.transfer.unwrap_or(film.transfer),
     };
@@ -72,6 +124,10 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     });
     // Fail before a long render, not after it.
     output::check_writable(&out)?;
+    if let Some(path) = &a.stats {
+        output::check_folder(path)?;
+    }
+    let threads = thread_count(a.threads)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -81,16 +137,33 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
     eprintln!("effects {}", prepared.effects);
-    let pool = {
-        let mut b = rayon::ThreadPoolBuilder::new();
-        if let Some(t) = a.threads {
-            if t == 0 {
-                return Err("--threads must be at least 1".into());
-            }
-            b = b.num_threads(t);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
+
+    // What it will cost: the shader's rule and a short calibration.
+    let est = estimate::estimate(&prepared);
+    eprintln!(
+        "estimate: {:.3e} rays, about {} on {threads} threads (calibrated on {} samples{})",
+        est.rays(),
+        human_seconds(est.seconds(threads)),
+        est.calibration_samples,
+        if est.proxy {
+            ", a shallower Global scaled by the rule"
+        } else {
+            ""
         }
-        b.build()?
-    };
+    );
+    if est.rays() > MAX_RAYS_UNFORCED && !a.force {
+        return Err(format!(
+            "the estimate of {:.3e} rays is beyond the {MAX_RAYS_UNFORCED:.0e} rays rtis starts \
+             without --force; lower the film size, spp or the shader's samples and depth, or \
+             pass --force",
+            est.rays()
+        )
+        .into());
+    }
+
     let bar = ProgressBar::new(render::tile_count(&prepared));
     bar.set_style(
         ProgressStyle::with_template(
@@ -99,9 +172,28 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         .expect("valid template"),
     );
     let tick = || bar.inc(1);
-    let result = pool.install(|| render::render(&prepared, &tick));
+    let result = {
+        let _graceful = Graceful::begin();
+        pool.install(|| render::render_until(&prepared, &tick, &interrupt::STOP))
+    };
     bar.finish_and_clear();
 
+    if !result.is_complete() {
+        // Interrupted: keep what the render has, under a name that says so.
+        let partial = partial_path(&out);
+        output::save(&result.image, &partial, prepared.film.transfer)?;
+        eprintln!(
+            "interrupted after {:.2} s: {} of {} tiles rendered ({:.1}% of the pixels, each with \
+             all {} spp; the rest is black) -> {}",
+            result.seconds,
+            result.tiles_done,
+            result.tiles,
+            100.0 * result.tiles_done as f64 / result.tiles as f64,
+            prepared.film.spp,
+            partial.display()
+        );
+        return Err(Box::new(Interrupted));
+    }
     output::save(&result.image, &out, prepared.film.transfer)?;
     if let Some(path) = &a.stats {
         let json = serde_json::to_string_pretty(&serde_json::json!({
@@ -110,10 +202,11 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
             "rays": result.stats,
             "effects": prepared.effects,
             "total_rays": result.stats.total(),
+            "estimated_rays": est.rays(),
             "mrays_per_second": result.mrays_per_second(),
         }))?;
-        std::fs::write(path, json)
-            .map_err(|e| format!("{}: cannot write stats: {e}", path.display()))?;
+        output::write_file(path, json.as_bytes())
+            .map_err(|e| format!("cannot write stats: {e}"))?;
     }
     let s = &result.stats;
     if s.dropped > 0 {

@@ -3,6 +3,7 @@
 //! tile order; then the image and its output files.
 
 pub mod effects;
+pub mod estimate;
 pub mod film;
 pub mod output;
 mod scene;
@@ -15,6 +16,7 @@ use crate::stats::RayStats;
 use film::Image;
 use glam::Vec3A;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Side of a square tile in pixels.
@@ -29,12 +31,21 @@ pub struct Rendered {
     pub stats: RayStats,
     /// Wall-clock seconds spent tracing.
     pub seconds: f64,
+    /// Tiles rendered; the rest are black when the render was stopped.
+    pub tiles_done: u64,
+    /// Tiles in the image.
+    pub tiles: u64,
 }
 
 impl Rendered {
     /// Millions of rays per second.
     pub fn mrays_per_second(&self) -> f64 {
         self.stats.total() as f64 / self.seconds.max(1e-9) / 1e6
+    }
+
+    /// Whether every tile was rendered.
+    pub fn is_complete(&self) -> bool {
+        self.tiles_done == self.tiles
     }
 }
 
@@ -45,37 +56,65 @@ impl Rendered {
 /// sample can never poison a pixel, and the count says that it happened.
 #[inline]
 pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStats) -> Vec3A {
+    let mut sum = Vec3A::ZERO;
+    for s in 0..scene.film.spp {
+        sum += render_sample(scene, col, row, s, stats);
+    }
+    sum / scene.film.spp as f32
+}
+
+/// Radiance of camera sample `s` of pixel `(col, row)`, from the sample's own random stream;
+/// zero (and counted in `stats.dropped`) when it is NaN, infinite or negative.
+#[inline]
+pub fn render_sample(
+    scene: &RenderScene,
+    col: u32,
+    row: u32,
+    s: u32,
+    stats: &mut RayStats,
+) -> Vec3A {
     let film = &scene.film;
     let pixel = row as u64 * film.width as u64 + col as u64;
-    let mut sum = Vec3A::ZERO;
-    for s in 0..film.spp {
-        let mut sampler = Sampler::new(scene.seed, pixel, s as u64);
-        let (dx, dy) = pixel_sample(s, film.spp, scene.seed ^ pixel, &mut sampler);
-        let u = (col as f32 + dx) / film.width as f32;
-        let v = (row as f32 + dy) / film.height as f32;
-        let ray = scene.camera.ray(u, v);
-        let mut tracer = scene.tracer(sampler, stats);
-        let l = radiance(&scene.shader, &mut tracer, &ray);
-        if l.is_finite() && l.min_element() >= 0.0 {
-            sum += l;
-        } else {
-            stats.dropped += 1;
-        }
+    let mut sampler = Sampler::new(scene.seed, pixel, s as u64);
+    let (dx, dy) = pixel_sample(s, film.spp, scene.seed ^ pixel, &mut sampler);
+    let u = (col as f32 + dx) / film.width as f32;
+    let v = (row as f32 + dy) / film.height as f32;
+    let ray = scene.camera.ray(u, v);
+    let mut tracer = scene.tracer(sampler, stats);
+    let l = radiance(&scene.shader, &mut tracer, &ray);
+    if l.is_finite() && l.min_element() >= 0.0 {
+        l
+    } else {
+        stats.dropped += 1;
+        Vec3A::ZERO
     }
-    sum / film.spp as f32
 }
 
 /// Render the scene on the current rayon pool; `on_tile` is called after each tile (progress).
 pub fn render(scene: &RenderScene, on_tile: &(dyn Fn() + Sync)) -> Rendered {
+    render_until(scene, on_tile, &AtomicBool::new(false))
+}
+
+/// [`render`], stopping early once `stop` is set: tiles already started are finished, tiles
+/// not yet started stay black, and [`Rendered::tiles_done`] says how many were rendered. Each
+/// finished tile holds every sample, so a stopped render is exact where it is not black.
+pub fn render_until(
+    scene: &RenderScene,
+    on_tile: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Rendered {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..tiles_x).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let done: Vec<(Vec<Vec3A>, RayStats)> = tiles
+    let done: Vec<Option<(Vec<Vec3A>, RayStats)>> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
+            if stop.load(Ordering::Relaxed) {
+                return None;
+            }
             let mut stats = RayStats::default();
             let mut px = Vec::with_capacity((TILE * TILE) as usize);
             for row in y0..(y0 + TILE).min(h) {
@@ -84,13 +123,15 @@ pub fn render(scene: &RenderScene, on_tile: &(dyn Fn() + Sync)) -> Rendered {
                 }
             }
             on_tile();
-            (px, stats)
+            Some((px, stats))
         })
         .collect();
     let mut image = Image::new(w, h);
     let mut stats = RayStats::default();
-    for (&(x0, y0), (px, st)) in tiles.iter().zip(done) {
+    let mut tiles_done = 0;
+    for (&(x0, y0), (px, st)) in tiles.iter().zip(done).filter_map(|(t, d)| Some((t, d?))) {
         stats += st;
+        tiles_done += 1;
         let tw = (x0 + TILE).min(w) - x0;
         for (i, p) in px.into_iter().enumerate() {
             let (col, row) = (x0 + i as u32 % tw, y0 + i as u32 / tw);
@@ -101,6 +142,8 @@ pub fn render(scene: &RenderScene, on_tile: &(dyn Fn() + Sync)) -> Rendered {
         image,
         stats,
         seconds: start.elapsed().as_secs_f64(),
+        tiles_done,
+        tiles: tiles.len() as u64,
     }
 }
 

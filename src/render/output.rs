@@ -5,6 +5,45 @@ use super::film::Image;
 use image::{ImageFormat, Rgb32FImage, RgbImage};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
+
+/// Temporary files being written now. A writer holds the lock from creating its file until
+/// the file is renamed into place or removed; [`remove_pending`] takes the same lock, so an
+/// interrupt either waits for a write to finish or finds nothing to remove, and never leaves a
+/// temporary file behind.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn pending() -> MutexGuard<'static, Vec<PathBuf>> {
+    PENDING.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Remove every temporary file being written and hold the lock for the rest of the process, so
+/// that no write starts again: for an interrupt handler that then exits.
+pub fn remove_pending() {
+    let guard = pending();
+    for p in guard.iter() {
+        let _ = std::fs::remove_file(p);
+    }
+    std::mem::forget(guard);
+}
+
+/// Run `write` on the temporary file `tmp` of `path`, registered so that an interrupt removes
+/// it, then rename it into place; on any failure the temporary file is removed.
+fn write_via_temp(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), OutputError> {
+    let tmp = temp_path(path);
+    let mut guard = pending();
+    guard.push(tmp.clone());
+    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    guard.retain(|p| p != &tmp);
+    drop(guard);
+    result.map_err(|e| io_err(path, e))
+}
 
 /// How 8-bit PNG values are made from linear radiance (EXR output is always linear float).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
@@ -76,9 +115,27 @@ fn io_err(path: &Path, e: impl std::fmt::Display) -> OutputError {
 /// Check before a long render that `path` has a known format and its folder takes new files.
 pub fn check_writable(path: &Path) -> Result<(), OutputError> {
     format_of(path)?;
+    check_folder(path)
+}
+
+/// Check before a long render that the folder of `path` takes new files (any format).
+pub fn check_folder(path: &Path) -> Result<(), OutputError> {
     let tmp = temp_path(path);
-    std::fs::write(&tmp, b"").map_err(|e| io_err(path, e))?;
-    std::fs::remove_file(&tmp).map_err(|e| io_err(path, e))
+    let mut guard = pending();
+    guard.push(tmp.clone());
+    let result = std::fs::write(&tmp, b"").and_then(|()| std::fs::remove_file(&tmp));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    guard.retain(|p| p != &tmp);
+    result.map_err(|e| io_err(path, e))
+}
+
+/// Write `bytes` to `path` through a temporary file and a rename (for text outputs).
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    write_via_temp(path, |tmp| {
+        std::fs::write(tmp, bytes).map_err(|e| e.to_string())
+    })
 }
 
 /// The sRGB transfer curve for a linear value clamped to [0, 1].
@@ -111,23 +168,15 @@ pub fn to_rgb8(img: &Image, transfer: Transfer) -> RgbImage {
 /// Write `img` to `path` (format by extension) via a temporary file and a rename.
 pub fn save(img: &Image, path: &Path, transfer: Transfer) -> Result<(), OutputError> {
     let format = format_of(path)?;
-    let tmp = temp_path(path);
-    let result = match format {
-        ImageFormat::OpenExr => {
-            let buf = Rgb32FImage::from_fn(img.width, img.height, |x, y| {
+    write_via_temp(path, |tmp| {
+        match format {
+            ImageFormat::OpenExr => Rgb32FImage::from_fn(img.width, img.height, |x, y| {
                 image::Rgb(img.get(x, y).to_array())
-            });
-            buf.save_with_format(&tmp, format)
+            })
+            .save_with_format(tmp, format),
+            _ => to_rgb8(img, transfer).save_with_format(tmp, format),
         }
-        _ => to_rgb8(img, transfer).save_with_format(&tmp, format),
-    };
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io_err(path, e));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io_err(path, e)
+        .map_err(|e| e.to_string())
     })
 }
 

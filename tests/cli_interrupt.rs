@@ -1,0 +1,180 @@
+//! Ctrl-C and SIGTERM (src/cli/interrupt.rs): the first Ctrl-C keeps a long render's image so
+//! far, a second one or SIGTERM quits at once, and no temporary file is ever left behind, even
+//! when the signal comes while the image is being written.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rtis-int-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn scene(dir: &Path, shader: &str) -> PathBuf {
+    let cornell = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+    let p = dir.join("scene.ron");
+    let text = format!("Scene(extends: {:?}, shader: {shader})\n", cornell);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Start `rtis render`; the receiver gets each stderr line (progress redraws split at '\r').
+fn start(args: &[&str]) -> (Child, mpsc::Receiver<String>) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtis"))
+        .arg("render")
+        .args(args)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run rtis");
+    let err = child.stderr.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(err).split(b'\n') {
+            let Ok(line) = line else { break };
+            for part in String::from_utf8_lossy(&line).split('\r') {
+                let _ = tx.send(part.to_string());
+            }
+        }
+    });
+    (child, rx)
+}
+
+/// Wait for a stderr line containing `needle`.
+fn wait_for(rx: &mpsc::Receiver<String>, needle: &str) -> Vec<String> {
+    let mut seen = Vec::new();
+    loop {
+        match rx.recv_timeout(Duration::from_secs(120)) {
+            Ok(l) => {
+                let hit = l.contains(needle);
+                seen.push(l);
+                if hit {
+                    return seen;
+                }
+            }
+            Err(e) => panic!("no `{needle}` on stderr ({e}); saw {seen:?}"),
+        }
+    }
+}
+
+fn signal(child: &Child, sig: &str) {
+    let ok = Command::new("kill")
+        .args([sig, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+}
+
+fn files(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "scene.ron")
+        .collect();
+    v.sort();
+    v
+}
+
+fn rest(rx: &mpsc::Receiver<String>) -> String {
+    rx.iter().collect::<Vec<_>>().join("\n")
+}
+
+#[test]
+fn first_ctrl_c_writes_the_partial_image_and_exits_130() {
+    let d = tmp("partial");
+    let s = scene(&d, "Global(samples: 64, max_depth: 3)");
+    let out = d.join("box.png");
+    let (mut child, rx) = start(&[s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    wait_for(&rx, "estimate:");
+    std::thread::sleep(Duration::from_millis(300));
+    signal(&child, "-INT");
+    let status = child.wait().unwrap();
+    let err = rest(&rx);
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("tiles rendered") && err.contains("box.partial.png"),
+        "{err}"
+    );
+    // Only the partial image, whole, under its own name.
+    assert_eq!(files(&d), vec!["box.partial.png".to_string()]);
+    let img = image::open(d.join("box.partial.png")).unwrap().to_rgb8();
+    assert_eq!((img.width(), img.height()), (720, 576));
+    // Rendered tiles are not black, the ones never started are.
+    assert!(img.pixels().any(|p| p.0 != [0, 0, 0]));
+    assert_eq!(img.get_pixel(719, 575).0, [0, 0, 0], "{err}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn sigterm_quits_at_once_with_143_and_leaves_nothing() {
+    let d = tmp("term");
+    let s = scene(&d, "Global(samples: 64, max_depth: 3)");
+    let out = d.join("box.png");
+    let (mut child, rx) = start(&[s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    wait_for(&rx, "estimate:");
+    signal(&child, "-TERM");
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(143), "{}", rest(&rx));
+    assert!(files(&d).is_empty(), "{:?}", files(&d));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn second_ctrl_c_quits_at_once() {
+    let d = tmp("twice");
+    let s = scene(&d, "Global(samples: 64, max_depth: 3)");
+    let out = d.join("box.png");
+    let (mut child, rx) = start(&[s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    wait_for(&rx, "estimate:");
+    signal(&child, "-INT");
+    wait_for(&rx, "press Ctrl-C again");
+    signal(&child, "-INT");
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{}", rest(&rx));
+    // No full image, no temporary file; a partial image only if it was written whole first.
+    for f in files(&d) {
+        assert_eq!(f, "box.partial.png");
+        image::open(d.join(&f)).expect("a whole image");
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// SIGTERM at moments spread over a short render and its write: the output is absent or
+/// whole, and no temporary file is ever left.
+#[test]
+fn signal_during_the_write_leaves_no_temporary_file() {
+    let d = tmp("write");
+    let s = scene(&d, "Normal");
+    let out = d.join("n.exr");
+    for delay_ms in (0..=300).step_by(25) {
+        let (mut child, rx) = start(&[
+            s.to_str().unwrap(),
+            "--width",
+            "2000",
+            "--height",
+            "2000",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        wait_for(&rx, "estimate:");
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        signal(&child, "-TERM");
+        let status = child.wait().unwrap();
+        assert!(
+            matches!(status.code(), Some(0 | 143)),
+            "{status:?} {}",
+            rest(&rx)
+        );
+        for f in files(&d) {
+            assert_eq!(f, "n.exr", "left behind after {delay_ms} ms");
+            let img = image::open(&out).expect("a whole image");
+            assert_eq!((img.width(), img.height()), (2000, 2000));
+            std::fs::remove_file(&out).unwrap();
+        }
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
