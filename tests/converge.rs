@@ -97,3 +97,29 @@ fn reference_key_tracks_the_scene() {
         converge::reference_key(&b, 64)
     );
 }
+
+/// The reference draws from streams independent of every rung: a Path rung with as many
+/// samples as the reference differs from it in nearly every pixel, and its error is its noise.
+#[test]
+fn reference_streams_are_independent_of_the_rungs() {
+    let s = small_box();
+    let reference = render(&converge::reference_scene(&s, 16), &|| {}).image;
+    let rung = render(
+        &converge::with_settings(&s, converge::reference_shader(), 16),
+        &|| {},
+    )
+    .image;
+    let same = rung
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .filter(|(a, b)| a == b)
+        .count();
+    // Pixels that see only the black background agree whatever the streams.
+    assert!(
+        same * 10 < rung.pixels.len(),
+        "{same} of {} pixels identical",
+        rung.pixels.len()
+    );
+    assert!(converge::metrics::rmse(&rung, &reference) > 0.0);
+}

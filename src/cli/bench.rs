@@ -18,23 +18,35 @@ use std::time::Instant;
 /// Arguments of `rtis bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Renders per case; the median is printed.
-    #[arg(long, default_value_t = 3)]
-    runs: usize,
-    /// Divide the film size by this (for a quick look; 1 is the course's 720x576).
-    #[arg(long, default_value_t = 1)]
+    /// Renders per case, at least 1; the median is printed.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
+    runs: u32,
+    /// Divide the film size by this, from 1 (the course's 720x576) to 288 (2x2), in every
+    /// section that renders (cornell and effects).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=288))]
     shrink: u32,
-    /// Which figures: `cornell` (the course's box), `effects` (the time and error each effect
-    /// costs, for every scene in --scenes), `meshes` (BVH build and ray rates at 10k to 1M
-    /// triangles), or `all`.
-    #[arg(long, default_value = "all")]
-    section: String,
+    /// Which figures.
+    #[arg(long, value_enum, default_value_t = Section::All)]
+    section: Section,
     /// Folder of scenes for the effects section.
     #[arg(long, default_value = "scenes")]
     scenes: std::path::PathBuf,
 }
 
-fn median_seconds(scene: &RenderScene, runs: usize) -> (f64, rtis::stats::RayStats) {
+/// The sections of `rtis bench`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Section {
+    /// Every section below.
+    All,
+    /// The course's Cornell box under each shader, and cost against resolution and samples.
+    Cornell,
+    /// The time and error each effect costs, for every scene in --scenes.
+    Effects,
+    /// BVH build time, bytes per triangle and ray rates for meshes of 10k to 1M triangles.
+    Meshes,
+}
+
+fn median_seconds(scene: &RenderScene, runs: u32) -> (f64, rtis::stats::RayStats) {
     let mut results: Vec<_> = (0..runs.max(1)).map(|_| render(scene, &|| {})).collect();
     results.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
     let r = &results[results.len() / 2];
@@ -44,7 +56,7 @@ fn median_seconds(scene: &RenderScene, runs: usize) -> (f64, rtis::stats::RaySta
 /// What each effect costs: for every scene in `dir` at 360 pixels wide, the render with the
 /// effects the scene calls for, then with each of them switched off in turn: seconds, rays,
 /// and the error (RMSE) the saving brings.
-fn effects_section(dir: &std::path::Path, runs: usize, shrink: u32) -> Result<(), CliError> {
+fn effects_section(dir: &std::path::Path, runs: u32, shrink: u32) -> Result<(), CliError> {
     let width = (360 / shrink).max(1);
     println!(
         "-- effects: the price of each effect, {width} px wide, median of {runs}: time and rays \
@@ -105,29 +117,41 @@ fn effects_section(dir: &std::path::Path, runs: usize, shrink: u32) -> Result<()
     Ok(())
 }
 
-/// Peak resident set size of this process in MiB (Linux; 0 elsewhere).
-pub fn peak_rss_mib() -> f64 {
+/// A field of /proc/self/status in MiB (Linux; 0 elsewhere).
+fn status_mib(field: &str) -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
             s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
+                .find(|l| l.starts_with(field))
                 .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
         })
         .map_or(0.0, |kb| kb / 1024.0)
 }
 
-fn case(name: &str, scene: &RenderScene, runs: usize) {
-    let (seconds, stats) = median_seconds(scene, runs);
+/// Memory one case adds at its peak, in MiB: the process's peak resident set is reset to its
+/// current size (Linux's `clear_refs` 5), the case runs, and the new peak less the size before
+/// it is the case's own (0 where Linux's counters are missing).
+fn own_peak_mib(f: impl FnOnce()) -> f64 {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+    let before = status_mib("VmRSS:");
+    f();
+    (status_mib("VmHWM:") - before).max(0.0)
+}
+
+fn case(name: &str, scene: &RenderScene, runs: u32) {
+    let mut result = None;
+    let peak = own_peak_mib(|| result = Some(median_seconds(scene, runs)));
+    let (seconds, stats) = result.expect("the case ran");
     println!(
-        "{name:<34} {:>4}x{:<4} {:>5} spp {:>9.3} s {:>8.1} Mrays {:>7.1} Mrays/s {:>8.1} MiB peak",
+        "{name:<34} {:>4}x{:<4} {:>5} spp {:>9.3} s {:>8.1} Mrays {:>7.1} Mrays/s {:>8.1} MiB own peak",
         scene.film.width,
         scene.film.height,
         scene.film.spp,
         seconds,
         stats.total() as f64 / 1e6,
         stats.total() as f64 / seconds.max(1e-9) / 1e6,
-        peak_rss_mib()
+        peak
     );
 }
 
@@ -221,29 +245,20 @@ fn meshes_section() {
 
 /// Run `rtis bench`.
 pub fn run(a: BenchArgs) -> Result<(), CliError> {
-    if a.shrink == 0 {
-        return Err("--shrink must be at least 1".into());
-    }
     let threads = rayon::current_num_threads();
     println!(
         "rtis bench: {} cores available, {threads} threads, median of {} runs",
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         a.runs
     );
-    if !["all", "cornell", "effects", "meshes"].contains(&a.section.as_str()) {
-        return Err(format!(
-            "--section {}: use all, cornell, effects or meshes",
-            a.section
-        )
-        .into());
-    }
-    if a.section == "all" || a.section == "meshes" {
+    let wants = |s: Section| a.section == Section::All || a.section == s;
+    if wants(Section::Meshes) {
         meshes_section();
     }
-    if a.section == "all" || a.section == "effects" {
+    if wants(Section::Effects) {
         effects_section(&a.scenes, a.runs, a.shrink)?;
     }
-    if a.section != "all" && a.section != "cornell" {
+    if !wants(Section::Cornell) {
         return Ok(());
     }
     let mut scene = load_default();

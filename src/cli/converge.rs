@@ -21,14 +21,14 @@ pub struct ConvergeArgs {
     #[arg(long, default_value = "converge")]
     out: PathBuf,
     /// Width of every render (default 180; the height keeps the scene's aspect ratio).
-    #[arg(long, default_value_t = 180)]
+    #[arg(long, default_value_t = 180, allow_negative_numbers = true, value_parser = super::render::side())]
     width: u32,
     /// Height (default: from the width and the scene's aspect ratio).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = super::render::side())]
     height: Option<u32>,
-    /// Renders per rung; the median time is reported.
-    #[arg(long, default_value_t = 3)]
-    runs: usize,
+    /// Renders per rung, at least 1; the median time is reported.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
+    runs: u32,
 }
 
 /// Run `rtis converge`.
@@ -77,11 +77,7 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
                         "reference: Path, {:?} model, {} spp at {}x{}...",
                         prepared.model, a.reference_spp, prepared.film.width, prepared.film.height
                     );
-                    let s = converge::with_settings(
-                        &prepared,
-                        converge::reference_shader(),
-                        a.reference_spp,
-                    );
+                    let s = converge::reference_scene(&prepared, a.reference_spp);
                     let r = render::render(&s, &|| {});
                     eprintln!(
                         "reference: {:.1} s, {:.1} Mrays/s",
@@ -101,7 +97,7 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
         "{:<16} {:<10} {:>9} {:>10} {:>9}",
         "family", "setting", "seconds", "Mrays", "RMSE"
     );
-    let rows = converge::sweep(&prepared, &reference, &rungs, a.runs, &mut |r| {
+    let rows = converge::sweep(&prepared, &reference, &rungs, a.runs as usize, &mut |r| {
         eprintln!(
             "{:<16} {:<10} {:>9.3} {:>10.1} {:>9.5}",
             r.family,
@@ -111,10 +107,7 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
             r.rmse
         )
     });
-    let write = |name: &str, text: String| {
-        std::fs::write(a.out.join(name), text)
-            .map_err(|e| format!("{}: {e}", a.out.join(name).display()))
-    };
+    let write = |name: &str, text: String| output::write_file(&a.out.join(name), text.as_bytes());
     write("converge.csv", converge::to_csv(&rows))?;
     write("converge.md", converge::to_markdown(&rows, prepared.model))?;
     let name = a.scene.as_deref().and_then(|p| p.file_name()).map_or_else(

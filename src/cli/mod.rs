@@ -29,7 +29,8 @@ enum Command {
     },
     /// Measure error against time for a ladder of shader settings (CSV, table, plot).
     Converge(converge::ConvergeArgs),
-    /// Print speed figures (seconds, Mrays/s, peak memory) for the course's Cornell box.
+    /// Print speed figures: the course's Cornell box under each shader (seconds, Mrays/s, own
+    /// peak memory), the price of each effect, and BVH build and ray rates for meshes.
     Bench(bench::BenchArgs),
 }
 

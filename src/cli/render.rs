@@ -17,17 +17,18 @@ pub struct RenderArgs {
     /// Output image: .png (8-bit) or .exr (linear float). Default: the scene's name with .png.
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Override the film width in pixels.
-    #[arg(long)]
+    /// Override the film width in pixels (1 to 32768; alone, the height keeps the aspect ratio).
+    #[arg(long, allow_negative_numbers = true, value_parser = side())]
     width: Option<u32>,
-    /// Override the film height in pixels.
-    #[arg(long)]
+    /// Override the film height in pixels (1 to 32768; alone, the width keeps the aspect ratio).
+    #[arg(long, allow_negative_numbers = true, value_parser = side())]
     height: Option<u32>,
-    /// Override the samples per pixel.
-    #[arg(long)]
+    /// Override the samples per pixel (1 to 1048576).
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=rtis::render::MAX_SPP as i64))]
     spp: Option<u32>,
-    /// Worker threads (default: one per core). The image does not depend on it.
-    #[arg(long)]
+    /// Worker threads (default: one per core; at most 4 per core). The image does not depend
+    /// on it.
+    #[arg(long, allow_negative_numbers = true)]
     threads: Option<usize>,
     /// Override the scene's random seed.
     #[arg(long)]
@@ -41,6 +42,11 @@ pub struct RenderArgs {
     /// Render even when the estimate is beyond 2e11 rays (about an hour on 2 cores).
     #[arg(long)]
     force: bool,
+}
+
+/// The parser of an image side: a whole number of pixels from 1 to [`render::MAX_SIDE`].
+pub fn side() -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(1..=render::MAX_SIDE as i64)
 }
 
 /// Film size from the scene's and the command line's: a side given alone keeps the scene's

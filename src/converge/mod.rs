@@ -120,10 +120,26 @@ pub fn with_settings(scene: &RenderScene, shader: Shader, spp: u32) -> RenderSce
     s
 }
 
+/// The reference render's seed. Rungs draw from the streams of the scene's seed; the
+/// reference draws from streams independent of all of them (a bijective mix of the seed with
+/// a tag), so that a rung with as many samples as the reference still measures its own noise.
+pub fn reference_seed(seed: u64) -> u64 {
+    crate::sampling::mix(seed ^ 0x5245_4645_5245_4e43)
+}
+
+/// The reference render of `scene`: Path with unbounded depth, `spp` samples per pixel, its own
+/// seed ([`reference_seed`]).
+pub fn reference_scene(scene: &RenderScene, spp: u32) -> RenderScene {
+    RenderScene {
+        seed: reference_seed(scene.seed),
+        ..with_settings(scene, reference_shader(), spp)
+    }
+}
+
 /// A key that changes whenever anything that affects the reference image changes.
 pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
     let text = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
+        "reference v2 (own seed)|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
         scene.camera,
         scene.geometry.prims,
         scene.materials,

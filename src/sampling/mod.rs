@@ -6,5 +6,5 @@ mod rng;
 mod strategy;
 
 pub use pixel::pixel_sample;
-pub use rng::Sampler;
+pub use rng::{Sampler, mix};
 pub use strategy::Sampling;
