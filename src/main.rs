@@ -6,6 +6,12 @@ use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // Like every Unix filter: a closed pipe (`rtis bench | head`) ends the process quietly
+    // instead of making each print fail.
+    // SAFETY: restores the default action of one signal before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let args = cli::Cli::parse();
     if let Err(e) = cli::interrupt::install() {
         eprintln!("error: cannot handle Ctrl-C: {e}");

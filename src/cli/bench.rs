@@ -31,6 +31,19 @@ pub struct BenchArgs {
     /// Folder of scenes for the effects section.
     #[arg(long, default_value = "scenes")]
     scenes: std::path::PathBuf,
+    /// Print one JSON object per line (machine-readable, for bench/readme_figures.py) instead
+    /// of tables.
+    #[arg(long)]
+    json: bool,
+}
+
+/// One figure of the bench: a table row, or with `--json` a JSON line.
+fn emit(json: bool, row: serde_json::Value, table: impl FnOnce() -> String) {
+    if json {
+        println!("{row}");
+    } else {
+        println!("{}", table());
+    }
 }
 
 /// The sections of `rtis bench`.
@@ -56,16 +69,23 @@ fn median_seconds(scene: &RenderScene, runs: u32) -> (f64, rtis::stats::RayStats
 /// What each effect costs: for every scene in `dir` at 360 pixels wide, the render with the
 /// effects the scene calls for, then with each of them switched off in turn: seconds, rays,
 /// and the error (RMSE) the saving brings.
-fn effects_section(dir: &std::path::Path, runs: u32, shrink: u32) -> Result<(), CliError> {
+fn effects_section(
+    dir: &std::path::Path,
+    runs: u32,
+    shrink: u32,
+    json: bool,
+) -> Result<(), CliError> {
     let width = (360 / shrink).max(1);
-    println!(
-        "-- effects: the price of each effect, {width} px wide, median of {runs}: time and rays \
-         with it, and with it switched off (RMSE against the full render)"
-    );
-    println!(
-        "{:<26} {:<12} {:>9} {:>10} {:>7} {:>9}",
-        "scene", "effect off", "seconds", "Mrays", "speedup", "RMSE"
-    );
+    if !json {
+        println!(
+            "-- effects: the price of each effect, {width} px wide, median of {runs}: time and \
+             rays with it, and with it switched off (RMSE against the full render)"
+        );
+        println!(
+            "{:<26} {:<12} {:>9} {:>10} {:>7} {:>9}",
+            "scene", "effect off", "seconds", "Mrays", "speedup", "RMSE"
+        );
+    }
     let mut paths: Vec<_> = std::fs::read_dir(dir)
         .map_err(|e| format!("{}: {e}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -81,13 +101,22 @@ fn effects_section(dir: &std::path::Path, runs: u32, shrink: u32) -> Result<(), 
         let name = path.file_name().unwrap_or_default().to_string_lossy();
         let (t_full, s_full) = median_seconds(&full, runs);
         let reference = render(&full, &|| {}).image;
-        println!(
-            "{name:<26} {:<12} {t_full:>9.3} {:>10.2} {:>7} {:>9}",
-            "(none)",
-            s_full.total() as f64 / 1e6,
-            "",
-            ""
-        );
+        let row = |off: &str, t: f64, rays: u64, rmse: f64| {
+            serde_json::json!({
+                "section": "effects", "scene": name, "width": full.film.width,
+                "height": full.film.height, "effect_off": off, "seconds": t, "rays": rays,
+                "speedup": t_full / t.max(1e-9), "rmse": rmse,
+            })
+        };
+        emit(json, row("", t_full, s_full.total(), 0.0), || {
+            format!(
+                "{name:<26} {:<12} {t_full:>9.3} {:>10.2} {:>7} {:>9}",
+                "(none)",
+                s_full.total() as f64 / 1e6,
+                "",
+                ""
+            )
+        });
         for (effect, on) in full.effects.named().into_iter().take(6) {
             if !on {
                 continue;
@@ -105,16 +134,31 @@ fn effects_section(dir: &std::path::Path, runs: u32, shrink: u32) -> Result<(), 
             off.set_effects(effects);
             let (t, st) = median_seconds(&off, runs);
             let img = render(&off, &|| {}).image;
-            println!(
-                "{:<26} {effect:<12} {t:>9.3} {:>10.2} {:>7.2} {:>9.5}",
-                "",
-                st.total() as f64 / 1e6,
-                t_full / t.max(1e-9),
-                rtis::converge::metrics::rmse(&img, &reference)
-            );
+            let rmse = rtis::converge::metrics::rmse(&img, &reference);
+            emit(json, row(effect, t, st.total(), rmse), || {
+                format!(
+                    "{:<26} {effect:<12} {t:>9.3} {:>10.2} {:>7.2} {rmse:>9.5}",
+                    "",
+                    st.total() as f64 / 1e6,
+                    t_full / t.max(1e-9),
+                )
+            });
         }
     }
     Ok(())
+}
+
+/// The CPU's model name (Linux's /proc/cpuinfo; "unknown CPU" elsewhere).
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into())
 }
 
 /// A field of /proc/self/status in MiB (Linux; 0 elsewhere).
@@ -139,20 +183,27 @@ fn own_peak_mib(f: impl FnOnce()) -> f64 {
     (status_mib("VmHWM:") - before).max(0.0)
 }
 
-fn case(name: &str, scene: &RenderScene, runs: u32) {
+fn case(name: &str, scene: &RenderScene, runs: u32, json: bool) {
     let mut result = None;
     let peak = own_peak_mib(|| result = Some(median_seconds(scene, runs)));
     let (seconds, stats) = result.expect("the case ran");
-    println!(
-        "{name:<34} {:>4}x{:<4} {:>5} spp {:>9.3} s {:>8.1} Mrays {:>7.1} Mrays/s {:>8.1} MiB own peak",
-        scene.film.width,
-        scene.film.height,
-        scene.film.spp,
-        seconds,
-        stats.total() as f64 / 1e6,
-        stats.total() as f64 / seconds.max(1e-9) / 1e6,
-        peak
-    );
+    let (f, rays) = (scene.film, stats.total());
+    let mrays = rays as f64 / seconds.max(1e-9) / 1e6;
+    let row = serde_json::json!({
+        "section": "cornell", "case": name, "width": f.width, "height": f.height,
+        "spp": f.spp, "seconds": seconds, "rays": rays, "mrays_per_second": mrays,
+        "own_peak_mib": peak,
+    });
+    emit(json, row, || {
+        format!(
+            "{name:<34} {:>4}x{:<4} {:>5} spp {seconds:>9.3} s {:>8.1} Mrays {mrays:>7.1} Mrays/s \
+             {peak:>8.1} MiB own peak",
+            f.width,
+            f.height,
+            f.spp,
+            rays as f64 / 1e6,
+        )
+    });
 }
 
 /// Mrays/s of `rays` run through `f` in parallel (chunks of 4096 rays).
@@ -171,12 +222,21 @@ fn rate(rays: &[Ray], f: impl Fn(&Ray) -> bool + Sync) -> (f64, usize) {
 
 /// BVH build time, memory per triangle and ray rates for procedural meshes of 10k, 100k and
 /// 1M triangles (a displaced sphere of radius 1 at the origin).
-fn meshes_section() {
-    println!("-- meshes: displaced sphere, 1M rays of each kind");
-    println!(
-        "{:>9} {:>9} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12}",
-        "triangles", "build s", "nodes", "BVH B/tri", "prim B", "camera", "shadow", "incoherent"
-    );
+fn meshes_section(json: bool) {
+    if !json {
+        println!("-- meshes: displaced sphere, 1M rays of each kind");
+        println!(
+            "{:>9} {:>9} {:>8} {:>9} {:>9} {:>10} {:>10} {:>12}",
+            "triangles",
+            "build s",
+            "nodes",
+            "BVH B/tri",
+            "prim B",
+            "camera",
+            "shadow",
+            "incoherent"
+        );
+    }
     for n in [10_000usize, 100_000, 1_000_000] {
         let mesh = displaced_sphere(n, Vec3::ZERO, 1.0, 0.05);
         let prims: Vec<Prim> = mesh
@@ -236,27 +296,43 @@ fn meshes_section() {
             })
             .collect();
         let (inc_rate, _) = rate(&incoherent, |r| g.intersect(r).is_some());
-        println!(
-            "{count:>9} {build:>9.3} {nodes:>8} {bvh_bytes:>9.1} {:>9} {cam_rate:>7.1} M/s {shadow_rate:>7.1} M/s {inc_rate:>9.1} M/s",
-            std::mem::size_of::<Prim>()
-        );
+        let prim_bytes = std::mem::size_of::<Prim>();
+        let row = serde_json::json!({
+            "section": "meshes", "triangles": count, "build_s": build, "nodes": nodes,
+            "bvh_bytes_per_triangle": bvh_bytes, "primitive_bytes": prim_bytes,
+            "camera_mrays": cam_rate, "shadow_mrays": shadow_rate,
+            "incoherent_mrays": inc_rate,
+        });
+        emit(json, row, || {
+            format!(
+                "{count:>9} {build:>9.3} {nodes:>8} {bvh_bytes:>9.1} {prim_bytes:>9} \
+                 {cam_rate:>7.1} M/s {shadow_rate:>7.1} M/s {inc_rate:>9.1} M/s"
+            )
+        });
     }
 }
 
 /// Run `rtis bench`.
 pub fn run(a: BenchArgs) -> Result<(), CliError> {
     let threads = rayon::current_num_threads();
-    println!(
-        "rtis bench: {} cores available, {threads} threads, median of {} runs",
-        std::thread::available_parallelism().map_or(0, |n| n.get()),
-        a.runs
-    );
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let head = serde_json::json!({
+        "section": "machine", "cores": cores, "threads": threads, "runs": a.runs,
+        "cpu": cpu_model(),
+    });
+    emit(a.json, head, || {
+        format!(
+            "rtis bench: {} ({cores} cores available), {threads} threads, median of {} runs",
+            cpu_model(),
+            a.runs
+        )
+    });
     let wants = |s: Section| a.section == Section::All || a.section == s;
     if wants(Section::Meshes) {
-        meshes_section();
+        meshes_section(a.json);
     }
     if wants(Section::Effects) {
-        effects_section(&a.scenes, a.runs, a.shrink)?;
+        effects_section(&a.scenes, a.runs, a.shrink, a.json)?;
     }
     if !wants(Section::Cornell) {
         return Ok(());
@@ -273,31 +349,38 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
             max_specular: 32,
         })
     };
-    println!("-- the course's Cornell box");
+    if !a.json {
+        println!("-- the course's Cornell box");
+    }
     case(
         "Direct",
         &with_settings(&base, Shader::Direct { max_specular: 32 }, 1),
         a.runs,
+        a.json,
     );
     case(
         "Global n=64 D=3",
         &with_settings(&base, global(64, 3), 1),
         a.runs,
+        a.json,
     );
     case(
         "Path (Course model) 64 spp",
         &with_settings(&base, reference_shader(), 64),
         a.runs,
+        a.json,
     );
     let mut physical = with_settings(&base, reference_shader(), 64);
     physical.model = rtis::scene::Model::Physical;
-    case("Path (Physical model) 64 spp", &physical, a.runs);
-    println!("-- cost against resolution and samples (Global n=16 D=2; should grow linearly)");
+    case("Path (Physical model) 64 spp", &physical, a.runs, a.json);
+    if !a.json {
+        println!("-- cost against resolution and samples (Global n=16 D=2; should grow linearly)");
+    }
     for (div, spp) in [(2, 1), (1, 1), (2, 4), (1, 4)] {
         let mut s = with_settings(&base, global(16, 2), spp);
         s.film.width /= div;
         s.film.height /= div;
-        case("Global n=16 D=2", &s, a.runs);
+        case("Global n=16 D=2", &s, a.runs, a.json);
     }
     Ok(())
 }
