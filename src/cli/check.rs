@@ -1,86 +1,269 @@
-//! `rtis check`.
+//! `rtis check`: validate a scene and print it in its own terms.
+//!
+//! The output is the scene as RON, as it loads: `extends` resolved, every default written out,
+//! one line per entity, materials of the `materials` table by name. It can be pasted back as a
+//! scene file. Comments (`//`) carry what is not scene syntax: warnings, the effects the render
+//! will simulate, and its cost estimate.
 
 use super::CliError;
-use rtis::scene;
-use rtis::world::{Material, MaterialName, Projection, WorldLight, WorldShape};
+use glam::{DVec3, Vec3A};
+use rtis::render::estimate::{self, human_seconds};
+use rtis::scene::{self, Scene};
+use rtis::shader::Shader;
+use rtis::world::{Material, MaterialName, Name, Projection, Transform, WorldLight, WorldShape};
 use std::collections::BTreeMap;
+use std::fmt::Write;
 use std::path::Path;
 
-/// Validate the scene and print what it contains.
-pub fn run(path: &Path) -> Result<(), CliError> {
-    let scene = scene::load_path(path)?;
-    let s = &scene.settings;
-    println!("scene {}: valid", scene.origin);
-    println!(
-        "  film        {}x{}, {} spp, PNG transfer {:?}",
-        s.film.width, s.film.height, s.film.spp, s.film.transfer
-    );
-    let (pos, look, up) = (s.camera.position, s.camera.look_at, s.camera.up);
-    let kind = match s.camera.projection {
-        Projection::Perspective { fov } => format!("perspective, fov {fov} deg"),
-        Projection::Orthographic { height } => format!("orthographic, height {height}"),
-    };
-    println!("  camera      {kind}, at {pos} looking at {look}, up {up}");
-    println!("  shader      {:?}", s.shader);
-    println!("  model       {:?}", s.model);
-    println!("  background  {}", s.background);
-    println!("  seed        {}", s.seed);
+/// A number as RON reads it: the shortest text that reads back as the same value, in
+/// scientific notation when very large or small (never 300 digits).
+pub fn num<T: Copy + Into<f64> + std::fmt::Display + std::fmt::LowerExp>(v: T) -> String {
+    let a = v.into().abs();
+    if a != 0.0 && !(1e-4..1e7).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
 
-    let mut shapes: BTreeMap<&str, usize> = BTreeMap::new();
-    let mut triangles = 0usize;
-    for shape in scene.world.query::<&WorldShape>().iter() {
-        let k = match shape {
-            WorldShape::Sphere { .. } => "Sphere",
-            WorldShape::Plane { .. } => "InfinitePlane",
-            WorldShape::Triangle { .. } => "Triangle",
-            WorldShape::Mesh(m) => {
-                triangles += m.faces.len();
-                "Mesh"
-            }
-        };
-        *shapes.entry(k).or_default() += 1;
+fn v3(v: DVec3) -> String {
+    format!("({}, {}, {})", num(v.x), num(v.y), num(v.z))
+}
+
+fn rgb(v: Vec3A) -> String {
+    format!("({}, {}, {})", num(v.x), num(v.y), num(v.z))
+}
+
+fn material(m: &Material) -> String {
+    match m {
+        Material::Phong(p) => format!(
+            "Phong(kd: {}, ks: {}, shininess: {})",
+            rgb(p.kd),
+            rgb(p.ks),
+            num(p.shininess)
+        ),
+        Material::Mirror(m) => format!("Mirror(color: {})", rgb(m.color)),
+        Material::Transmissive(t) => {
+            format!("Transmissive(ior: {}, color: {})", num(t.ior), rgb(t.color))
+        }
     }
-    println!("  entities    {}", scene.world.len());
-    for (k, n) in &shapes {
-        println!("    {n:>5} x {k}");
+}
+
+fn shape(s: &WorldShape) -> String {
+    match s {
+        WorldShape::Sphere { center, radius } => {
+            format!("Sphere(center: {}, radius: {})", v3(*center), num(*radius))
+        }
+        WorldShape::Plane { point, normal } => {
+            format!(
+                "InfinitePlane(point: {}, normal: {})",
+                v3(*point),
+                v3(*normal)
+            )
+        }
+        WorldShape::Triangle { v } => {
+            format!(
+                "Triangle(a: {}, b: {}, c: {})",
+                v3(v[0]),
+                v3(v[1]),
+                v3(v[2])
+            )
+        }
+        WorldShape::Mesh(m) => {
+            let list = |vs: &[DVec3]| vs.iter().map(|v| v3(*v)).collect::<Vec<_>>().join(", ");
+            let faces: Vec<String> = m
+                .faces
+                .iter()
+                .map(|f| format!("({}, {}, {})", f[0], f[1], f[2]))
+                .collect();
+            let normals = if m.normals.is_empty() {
+                String::new()
+            } else {
+                format!(", normals: [{}]", list(&m.normals))
+            };
+            format!(
+                "TriangleMesh(vertices: [{}], faces: [{}]{normals})",
+                list(&m.positions),
+                faces.join(", ")
+            )
+        }
     }
-    if triangles > 0 {
-        println!("          ({triangles} mesh triangles)");
+}
+
+fn shader(s: &Shader) -> String {
+    match s {
+        Shader::Intersection { color } => format!("Intersection(color: {})", rgb(*color)),
+        Shader::Depth {
+            max_distance,
+            color,
+        } => format!(
+            "Depth(max_distance: {}, color: {})",
+            num(*max_distance),
+            rgb(*color)
+        ),
+        Shader::Normal => "Normal".into(),
+        Shader::Direct { max_specular } => format!("Direct(max_specular: {max_specular})"),
+        Shader::Global(g) => format!(
+            "Global(samples: {}, max_depth: {}, ambient: {}, max_specular: {})",
+            g.samples,
+            g.max_depth,
+            rgb(g.ambient),
+            g.max_specular
+        ),
+        Shader::Path(p) => {
+            let depth = p
+                .max_depth
+                .map_or(String::new(), |d| format!("max_depth: {d}, "));
+            format!(
+                "Path({depth}rr_depth: {}, sampling: {:?})",
+                p.rr_depth, p.sampling
+            )
+        }
     }
-    let mut materials: BTreeMap<String, (String, usize)> = BTreeMap::new();
-    for (m, name) in scene
+}
+
+/// The scene as RON text, every default written out (see the module documentation).
+pub fn to_ron(scene: &Scene) -> String {
+    let s = &scene.settings;
+    let mut out = String::from("Scene(\n");
+    let f = &s.film;
+    let _ = writeln!(
+        out,
+        "    film: (width: {}, height: {}, spp: {}, transfer: {:?}),",
+        f.width, f.height, f.spp, f.transfer
+    );
+    let c = &s.camera;
+    let (kind, extent) = match c.projection {
+        Projection::Perspective { fov } => ("Perspective", format!("fov: {}", num(fov))),
+        Projection::Orthographic { height } => ("Orthographic", format!("height: {}", num(height))),
+    };
+    let _ = writeln!(
+        out,
+        "    camera: {kind}(position: {}, look_at: {}, up: {}, {extent}),",
+        v3(c.position),
+        v3(c.look_at),
+        v3(c.up)
+    );
+    let _ = writeln!(out, "    shader: {},", shader(&s.shader));
+    let _ = writeln!(out, "    model: {:?},", s.model);
+    let _ = writeln!(out, "    background: {},", rgb(s.background));
+    let _ = writeln!(out, "    seed: {},", s.seed);
+    let e = &s.effects;
+    let switches: Vec<String> = [
+        ("shadows", e.shadows),
+        ("reflection", e.reflection),
+        ("refraction", e.refraction),
+        ("indirect", e.indirect),
+        ("ambient", e.ambient),
+        ("background", e.background),
+    ]
+    .iter()
+    .filter_map(|(k, v)| v.map(|v| format!("{k}: {v}")))
+    .collect();
+    if !switches.is_empty() {
+        let _ = writeln!(out, "    effects: ({}),", switches.join(", "));
+    }
+
+    // The materials table: each name once, in name order.
+    let mut table: BTreeMap<String, String> = BTreeMap::new();
+    for (m, name) in scene.world.query::<(&Material, &MaterialName)>().iter() {
+        table.insert(name.0.clone(), material(m));
+    }
+    if !table.is_empty() {
+        out.push_str("    materials: {\n");
+        for (name, m) in &table {
+            let _ = writeln!(out, "        {name:?}: {m},");
+        }
+        out.push_str("    },\n");
+    }
+
+    // One line per entity, in the order of the file.
+    let mut entities: Vec<(hecs::Entity, String)> = Vec::new();
+    for (id, name, sh, m, mname, t, light) in scene
         .world
-        .query::<(&Material, Option<&MaterialName>)>()
+        .query::<(
+            hecs::Entity,
+            Option<&Name>,
+            Option<&WorldShape>,
+            Option<&Material>,
+            Option<&MaterialName>,
+            Option<&Transform>,
+            Option<&WorldLight>,
+        )>()
         .iter()
     {
-        let key = name.map_or_else(|| "(inline)".to_string(), |n| n.0.clone());
-        let kind = match m {
-            Material::Phong(_) => "Phong",
-            Material::Mirror(_) => "Mirror",
-            Material::Transmissive(_) => "Transmissive",
-        };
-        let e = materials
-            .entry(format!("{key} [{kind}]"))
-            .or_insert((kind.into(), 0));
-        e.1 += 1;
-    }
-    println!("  materials   {} in use", materials.len());
-    for (k, (_, n)) in &materials {
-        println!("    {k}: {n} entities");
-    }
-    let lights: Vec<_> = scene.world.query::<&WorldLight>().iter().copied().collect();
-    println!("  lights      {}", lights.len());
-    for l in lights {
-        let WorldLight::Point {
+        let mut fields = Vec::new();
+        if let Some(n) = name {
+            fields.push(format!("name: {:?}", n.0));
+        }
+        if let Some(sh) = sh {
+            fields.push(format!("shape: {}", shape(sh)));
+        }
+        match (m, mname) {
+            (_, Some(n)) => fields.push(format!("material: Named({:?})", n.0)),
+            (Some(m), None) => fields.push(format!("material: {}", material(m))),
+            (None, None) => {}
+        }
+        if let Some(t) = t
+            && *t != Transform::IDENTITY
+        {
+            fields.push(format!(
+                "transform: (scale: {}, rotate: {}, translate: {})",
+                v3(t.scale),
+                v3(t.rotate),
+                v3(t.translate)
+            ));
+        }
+        if let Some(WorldLight::Point {
             position,
             intensity,
-        } = l;
-        println!("    Point at {position} intensity {intensity} W/sr");
+        }) = light
+        {
+            fields.push(format!(
+                "light: Point(position: {}, intensity: {})",
+                v3(*position),
+                rgb((*intensity).into())
+            ));
+        }
+        entities.push((id, format!("        ({}),", fields.join(", "))));
     }
+    entities.sort_by_key(|(id, _)| id.id());
+    out.push_str("    entities: [\n");
+    for (_, line) in entities {
+        out.push_str(&line);
+        out.push('\n');
+    }
+    out.push_str("    ],\n)\n");
+    out
+}
+
+/// Validate the scene and print it, its effects and its cost.
+pub fn run(path: &Path) -> Result<(), CliError> {
+    let scene = scene::load_path(path)?;
+    println!(
+        "// {}: valid. As loaded: extends resolved, defaults written out.",
+        scene.origin
+    );
+    print!("{}", to_ron(&scene));
     let prepared = rtis::extract(&scene);
-    println!("  effects     {}", prepared.effects);
     for w in scene.warnings.iter().chain(&prepared.warnings) {
-        println!("warning: {w}");
+        println!("// warning: {w}");
     }
+    println!("// effects {}", prepared.effects);
+    let est = estimate::estimate(&prepared);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let rule = est
+        .rule_per_sample
+        .map_or("set by Russian roulette".into(), |r| {
+            format!("{} by the shader's rule", num(r))
+        });
+    println!(
+        "// cost: {} camera samples, {:.1} rays each ({rule}), {:.3e} rays in all, about {} on \
+         {threads} threads",
+        est.samples,
+        est.rays_per_sample,
+        est.rays(),
+        human_seconds(est.seconds(threads))
+    );
     Ok(())
 }
