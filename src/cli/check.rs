@@ -222,7 +222,7 @@ pub fn to_ron(scene: &Scene) -> String {
             fields.push(format!(
                 "light: Point(position: {}, intensity: {})",
                 v3(*position),
-                rgb((*intensity).into())
+                rgb(*intensity)
             ));
         }
         entities.push((id, format!("        ({}),", fields.join(", "))));
