@@ -364,3 +364,53 @@ fn closed_pipe_ends_quietly() {
     assert!(out.starts_with("{\"cores\":"), "{out}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// `rtis diff` on images whose differences are known: a uniform 0.5 against a uniform 0.25
+/// (linear EXR) has RMSE and largest error 0.25 and relMSE 0.0625 / (0.0625 + 0.01); an image
+/// against itself has every figure 0; images of two sizes are refused.
+#[test]
+fn diff_prints_exact_figures_and_writes_the_heatmap() {
+    let d = tmp("diff");
+    let exr = |name: &str, v: f32, w: u32| {
+        let p = d.join(name);
+        image::Rgb32FImage::from_pixel(w, 8, image::Rgb([v, v, v]))
+            .save(&p)
+            .unwrap();
+        p
+    };
+    let (a, b, c) = (
+        exr("a.exr", 0.5, 8),
+        exr("b.exr", 0.25, 8),
+        exr("c.exr", 0.5, 9),
+    );
+    let heat = d.join("heat.png");
+    let o = rtis(&[
+        "diff",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "-o",
+        heat.to_str().unwrap(),
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for line in [
+        "  RMSE        0.250000",
+        "  relMSE      0.862069",
+        "  max error   0.250000",
+        "  pixels that differ  64 of 64",
+    ] {
+        assert!(out.lines().any(|l| l == line), "{line:?} in\n{out}");
+    }
+    assert!(out.contains("mean FLIP"), "{out}");
+    assert_eq!(image::open(&heat).unwrap().width(), 8);
+    let o = rtis(&["diff", a.to_str().unwrap(), a.to_str().unwrap()]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("  RMSE        0.000000") && out.contains("  mean FLIP   0.000000"),
+        "{out}"
+    );
+    let o = rtis(&["diff", a.to_str().unwrap(), c.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("is 8x8 but"), "{}", stderr(&o));
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -3,6 +3,7 @@
 mod bench;
 mod check;
 mod converge;
+mod diff;
 pub mod interrupt;
 mod render;
 
@@ -27,6 +28,8 @@ enum Command {
         /// The scene file (RON).
         scene: PathBuf,
     },
+    /// Compare two images (PNG or EXR): RMSE, relMSE, largest error, FLIP, and a FLIP heatmap.
+    Diff(diff::DiffArgs),
     /// Measure error against time for a ladder of shader settings (CSV, table, plot).
     Converge(converge::ConvergeArgs),
     /// Print speed figures: the course's Cornell box under each shader (seconds, Mrays/s, own
@@ -48,6 +51,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Render(args) => render::run(args),
         Command::Check { scene } => check::run(&scene),
         Command::Converge(args) => converge::run(args),
+        Command::Diff(args) => diff::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

@@ -38,3 +38,45 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
         (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
     })
 }
+
+/// Largest absolute difference of any channel of any pixel.
+pub fn max_abs_error(a: &Image, reference: &Image) -> f64 {
+    a.pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(p, r)| (*p - *r).abs().max_element() as f64)
+        .fold(0.0, f64::max)
+}
+
+/// NVIDIA's FLIP between two images (LDR-FLIP on their 8-bit sRGB encodings, at FLIP's default
+/// 67 pixels per degree: a 0.7 m wide monitor of 3840 pixels seen from 0.7 m).
+#[derive(Clone, Debug)]
+pub struct Flip {
+    /// Mean FLIP error over the pixels, in [0, 1].
+    pub mean: f64,
+    /// FLIP error per pixel, row-major, in [0, 1].
+    pub map: Vec<f32>,
+    /// The map through FLIP's magma colour map (black: no perceived difference), RGB8.
+    pub heatmap: image::RgbImage,
+}
+
+/// FLIP between `test` and `reference`, both 8-bit sRGB images of one size.
+pub fn flip_rgb8(test: &image::RgbImage, reference: &image::RgbImage) -> Flip {
+    let (w, h) = test.dimensions();
+    let t = nv_flip::FlipImageRgb8::with_data(w, h, test.as_raw());
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, reference.as_raw());
+    let err = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    let mean = nv_flip::FlipPool::from_image(&err).mean() as f64;
+    let map = err.to_vec();
+    let lut = nv_flip::magma_lut();
+    let colored = err.apply_color_lut(&lut);
+    let heatmap =
+        image::RgbImage::from_raw(w, h, colored.to_vec()).expect("FLIP's map has the size");
+    Flip { mean, map, heatmap }
+}
+
+/// FLIP between two linear images of one size, through their sRGB encodings.
+pub fn flip(test: &Image, reference: &Image) -> Flip {
+    let enc = |i: &Image| crate::render::output::to_rgb8(i, crate::render::output::Transfer::Srgb);
+    flip_rgb8(&enc(test), &enc(reference))
+}
