@@ -4,6 +4,7 @@
 
 pub mod effects;
 pub mod estimate;
+pub mod exact;
 pub mod film;
 pub mod output;
 mod scene;
@@ -13,6 +14,7 @@ pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};
 use crate::sampling::{Sampler, pixel_sample};
 use crate::shader::radiance;
 use crate::stats::RayStats;
+use exact::RgbSum;
 use film::Image;
 use glam::Vec3A;
 use rayon::prelude::*;
@@ -49,18 +51,31 @@ impl Rendered {
     }
 }
 
-/// The colour of pixel `(col, row)`: the mean radiance of its `spp` camera samples.
+/// The colour of pixel `(col, row)`: the mean radiance of its `spp` camera samples, summed
+/// exactly ([`exact`]), so that the order of the samples never changes a bit.
 ///
 /// The last line of defence against numerical failure: a sample whose radiance is NaN,
 /// infinite or negative is dropped (it adds zero) and counted in `stats.dropped`, so one bad
 /// sample can never poison a pixel, and the count says that it happened.
 #[inline]
 pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStats) -> Vec3A {
-    let mut sum = Vec3A::ZERO;
-    for s in 0..scene.film.spp {
-        sum += render_sample(scene, col, row, s, stats);
+    pixel_sum(scene, col, row, 0..scene.film.spp, stats).mean(scene.film.spp as u64)
+}
+
+/// The exact sum of the samples `samples` of pixel `(col, row)`.
+#[inline]
+pub fn pixel_sum(
+    scene: &RenderScene,
+    col: u32,
+    row: u32,
+    samples: std::ops::Range<u32>,
+    stats: &mut RayStats,
+) -> RgbSum {
+    let mut sum = RgbSum::default();
+    for s in samples {
+        sum.add(render_sample(scene, col, row, s, stats));
     }
-    sum / scene.film.spp as f32
+    sum
 }
 
 /// Radiance of camera sample `s` of pixel `(col, row)`, from the sample's own random stream;
@@ -103,13 +118,87 @@ pub fn render_until(
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
 ) -> Rendered {
+    let t = by_tiles(scene, on_tile, stop, |col, row, stats| {
+        render_pixel(scene, col, row, stats)
+    });
+    Rendered {
+        image: Image {
+            width: scene.film.width,
+            height: scene.film.height,
+            pixels: t.pixels,
+        },
+        stats: t.stats,
+        seconds: t.seconds,
+        tiles_done: t.tiles_done,
+        tiles: t.tiles,
+    }
+}
+
+/// A pass: the exact sums of the samples `samples` of every pixel (see [`exact`]).
+#[derive(Clone, Debug)]
+pub struct PassSums {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Per-pixel sums, row-major.
+    pub pixels: Vec<RgbSum>,
+    /// Rays traced, by kind.
+    pub stats: RayStats,
+    /// Wall-clock seconds spent tracing.
+    pub seconds: f64,
+    /// Tiles rendered (all of them unless stopped).
+    pub tiles_done: u64,
+    /// Tiles in the image.
+    pub tiles: u64,
+}
+
+/// Render the sample indices `samples` of every pixel, keeping exact sums: passes of one
+/// scene, merged, give the same bits as one render ([`render`]) of all its samples.
+pub fn render_pass(
+    scene: &RenderScene,
+    samples: std::ops::Range<u32>,
+    on_tile: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> PassSums {
+    let t = by_tiles(scene, on_tile, stop, |col, row, stats| {
+        pixel_sum(scene, col, row, samples.clone(), stats)
+    });
+    PassSums {
+        width: scene.film.width,
+        height: scene.film.height,
+        pixels: t.pixels,
+        stats: t.stats,
+        seconds: t.seconds,
+        tiles_done: t.tiles_done,
+        tiles: t.tiles,
+    }
+}
+
+/// Per-pixel values of a tiled render, in row-major order.
+struct Tiled<T> {
+    pixels: Vec<T>,
+    stats: RayStats,
+    seconds: f64,
+    tiles_done: u64,
+    tiles: u64,
+}
+
+/// Run `pixel` over every pixel in 16x16 tiles on the current rayon pool; tiles not started
+/// when `stop` is set keep `T::default()`.
+fn by_tiles<T: Clone + Default + Send>(
+    scene: &RenderScene,
+    on_tile: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+    pixel: impl Fn(u32, u32, &mut RayStats) -> T + Sync,
+) -> Tiled<T> {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..tiles_x).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let done: Vec<Option<(Vec<Vec3A>, RayStats)>> = tiles
+    let done: Vec<Option<(Vec<T>, RayStats)>> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             if stop.load(Ordering::Relaxed) {
@@ -119,14 +208,14 @@ pub fn render_until(
             let mut px = Vec::with_capacity((TILE * TILE) as usize);
             for row in y0..(y0 + TILE).min(h) {
                 for col in x0..(x0 + TILE).min(w) {
-                    px.push(render_pixel(scene, col, row, &mut stats));
+                    px.push(pixel(col, row, &mut stats));
                 }
             }
             on_tile();
             Some((px, stats))
         })
         .collect();
-    let mut image = Image::new(w, h);
+    let mut pixels = vec![T::default(); w as usize * h as usize];
     let mut stats = RayStats::default();
     let mut tiles_done = 0;
     for (&(x0, y0), (px, st)) in tiles.iter().zip(done).filter_map(|(t, d)| Some((t, d?))) {
@@ -135,11 +224,11 @@ pub fn render_until(
         let tw = (x0 + TILE).min(w) - x0;
         for (i, p) in px.into_iter().enumerate() {
             let (col, row) = (x0 + i as u32 % tw, y0 + i as u32 / tw);
-            image.pixels[(row * w + col) as usize] = p;
+            pixels[(row * w + col) as usize] = p;
         }
     }
-    Rendered {
-        image,
+    Tiled {
+        pixels,
         stats,
         seconds: start.elapsed().as_secs_f64(),
         tiles_done,
