@@ -13,8 +13,21 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj(path, &options)
-        .map_err(|e| format!("cannot load mesh {}: {e}", path.display()))?;
+    // Read the file here rather than in tobj, which drops the system's reason ("No such file
+    // or directory", "Is a directory", "Permission denied").
+    let bytes =
+        std::fs::read(path).map_err(|e| format!("cannot read mesh {}: {e}", path.display()))?;
+    // Materials (`mtllib`) are not used: the scene gives the material.
+    let (models, _materials) = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| match e {
+        tobj::LoadError::ReadError => format!(
+            "cannot load mesh {}: it is not a text file (not UTF-8)",
+            path.display()
+        ),
+        e => format!("cannot load mesh {}: {e}", path.display()),
+    })?;
     let mut mesh = MeshData::default();
     let mut all_normals = true;
     for m in &models {

@@ -57,7 +57,7 @@ pub struct SceneFile {
     #[serde(default)]
     pub background: Option<Rgb>,
     /// Seed of every random number of the render. Default: 0.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::values::seed")]
     pub seed: Option<u64>,
     /// Light-transport model for the shaders that have one. Default: `Course`.
     #[serde(default)]
@@ -418,7 +418,8 @@ impl TryFrom<MaterialDesc> for TableMaterial {
         match m.to_world() {
             Some(m) => Ok(TableMaterial(m)),
             None => Err(format!(
-                "material table entry cannot be {m:?}: write it inline"
+                "an entry of `materials` cannot be {m:?}: write the material itself, as \
+                 `Phong(kd: (0.8, 0.8, 0.8))`"
             )),
         }
     }
@@ -466,7 +467,8 @@ pub enum ShapeDesc {
     TriangleMesh {
         /// Vertex positions.
         vertices: Vec<Point>,
-        /// Triangles as triples of indices into `vertices`.
+        /// Triangles as triples of indices into `vertices`; at least one.
+        #[serde(deserialize_with = "super::values::faces")]
         faces: Vec<(u32, u32, u32)>,
         /// Optional per-vertex normals for smooth shading (same count as `vertices`).
         #[serde(default)]
@@ -649,7 +651,7 @@ impl TryFrom<EntityFields> for EntityDesc {
             .name
             .as_deref()
             .map(|n| format!("entity \"{n}\""))
-            .unwrap_or_else(|| "entity".into());
+            .unwrap_or_else(|| "this entity".into());
         match (&e.shape, &e.material, &e.light) {
             (Some(_), None, _) => Err(format!("{label} has a shape but no material")),
             (None, Some(_), _) => Err(format!("{label} has a material but no shape")),
@@ -658,9 +660,13 @@ impl TryFrom<EntityFields> for EntityDesc {
                 if let (Some(ShapeDesc::Sphere { .. }), Some(t)) = (&e.shape, &e.transform) {
                     let s = t.scale.0.abs();
                     if s.x != s.y || s.y != s.z {
+                        let s = t.scale.0;
                         return Err(format!(
-                            "{label}: a sphere takes only a uniform scale, got {}",
-                            t.scale.0
+                            "{label}: a sphere takes only a uniform scale (the same factor on \
+                             x, y and z), got ({}, {}, {})",
+                            super::values::show(s.x),
+                            super::values::show(s.y),
+                            super::values::show(s.z)
                         ));
                     }
                 }
@@ -671,7 +677,8 @@ impl TryFrom<EntityFields> for EntityDesc {
                     && normals.len() != vertices.len()
                 {
                     return Err(format!(
-                        "{label}: {} normals for {} vertices: give one per vertex or none",
+                        "{label}: {} normals for {} vertices: give one normal per vertex, or \
+                         none",
                         normals.len(),
                         vertices.len()
                     ));
@@ -686,9 +693,15 @@ impl TryFrom<EntityFields> for EntityDesc {
                         .enumerate()
                         .find(|(_, f)| f.0 as u64 >= n || f.1 as u64 >= n || f.2 as u64 >= n)
                     {
-                        return Err(format!(
-                            "{label}: face {i} {f:?} indexes past the {n} vertices"
-                        ));
+                        return Err(if n == 0 {
+                            format!("{label}: face {i} is {f:?}, but there are no vertices")
+                        } else {
+                            format!(
+                                "{label}: face {i} is {f:?}, but the {n} vertices are numbered \
+                                 from 0 to {}",
+                                n - 1
+                            )
+                        });
                     }
                 }
                 Ok(EntityDesc(e))

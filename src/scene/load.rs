@@ -2,10 +2,13 @@
 //! own component types: names resolved, meshes loaded.
 
 use super::SceneError;
+use super::error::{clip, line_col};
 use super::file::{
     CameraDesc, EffectsDesc, EntityDesc, FilmDesc, MaterialDesc, Model, SceneFile, ShaderDesc,
     TableMaterial,
 };
+use super::messages::{explain, offset_of};
+use super::spans::{self, Node};
 use super::values::Rgb;
 use crate::material::Material;
 use crate::world::{MaterialName, Name, Scene, Settings};
@@ -16,43 +19,157 @@ use std::path::{Path, PathBuf};
 /// The course's Cornell box, embedded: what `rtis render` draws when given no scene.
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/cornell.ron");
 
-/// Deepest chain of `extends`.
-const MAX_EXTENDS: usize = 16;
+/// Most `extends` in a chain: the file loaded and up to this many bases above it.
+pub const MAX_EXTENDS: usize = 16;
 
-/// One parsed file: its display name, text and folder (for relative paths).
+/// One parsed file: its display name, text, folder (for relative paths), and where its values
+/// are (for errors found after parsing).
 struct Source {
     name: String,
     text: String,
     dir: Option<PathBuf>,
+    tree: Option<Node>,
+}
+
+impl Source {
+    fn new(name: String, text: String, dir: Option<PathBuf>) -> Self {
+        Source {
+            name,
+            text,
+            dir,
+            tree: None,
+        }
+    }
+
+    /// An error at byte `offset` of this file.
+    fn error(&self, offset: usize, message: impl Into<String>) -> SceneError {
+        SceneError::at_offset(&self.name, &self.text, offset, message)
+    }
+
+    /// Entity `i` of this file's `entities` list, as written.
+    fn entity(&self, i: usize) -> Option<&Node> {
+        let tree = self.tree.as_ref()?;
+        tree.get("entities", &self.text)?.items().get(i)
+    }
+
+    /// Where the top-level field `name` is written (its value), else the file's start.
+    fn top_field(&self, name: &str) -> usize {
+        self.tree
+            .as_ref()
+            .and_then(|t| t.get(name, &self.text))
+            .map_or(0, |v| v.start)
+    }
 }
 
 fn ron_options() -> ron::Options {
     ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME)
 }
 
-fn parse(src: &Source) -> Result<SceneFile, SceneError> {
-    ron_options().from_str::<SceneFile>(&src.text).map_err(|e| {
-        let (line, col) = (e.span.start.line, e.span.start.col);
-        SceneError::at(&src.name, &src.text, line, col, e.code.to_string())
-    })
+/// Parse a file, then check what spans several values: duplicate names and a transform on a
+/// light-only entity.
+fn parse(src: &mut Source) -> Result<SceneFile, SceneError> {
+    let file = ron_options()
+        .from_str::<SceneFile>(&src.text)
+        .map_err(|e| {
+            let start = offset_of(&src.text, e.span.start.line, e.span.start.col);
+            let end = offset_of(&src.text, e.span.end.line, e.span.end.col);
+            src.error(start, explain(&e.code, &src.text, start, end))
+        })?;
+    src.tree = spans::parse(&src.text);
+    check(src, &file)?;
+    Ok(file)
+}
+
+/// Duplicate material keys, duplicate entity names, and transforms on entities without a
+/// shape, each at the second occurrence (or the transform) and naming the first.
+fn check(src: &Source, file: &SceneFile) -> Result<(), SceneError> {
+    let text = &src.text;
+    let tree = src.tree.as_ref();
+    let lc = |off: usize| {
+        let (l, c) = line_col(text, off);
+        format!("line {l}, column {c}")
+    };
+    if let Some(map) = tree.and_then(|t| t.get("materials", text)) {
+        let mut seen: BTreeMap<String, usize> = BTreeMap::new();
+        for (key, _) in map.entries() {
+            let Some(name) = key.string(text) else {
+                continue;
+            };
+            if let Some(&first) = seen.get(&name) {
+                return Err(src.error(
+                    key.start,
+                    format!(
+                        "material \"{}\" is defined twice in `materials` (first at {}): \
+                         rename or remove one",
+                        clip(&name, 60),
+                        lc(first)
+                    ),
+                ));
+            }
+            seen.insert(name, key.start);
+        }
+    }
+    let entities = file.entities.as_deref().unwrap_or_default();
+    let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+    for (i, EntityDesc(e)) in entities.iter().enumerate() {
+        let node = src.entity(i);
+        if let Some(name) = &e.name {
+            let at = node
+                .and_then(|n| n.get("name", text))
+                .map_or_else(|| src.top_field("entities"), |v| v.start);
+            if let Some(&first) = seen.get(name.as_str()) {
+                return Err(src.error(
+                    at,
+                    format!(
+                        "two entities are named \"{}\" (the first at {}): names must be \
+                         unique within a file (an entity named like one of the base scene's \
+                         replaces it)",
+                        clip(name, 60),
+                        lc(first)
+                    ),
+                ));
+            }
+            seen.insert(name, at);
+        }
+        if e.shape.is_none() && e.light.is_some() && e.transform.is_some() {
+            let at = node
+                .and_then(|n| n.field("transform"))
+                .map_or_else(|| src.top_field("entities"), |f| f.at);
+            let label = e.name.as_deref().map_or("this entity".to_string(), |n| {
+                format!("entity \"{}\"", clip(n, 60))
+            });
+            return Err(src.error(
+                at,
+                format!(
+                    "{label} has a light but no shape, and a `transform` moves only a shape: \
+                     remove it and set the light's `position` instead"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Load the scene file at `path`.
 pub fn load_path(path: &Path) -> Result<Scene, SceneError> {
-    let src = read(path)?;
+    let name = path.display().to_string();
+    let src = read(path).map_err(|e| match e {
+        ReadError::Io(e) => SceneError::whole_file(&name, format!("cannot read scene file: {e}")),
+        ReadError::Located(e) => e,
+    })?;
     let mut chain: Vec<PathBuf> = path.canonicalize().into_iter().collect();
-    resolve(src, &mut chain).and_then(|r| r.into_scene(path.display().to_string()))
+    resolve(src, &mut chain, 0).and_then(|r| r.into_scene(name))
 }
 
 /// Load a scene from text; `name` labels errors and `dir` resolves `extends` (the current folder
 /// when `None`).
 pub fn load_str(text: &str, name: &str, dir: Option<&Path>) -> Result<Scene, SceneError> {
-    let src = Source {
-        name: name.to_string(),
-        text: text.to_string(),
-        dir: dir.map(Path::to_path_buf),
-    };
-    resolve(src, &mut Vec::new()).and_then(|r| r.into_scene(name.to_string()))
+    let src = Source::new(
+        name.to_string(),
+        text.to_string(),
+        dir.map(Path::to_path_buf),
+    );
+    resolve(src, &mut Vec::new(), 0).and_then(|r| r.into_scene(name.to_string()))
 }
 
 /// The embedded Cornell box ([`DEFAULT_SCENE`]).
@@ -61,14 +178,54 @@ pub fn load_default() -> Scene {
         .expect("the embedded default scene is valid (checked by the tests)")
 }
 
-fn read(path: &Path) -> Result<Source, SceneError> {
+/// Why a file could not be read: the system's reason, or text that is not UTF-8 (located).
+enum ReadError {
+    Io(std::io::Error),
+    Located(SceneError),
+}
+
+fn read(path: &Path) -> Result<Source, ReadError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::whole_file(&name, format!("cannot read scene file: {e}")))?;
-    Ok(Source {
+    let bytes = std::fs::read(path).map_err(ReadError::Io)?;
+    let text = decode(&name, bytes).map_err(ReadError::Located)?;
+    Ok(Source::new(
         name,
         text,
-        dir: path.parent().map(Path::to_path_buf),
+        path.parent().map(Path::to_path_buf),
+    ))
+}
+
+/// The text of a file, or an error at the line and column of its first byte that is not UTF-8.
+fn decode(name: &str, bytes: Vec<u8>) -> Result<String, SceneError> {
+    String::from_utf8(bytes).map_err(|e| {
+        let bad = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let shown: Vec<String> = bytes[bad..]
+            .iter()
+            .take(
+                e.utf8_error()
+                    .error_len()
+                    .unwrap_or(bytes.len() - bad)
+                    .min(4),
+            )
+            .map(|b| format!("0x{b:02X}"))
+            .collect();
+        // The valid prefix places the error; the line is shown with U+FFFD for bad bytes.
+        let lossy = String::from_utf8_lossy(bytes);
+        let prefix = std::str::from_utf8(&bytes[..bad]).unwrap_or_default();
+        let (line, col) = line_col(prefix, prefix.len());
+        SceneError::at(
+            name,
+            &lossy,
+            line,
+            col,
+            format!(
+                "the file is not UTF-8 text: byte{} {} cannot start a character here; save \
+                 the file as UTF-8",
+                if shown.len() == 1 { "" } else { "s" },
+                shown.join(" ")
+            ),
+        )
     })
 }
 
@@ -83,11 +240,16 @@ struct Resolved {
     model: Option<Model>,
     effects: Option<EffectsDesc>,
     materials: BTreeMap<String, (Material, usize)>,
-    entities: Vec<(EntityDesc, usize)>,
+    /// Each entity, the index of its source, and its index in that file's `entities`.
+    entities: Vec<(EntityDesc, usize, usize)>,
 }
 
-fn resolve(src: Source, chain: &mut Vec<PathBuf>) -> Result<Resolved, SceneError> {
-    let file = parse(&src)?;
+fn resolve(
+    mut src: Source,
+    chain: &mut Vec<PathBuf>,
+    depth: usize,
+) -> Result<Resolved, SceneError> {
+    let file = parse(&mut src)?;
     let mut base = match &file.extends {
         None => Resolved {
             sources: Vec::new(),
@@ -103,25 +265,29 @@ fn resolve(src: Source, chain: &mut Vec<PathBuf>) -> Result<Resolved, SceneError
         },
         Some(rel) => {
             let path = src.dir.clone().unwrap_or_default().join(rel);
-            let err = |m: String| {
-                let off = src.text.find(&format!("\"{rel}\"")).unwrap_or(0);
-                SceneError::at_offset(&src.name, &src.text, off, m)
-            };
-            let canon = path
-                .canonicalize()
-                .map_err(|e| err(format!("cannot read base scene {}: {e}", path.display())))?;
-            if chain.contains(&canon) {
+            let at = src.top_field("extends");
+            let err = |m: String| src.error(at, m);
+            let shown = clip(&path.display().to_string(), 200);
+            if depth >= MAX_EXTENDS {
                 return Err(err(format!(
-                    "`extends` cycle: {} extends itself through its bases",
-                    path.display()
+                    "more than {MAX_EXTENDS} nested `extends`: a chain may have at most \
+                     {MAX_EXTENDS} base scenes"
                 )));
             }
-            if chain.len() >= MAX_EXTENDS {
-                return Err(err(format!("more than {MAX_EXTENDS} nested `extends`")));
+            let canon = path
+                .canonicalize()
+                .map_err(|e| err(format!("cannot read base scene {shown}: {e}")))?;
+            if chain.contains(&canon) {
+                return Err(err(format!(
+                    "`extends` cycle: {shown} extends itself through its bases"
+                )));
             }
+            let base_src = read(&path).map_err(|e| match e {
+                ReadError::Io(e) => err(format!("cannot read base scene {shown}: {e}")),
+                ReadError::Located(e) => e,
+            })?;
             chain.push(canon);
-            let base_src = read(&path)?;
-            let r = resolve(base_src, chain)?;
+            let r = resolve(base_src, chain, depth + 1)?;
             chain.pop();
             r
         }
@@ -138,48 +304,41 @@ fn resolve(src: Source, chain: &mut Vec<PathBuf>) -> Result<Resolved, SceneError
         base.materials.insert(name, (m, idx));
     }
     // An entity named like one of the base's replaces it in place; others are appended.
-    for e in file.entities.unwrap_or_default() {
+    for (i, e) in file.entities.unwrap_or_default().into_iter().enumerate() {
         let slot = e.0.name.as_ref().and_then(|n| {
             base.entities
                 .iter()
-                .position(|(b, _)| b.0.name.as_ref() == Some(n))
+                .position(|(b, _, _)| b.0.name.as_ref() == Some(n))
         });
         match slot {
-            Some(i) => base.entities[i] = (e, idx),
-            None => base.entities.push((e, idx)),
+            Some(j) => base.entities[j] = (e, idx, i),
+            None => base.entities.push((e, idx, i)),
         }
     }
     base.sources.push(src);
     Ok(base)
 }
 
-/// Byte offset of `Named("name")` in `text`, for locating a bad reference.
-fn find_named(text: &str, name: &str) -> usize {
-    let quoted = format!("\"{name}\"");
-    let mut from = 0;
-    while let Some(i) = text[from..].find(&quoted) {
-        let at = from + i;
-        let before = text[..at].trim_end();
-        if let Some(b) = before.strip_suffix('(')
-            && b.trim_end().ends_with("Named")
-        {
-            return at;
-        }
-        from = at + quoted.len();
-    }
-    0
-}
-
 impl Resolved {
     fn into_scene(self, origin: String) -> Result<Scene, SceneError> {
-        let located = |idx: usize, name: &str, msg: String| {
-            let s: &Source = &self.sources[idx];
-            SceneError::at_offset(&s.name, &s.text, find_named(&s.text, name), msg)
-        };
         let mut world = hecs::World::new();
         let mut warnings = Vec::new();
-        for (EntityDesc(e), idx) in &self.entities {
+        for (EntityDesc(e), idx, i) in &self.entities {
             let src = &self.sources[*idx];
+            // Where a component's value is written: the value of `field`, then `inner` inside
+            // it (`Mesh(path: ...)`, `Named("...")`), falling back to the entity, the
+            // `entities` list, the file's start.
+            let place = |field: &str, inner: Option<&str>| {
+                let node = src.entity(*i);
+                let value = node.and_then(|n| n.get(field, &src.text));
+                let deep = value.and_then(|v| match inner {
+                    Some(f) => v.get(f, &src.text),
+                    None => v.items().first(),
+                });
+                deep.or(value)
+                    .or(node)
+                    .map_or_else(|| src.top_field("entities"), |n| n.start)
+            };
             let mut b = hecs::EntityBuilder::new();
             if let Some(name) = &e.name {
                 b.add(Name(name.clone()));
@@ -190,14 +349,7 @@ impl Resolved {
                         let file = src.dir.clone().unwrap_or_default().join(path);
                         crate::mesh::load_obj(&file)
                     })
-                    .map_err(|m| {
-                        let path = match shape {
-                            super::file::ShapeDesc::Mesh { path } => path.as_str(),
-                            _ => "",
-                        };
-                        let off = src.text.find(&format!("\"{path}\"")).unwrap_or(0);
-                        SceneError::at_offset(&src.name, &src.text, off, m)
-                    })?;
+                    .map_err(|m| src.error(place("shape", Some("path")), m))?;
                 b.add(shape);
             }
             if let Some(t) = &e.transform {
@@ -220,10 +372,9 @@ impl Resolved {
                         } else {
                             format!("known materials: {}", known.join(", "))
                         };
-                        return Err(located(
-                            *idx,
-                            n,
-                            format!("unknown material \"{n}\"; {list}"),
+                        return Err(src.error(
+                            place("material", None),
+                            format!("unknown material \"{}\"; {list}", clip(n, 60)),
                         ));
                     }
                 },

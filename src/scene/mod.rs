@@ -8,12 +8,14 @@
 mod error;
 pub mod file;
 mod load;
+mod messages;
+mod spans;
 pub mod values;
 
 pub use crate::world::{Scene, Settings};
-pub use error::SceneError;
+pub use error::{EXCERPT_RADIUS, MAX_MESSAGE, SceneError};
 pub use file::{
     CameraDesc, FilmDesc, LightDesc, MaterialDesc, Model, ShaderDesc, ShapeDesc, TransformDesc,
 };
-pub use load::{DEFAULT_SCENE, load_default, load_path, load_str};
+pub use load::{DEFAULT_SCENE, MAX_EXTENDS, load_default, load_path, load_str};
 pub use values::Rgb;

@@ -8,6 +8,7 @@
 //! is refused here, with its location, rather than turning into NaN pixels later.
 
 use glam::DVec3;
+use serde::de::{self, Deserializer, Visitor};
 use serde::{Deserialize, Serialize};
 
 /// Largest coordinate magnitude, and largest length, in scene units.
@@ -258,21 +259,63 @@ impl From<Fov> for f64 {
     }
 }
 
+/// A number written where a whole number is expected: `Ok` with its value when it is whole
+/// (`720`, `720.0`, `1e3`), else `Err` with the number as written, for the message.
+struct Whole;
+
+impl Visitor<'_> for Whole {
+    type Value = Result<i128, String>;
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a whole number")
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<Self::Value, E> {
+        Ok(Ok(v.into()))
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Self::Value, E> {
+        Ok(Ok(v.into()))
+    }
+    fn visit_u128<E: de::Error>(self, v: u128) -> Result<Self::Value, E> {
+        Ok(i128::try_from(v).map_err(|_| v.to_string()))
+    }
+    fn visit_i128<E: de::Error>(self, v: i128) -> Result<Self::Value, E> {
+        Ok(Ok(v))
+    }
+    fn visit_f32<E: de::Error>(self, v: f32) -> Result<Self::Value, E> {
+        // Shown as the f32 it was read as, not its f64 widening (0.1, not 0.100000001).
+        Ok(self.visit_f64::<E>(v.into())?.map_err(|_| format!("{v}")))
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<Self::Value, E> {
+        if v.fract() == 0.0 && v.abs() < 1e18 {
+            Ok(Ok(v as i128))
+        } else {
+            Ok(Err(show(v)))
+        }
+    }
+}
+
+/// A whole number from `min` to `max`, with a message naming the bound it breaks, or the
+/// range when it is not whole.
+fn whole_in<'de, D: Deserializer<'de>>(d: D, min: u64, max: u64) -> Result<u64, D::Error> {
+    let message = match d.deserialize_any(Whole)? {
+        Ok(v) if (i128::from(min)..=i128::from(max)).contains(&v) => return Ok(v as u64),
+        Ok(v) if v > i128::from(max) => format!("must be at most {max}, got {v}"),
+        Ok(v) if min > 0 => format!("must be at least {min}, got {v}"),
+        Ok(v) => format!("must be a whole number from {min} to {max}, got {v}"),
+        Err(shown) => format!("must be a whole number from {min} to {max}, got {shown}"),
+    };
+    Err(de::Error::custom(message))
+}
+
 /// A count of at least 1 and at most `MAX` (samples per pixel, hemisphere samples...).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(try_from = "u64", into = "u32")]
+/// A number with a fractional part is refused with a message saying a whole number is
+/// expected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(into = "u32")]
 pub struct Count<const MAX: u32>(pub u32);
 
-impl<const MAX: u32> TryFrom<u64> for Count<MAX> {
-    type Error = String;
-    fn try_from(v: u64) -> Result<Self, String> {
-        if v == 0 {
-            Err("must be at least 1, got 0".into())
-        } else if v > MAX as u64 {
-            Err(format!("must be at most {MAX}, got {v}"))
-        } else {
-            Ok(Count(v as u32))
-        }
+impl<'de, const MAX: u32> Deserialize<'de> for Count<MAX> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        whole_in(d, 1, MAX.into()).map(|v| Count(v as u32))
     }
 }
 impl<const MAX: u32> From<Count<MAX>> for u32 {
@@ -282,24 +325,54 @@ impl<const MAX: u32> From<Count<MAX>> for u32 {
 }
 
 /// A whole number from 0 to `MAX` (depths).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(try_from = "u64", into = "u32")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(into = "u32")]
 pub struct UpTo<const MAX: u32>(pub u32);
 
-impl<const MAX: u32> TryFrom<u64> for UpTo<MAX> {
-    type Error = String;
-    fn try_from(v: u64) -> Result<Self, String> {
-        if v > MAX as u64 {
-            Err(format!("must be at most {MAX}, got {v}"))
-        } else {
-            Ok(UpTo(v as u32))
-        }
+impl<'de, const MAX: u32> Deserialize<'de> for UpTo<MAX> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        whole_in(d, 0, MAX.into()).map(|v| UpTo(v as u32))
     }
 }
 impl<const MAX: u32> From<UpTo<MAX>> for u32 {
     fn from(c: UpTo<MAX>) -> Self {
         c.0
     }
+}
+
+/// A whole number from 0 to `u64::MAX` (the seed).
+struct Any64(u64);
+
+impl<'de> Deserialize<'de> for Any64 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        whole_in(d, 0, u64::MAX).map(Any64)
+    }
+}
+
+/// Deserialize an optional seed: a whole number from 0 to `u64::MAX`.
+pub fn seed<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
+    Ok(Option::<Any64>::deserialize(d)?.map(|s| s.0))
+}
+
+/// A vertex index of a face.
+struct Index(u32);
+
+impl<'de> Deserialize<'de> for Index {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        whole_in(d, 0, u32::MAX.into()).map(|v| Index(v as u32))
+    }
+}
+
+/// Deserialize the faces of a triangle mesh: index triples, at least one.
+pub fn faces<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<(u32, u32, u32)>, D::Error> {
+    let f = Vec::<(Index, Index, Index)>::deserialize(d)?;
+    if f.is_empty() {
+        return Err(de::Error::custom(
+            "a TriangleMesh needs at least one face: `faces: [(0, 1, 2)]` makes a triangle \
+             of the first three vertices",
+        ));
+    }
+    Ok(f.into_iter().map(|(a, b, c)| (a.0, b.0, c.0)).collect())
 }
 
 /// A scale `(sx, sy, sz)`: each component's magnitude in [`SCALE_RANGE`] (negative mirrors).
