@@ -1,0 +1,32 @@
+//! README.md cannot drift: every measured figure sits in a block that
+//! `bench/readme_figures.py` regenerates and stamps with the machine, date and commit; this
+//! checks that every block is there with its stamp, and that the README's two commands are the
+//! ones the project promises.
+
+use std::process::Command;
+
+#[test]
+fn readme_figure_blocks_are_generated() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let o = Command::new("python3")
+        .args(["bench/readme_figures.py", "--check"])
+        .current_dir(root)
+        .output()
+        .expect("python3 runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn readme_keeps_its_two_commands() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    assert!(
+        text.contains("cargo run --release -- render "),
+        "the render command"
+    );
+    assert!(text.contains("\ncargo test --release "), "the test command");
+    let ci = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/.ci/run")).unwrap();
+    assert!(
+        ci.contains("\ncargo test --release\n"),
+        ".ci/run runs the README's test command"
+    );
+}
