@@ -5,6 +5,7 @@ mod check;
 mod converge;
 mod diff;
 pub mod interrupt;
+mod merge;
 mod render;
 
 use clap::{Parser, Subcommand};
@@ -30,6 +31,8 @@ enum Command {
     },
     /// Compare two images (PNG or EXR): RMSE, relMSE, largest error, FLIP, and a FLIP heatmap.
     Diff(diff::DiffArgs),
+    /// Merge pass files (`render --pass I/N`) into the image, bit-identical to one render.
+    Merge(merge::MergeArgs),
     /// Measure error against time for a ladder of shader settings (CSV, table, plot).
     Converge(converge::ConvergeArgs),
     /// Print speed figures: the course's Cornell box under each shader (seconds, Mrays/s, own
@@ -52,6 +55,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Check { scene } => check::run(&scene),
         Command::Converge(args) => converge::run(args),
         Command::Diff(args) => diff::run(args),
+        Command::Merge(args) => merge::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

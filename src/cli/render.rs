@@ -6,6 +6,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rtis::render::estimate::{self, MAX_RAYS_UNFORCED, human_seconds};
 use rtis::render::output::Transfer;
+use rtis::render::pass::{self, Pass};
 use rtis::render::{self, Film, output};
 use std::path::{Path, PathBuf};
 
@@ -42,6 +43,10 @@ pub struct RenderArgs {
     /// Render even when the estimate is beyond 2e11 rays (about an hour on 2 cores).
     #[arg(long)]
     force: bool,
+    /// Render only pass I of N (I from 0): a contiguous share of the sample indices, written as
+    /// a pass EXR of exact sums for `rtis merge` (default name NAME.pass-I-of-N.exr).
+    #[arg(long, value_parser = pass::parse_pass, value_name = "I/N")]
+    pass: Option<(u32, u32)>,
 }
 
 /// The parser of an image side: a whole number of pixels from 1 to [`render::MAX_SIDE`].
@@ -120,16 +125,33 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     if let Some(seed) = a.seed {
         scene.settings.seed = seed;
     }
-    let out = a.output.clone().unwrap_or_else(|| {
-        let stem = a
-            .scene
-            .as_deref()
-            .and_then(|p| p.file_stem())
-            .map_or_else(|| "cornell".into(), |s| s.to_string_lossy().into_owned());
-        PathBuf::from(format!("{stem}.png"))
+    let stem = a
+        .scene
+        .as_deref()
+        .and_then(|p| p.file_stem())
+        .map_or_else(|| "cornell".into(), |s| s.to_string_lossy().into_owned());
+    let out = a.output.clone().unwrap_or_else(|| match a.pass {
+        Some((i, n)) => PathBuf::from(format!("{stem}.pass-{i}-of-{n}.exr")),
+        None => PathBuf::from(format!("{stem}.png")),
     });
     // Fail before a long render, not after it.
     output::check_writable(&out)?;
+    let samples = match a.pass {
+        Some((i, n)) => {
+            if !out
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+            {
+                return Err(format!(
+                    "{}: a pass is written as an .exr file of exact sums (see rtis merge)",
+                    out.display()
+                )
+                .into());
+            }
+            pass::pass_range(i, n, scene.settings.film.spp)?
+        }
+        None => 0..scene.settings.film.spp,
+    };
     if let Some(path) = &a.stats {
         output::check_folder(path)?;
     }
@@ -147,8 +169,12 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         .num_threads(threads)
         .build()?;
 
-    // What it will cost: the shader's rule and a short calibration.
-    let est = estimate::estimate(&prepared);
+    // What it will cost: the shader's rule and a short calibration (for a pass, its share).
+    let est = {
+        let mut share = prepared.clone();
+        share.film.spp = samples.len() as u32;
+        estimate::estimate(&share)
+    };
     eprintln!(
         "estimate: {:.3e} rays, about {} on {threads} threads (calibrated on {} samples{})",
         est.rays(),
@@ -178,6 +204,26 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         .expect("valid template"),
     );
     let tick = || bar.inc(1);
+    if a.pass.is_some() {
+        // A pass is all or nothing: Ctrl-C quits at once (no Graceful), nothing is written.
+        let sums = pool
+            .install(|| render::render_pass(&prepared, samples.clone(), &tick, &interrupt::STOP));
+        bar.finish_and_clear();
+        Pass::from_render(&prepared, samples.clone(), sums.pixels).write(&out)?;
+        eprintln!(
+            "pass of samples {}..{} of {}: {}x{} in {:.2} s on {} threads, {} rays -> {}",
+            samples.start,
+            samples.end,
+            prepared.film.spp,
+            prepared.film.width,
+            prepared.film.height,
+            sums.seconds,
+            pool.current_num_threads(),
+            sums.stats.total(),
+            out.display()
+        );
+        return Ok(());
+    }
     let result = {
         let _graceful = Graceful::begin();
         pool.install(|| render::render_until(&prepared, &tick, &interrupt::STOP))

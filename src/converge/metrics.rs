@@ -32,12 +32,7 @@ pub fn rel_mse(a: &Image, reference: &Image) -> f64 {
     sum / (3 * a.pixels.len().max(1)) as f64
 }
 
-/// FNV-1a, 64 bits: a stable hash for cache keys and image fingerprints.
-pub fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
+pub use crate::render::pass::fnv1a;
 
 /// Largest absolute difference of any channel of any pixel.
 pub fn max_abs_error(a: &Image, reference: &Image) -> f64 {

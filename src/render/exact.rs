@@ -116,7 +116,15 @@ mod tests {
 
     #[test]
     fn small_sums_are_exact_and_order_free() {
-        let vals = [1.0f32, 1e-30, 3.5e30, 0.1, f32::MIN_POSITIVE / 8.0, 7.25, f32::MAX];
+        let vals = [
+            1.0f32,
+            1e-30,
+            3.5e30,
+            0.1,
+            f32::MIN_POSITIVE / 8.0,
+            7.25,
+            f32::MAX,
+        ];
         let mut fwd = ExactSum::default();
         vals.iter().for_each(|&v| fwd.add(v));
         let mut rev = ExactSum::default();

@@ -7,6 +7,7 @@ pub mod estimate;
 pub mod exact;
 pub mod film;
 pub mod output;
+pub mod pass;
 mod scene;
 
 pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};

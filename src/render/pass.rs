@@ -1,0 +1,353 @@
+//! Passes: a render split by sample index, rendered anywhere, merged bit-exactly.
+//!
+//! Pass `I` of `N` renders the sample indices `[I spp / N, (I + 1) spp / N)` of every pixel and
+//! keeps their exact sums ([`super::exact`]). A pass file is an OpenEXR image: channels `R`,
+//! `G`, `B` hold the mean of the samples it holds (to look at), and channels `sum.C.KK` (`C` in
+//! R, G, B; `KK` from 00 to 09) the exact sums as 32-bit words, least significant first. Its
+//! header records the scene's fingerprint, the seed, the full spp, the PNG transfer and the
+//! sample ranges it holds (`rtis.ranges`, e.g. `0..341,682..1024`).
+//!
+//! Merging adds the exact sums, which is exact and so independent of the order and grouping of
+//! the passes: the merged image has the bits of a single render of all the samples.
+
+use super::RenderScene;
+use super::exact::{RgbSum, WORDS};
+use super::film::Image;
+use super::output::{OutputError, Transfer};
+use exr::prelude::*;
+use std::ops::Range;
+use std::path::Path;
+
+/// FNV-1a, 64 bits: a stable hash for fingerprints and cache keys.
+pub fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// A hash of everything that decides a render's samples: camera, geometry, materials, lights,
+/// background, shader, model, effects and film size. Passes of one render share it.
+pub fn fingerprint(scene: &RenderScene) -> u64 {
+    let f = &scene.film;
+    let text = format!(
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}",
+        scene.camera,
+        scene.geometry.prims,
+        scene.materials,
+        scene.lights,
+        scene.background,
+        scene.shader,
+        scene.model,
+        scene.effects,
+        f.width,
+        f.height,
+    );
+    fnv1a(text.as_bytes())
+}
+
+/// Parse `I/N` (pass `I`, counting from 0, of `N`).
+pub fn parse_pass(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || format!("--pass {s}: write I/N, for example 0/4 (pass I of N, I from 0 to N-1)");
+    let (i, n) = s.split_once('/').ok_or_else(bad)?;
+    let (i, n): (u32, u32) = (
+        i.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if n == 0 || i >= n {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
+/// The sample indices of pass `i` of `n` for `spp` samples per pixel.
+pub fn pass_range(i: u32, n: u32, spp: u32) -> std::result::Result<Range<u32>, String> {
+    if n > spp {
+        return Err(format!(
+            "{n} passes of {spp} samples per pixel: at most {spp} passes (one sample each)"
+        ));
+    }
+    let at = |k: u32| (k as u64 * spp as u64 / n as u64) as u32;
+    Ok(at(i)..at(i + 1))
+}
+
+/// A pass, or several merged: exact per-pixel sums of some of a render's samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pass {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// The scene's [`fingerprint`].
+    pub fingerprint: u64,
+    /// The render's seed.
+    pub seed: u64,
+    /// Samples per pixel of the whole render.
+    pub spp: u32,
+    /// PNG transfer of the scene.
+    pub transfer: Transfer,
+    /// Sample ranges held, sorted, disjoint.
+    pub ranges: Vec<Range<u32>>,
+    /// Exact sums, row-major.
+    pub sums: Vec<RgbSum>,
+}
+
+fn show_ranges(r: &[Range<u32>]) -> String {
+    r.iter()
+        .map(|r| format!("{}..{}", r.start, r.end))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+fn parse_ranges(s: &str) -> Option<Vec<Range<u32>>> {
+    s.split(',')
+        .map(|r| {
+            let (a, b) = r.split_once("..")?;
+            let (a, b) = (a.parse().ok()?, b.parse().ok()?);
+            (a < b).then_some(a..b)
+        })
+        .collect()
+}
+
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+impl Pass {
+    /// Samples each pixel holds.
+    pub fn samples(&self) -> u64 {
+        self.ranges.iter().map(|r| (r.end - r.start) as u64).sum()
+    }
+
+    /// Whether the ranges cover every sample of the render.
+    pub fn is_complete(&self) -> bool {
+        self.ranges.len() == 1 && self.ranges[0] == (0..self.spp)
+    }
+
+    /// The image: each pixel's mean over the samples held (all of them when complete).
+    pub fn image(&self) -> Image {
+        let n = self.samples();
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels: self.sums.iter().map(|s| s.mean(n)).collect(),
+        }
+    }
+
+    /// The pass as OpenEXR bytes (see the module documentation).
+    pub fn to_exr(&self) -> std::result::Result<Vec<u8>, String> {
+        let size = (self.width as usize, self.height as usize);
+        let mean = self.image();
+        let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
+        for (c, name) in CHANNELS.iter().enumerate() {
+            let v = mean.pixels.iter().map(|p| p[c]).collect();
+            channels.push(AnyChannel::new(*name, FlatSamples::F32(v)));
+            for k in 0..2 * WORDS {
+                let words = self
+                    .sums
+                    .iter()
+                    .map(|s| (s.0[c].words[k / 2] >> (32 * (k % 2))) as u32)
+                    .collect();
+                channels.push(AnyChannel::new(
+                    format!("sum.{name}.{k:02}").as_str(),
+                    FlatSamples::U32(words),
+                ));
+            }
+        }
+        let mut attributes = LayerAttributes::named("rtis pass");
+        let mut put = |k: &str, v: String| {
+            attributes
+                .other
+                .insert(Text::from(k), AttributeValue::Text(Text::from(v.as_str())));
+        };
+        put("rtis.fingerprint", format!("{:016x}", self.fingerprint));
+        put("rtis.seed", self.seed.to_string());
+        put("rtis.spp", self.spp.to_string());
+        put("rtis.transfer", format!("{:?}", self.transfer));
+        put("rtis.ranges", show_ranges(&self.ranges));
+        let layer = Layer::new(
+            size,
+            attributes,
+            Encoding::SMALL_LOSSLESS,
+            AnyChannels::sort(channels.into()),
+        );
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        exr::prelude::Image::from_layer(layer)
+            .write()
+            .to_buffered(&mut bytes)
+            .map_err(|e| e.to_string())?;
+        Ok(bytes.into_inner())
+    }
+
+    /// Write the pass to `path` (an .exr name) through a temporary file and a rename.
+    pub fn write(&self, path: &Path) -> std::result::Result<(), OutputError> {
+        let bytes = self.to_exr().map_err(|reason| OutputError::Io {
+            path: path.display().to_string(),
+            reason,
+        })?;
+        super::output::write_file(path, &bytes)
+    }
+
+    /// Read a pass file written by [`Pass::write`].
+    pub fn read(path: &Path) -> std::result::Result<Pass, String> {
+        let at = |e: String| format!("{}: {e}", path.display());
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .from_file(path)
+            .map_err(|e| at(format!("cannot read pass: {e}")))?;
+        let layer = &image.layer_data;
+        let attr = |k: &str| -> std::result::Result<String, String> {
+            match layer.attributes.other.get(&Text::from(k)) {
+                Some(AttributeValue::Text(t)) => Ok(t.to_string()),
+                _ => Err(at(format!(
+                    "not an rtis pass: no `{k}` in its header (write passes with rtis render --pass)"
+                ))),
+            }
+        };
+        let number = |k: &str| -> std::result::Result<u64, String> {
+            attr(k)?
+                .parse::<u64>()
+                .map_err(|_| at(format!("`{k}` is not a number")))
+        };
+        let fingerprint = u64::from_str_radix(&attr("rtis.fingerprint")?, 16)
+            .map_err(|_| at("`rtis.fingerprint` is not a hash".into()))?;
+        let spp =
+            u32::try_from(number("rtis.spp")?).map_err(|_| at("`rtis.spp` too large".into()))?;
+        let transfer = match attr("rtis.transfer")?.as_str() {
+            "Linear" => Transfer::Linear,
+            _ => Transfer::Srgb,
+        };
+        let ranges = parse_ranges(&attr("rtis.ranges")?)
+            .filter(|r| r.iter().all(|r| r.end <= spp))
+            .ok_or_else(|| at("`rtis.ranges` is not a list of sample ranges within spp".into()))?;
+        let (w, h) = (layer.size.width(), layer.size.height());
+        let mut sums = vec![RgbSum::default(); w * h];
+        for (c, name) in CHANNELS.iter().enumerate() {
+            for k in 0..2 * WORDS {
+                let want = format!("sum.{name}.{k:02}");
+                let ch = layer
+                    .channel_data
+                    .list
+                    .iter()
+                    .find(|ch| ch.name.to_string() == want)
+                    .ok_or_else(|| at(format!("not an rtis pass: no channel {want}")))?;
+                let FlatSamples::U32(words) = &ch.sample_data else {
+                    return Err(at(format!("channel {want} is not 32-bit integer")));
+                };
+                for (s, &word) in sums.iter_mut().zip(words) {
+                    s.0[c].words[k / 2] |= (word as u64) << (32 * (k % 2));
+                }
+            }
+        }
+        Ok(Pass {
+            width: w as u32,
+            height: h as u32,
+            fingerprint,
+            seed: number("rtis.seed")?,
+            spp,
+            transfer,
+            ranges,
+            sums,
+        })
+    }
+
+    /// Merge passes named by their files: they must come from one scene and seed and hold
+    /// disjoint sample ranges; unless `partial`, together they must hold every sample.
+    pub fn merge(parts: Vec<(String, Pass)>) -> std::result::Result<Pass, String> {
+        let mut it = parts.into_iter();
+        let (first_name, mut acc) = it.next().ok_or("no passes to merge")?;
+        let mut owner: Vec<(Range<u32>, String)> = acc
+            .ranges
+            .iter()
+            .map(|r| (r.clone(), first_name.clone()))
+            .collect();
+        for (name, p) in it {
+            let differ = |what: &str, a: String, b: String| {
+                Err(format!(
+                    "{first_name} and {name} are passes of different renders: {what} {a} and {b}"
+                ))
+            };
+            if (p.width, p.height) != (acc.width, acc.height) {
+                return differ(
+                    "sizes",
+                    format!("{}x{}", acc.width, acc.height),
+                    format!("{}x{}", p.width, p.height),
+                );
+            }
+            if p.fingerprint != acc.fingerprint {
+                return differ(
+                    "scene fingerprints",
+                    format!("{:016x}", acc.fingerprint),
+                    format!("{:016x}", p.fingerprint),
+                );
+            }
+            if p.seed != acc.seed {
+                return differ("seeds", acc.seed.to_string(), p.seed.to_string());
+            }
+            if p.spp != acc.spp {
+                return differ("spp", acc.spp.to_string(), p.spp.to_string());
+            }
+            for (a, b) in acc.sums.iter_mut().zip(&p.sums) {
+                *a += *b;
+            }
+            owner.extend(p.ranges.iter().map(|r| (r.clone(), name.clone())));
+        }
+        owner.sort_by_key(|(r, _)| (r.start, r.end));
+        for w in owner.windows(2) {
+            let ((a, fa), (b, fb)) = (&w[0], &w[1]);
+            if b.start < a.end {
+                return Err(format!(
+                    "samples {}..{} are in both {fa} and {fb}: each sample range must be merged once",
+                    b.start,
+                    a.end.min(b.end)
+                ));
+            }
+        }
+        // Join adjacent ranges.
+        let mut ranges: Vec<Range<u32>> = Vec::new();
+        for (r, _) in owner {
+            match ranges.last_mut() {
+                Some(last) if last.end == r.start => last.end = r.end,
+                _ => ranges.push(r),
+            }
+        }
+        acc.ranges = ranges;
+        Ok(acc)
+    }
+
+    /// The sample ranges of the render this pass does not hold.
+    pub fn missing(&self) -> Vec<Range<u32>> {
+        let mut gaps = Vec::new();
+        let mut at = 0;
+        for r in &self.ranges {
+            if r.start > at {
+                gaps.push(at..r.start);
+            }
+            at = r.end;
+        }
+        if at < self.spp {
+            gaps.push(at..self.spp);
+        }
+        gaps
+    }
+
+    /// A pass from the exact sums a render of `samples` made.
+    pub fn from_render(scene: &RenderScene, samples: Range<u32>, sums: Vec<RgbSum>) -> Pass {
+        Pass {
+            width: scene.film.width,
+            height: scene.film.height,
+            fingerprint: fingerprint(scene),
+            seed: scene.seed,
+            spp: scene.film.spp,
+            transfer: scene.film.transfer,
+            ranges: vec![samples],
+            sums,
+        }
+    }
+}
+
+/// The missing ranges as text, for messages.
+pub fn describe_missing(p: &Pass) -> String {
+    show_ranges(&p.missing())
+}
