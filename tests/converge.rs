@@ -46,7 +46,8 @@ fn course_ladder_sweeps_and_path_converges() {
         &|| {},
     )
     .image;
-    let rows = converge::sweep(&s, &reference, &rungs, 1, &mut |_| {});
+    let measured = converge::sweep(&s, &reference, 0.0, &rungs, 1, 4, &mut |_| {});
+    let rows: Vec<converge::Row> = measured.iter().map(|m| m.row.clone()).collect();
     let err = |fam: &str, label: &str| {
         rows.iter()
             .find(|r| r.family == fam && r.label == label)
@@ -61,7 +62,34 @@ fn course_ladder_sweeps_and_path_converges() {
     // factor 2 of n = 16 while Path gains a factor 2 from 16 to 64 spp.
     assert!(err("Global D=2", "n=64") > 0.5 * err("Global D=2", "n=16"));
     let csv = converge::to_csv(&rows);
-    assert!(csv.starts_with("family,setting,seconds,rays,rmse,rel_mse\n"));
+    assert!(
+        csv.starts_with("family,setting,seconds,rays,rmse,rel_mse,flip,seeds,variance,bias2\n")
+    );
+    // Bias and variance: Path is unbiased, so at 64 spp its bias^2 is within noise of zero
+    // (below a tenth of the Global shader's); the Global shader's error is mostly bias.
+    let row = |fam: &str, label: &str| {
+        rows.iter()
+            .find(|r| r.family == fam && r.label == label)
+            .unwrap()
+    };
+    let (g, p) = (row("Global D=2", "n=64"), row("Path", "spp=64"));
+    assert!(g.bias2 > 2.0 * g.variance, "{g:?}");
+    assert!(p.bias2.abs() < 0.1 * g.bias2, "{p:?} {g:?}");
+    // The report holds every rung, the plot and the reference.
+    let effects = converge::effect_prices(&s, &reference, 1);
+    assert_eq!(effects[0].effect, "");
+    assert!(effects.iter().any(|e| e.effect == "shadows"));
+    let html = converge::report::html(&converge::report::Report {
+        title: "test".into(),
+        reference: &reference,
+        reference_note: "a note".into(),
+        rungs: &measured,
+        effects: &effects,
+        transfer: Default::default(),
+    });
+    assert_eq!(html.matches("<circle class=\"pt\"").count(), rows.len());
+    assert!(html.contains("id=\"slider\"") && html.contains("a note"));
+    assert!(!html.contains("src=\"http") && !html.contains("href=\"http"));
     assert_eq!(csv.lines().count(), rows.len() + 1);
     let dir = std::env::temp_dir().join(format!("rtis-conv-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -122,4 +150,28 @@ fn reference_streams_are_independent_of_the_rungs() {
         rung.pixels.len()
     );
     assert!(converge::metrics::rmse(&rung, &reference) > 0.0);
+}
+
+/// Variance and bias of known images: 0.5 and 0.7 against 0.5 have per-pixel variance 0.02
+/// (with K - 1 = 1) and a mean 0.1 away from the reference.
+#[test]
+fn variance_and_bias_of_known_images() {
+    let img = |v: f32| Image {
+        width: 2,
+        height: 1,
+        pixels: vec![glam::Vec3A::splat(v); 2],
+    };
+    let (var, mse) = converge::metrics::variance_and_mse_of_mean(&[img(0.5), img(0.7)], &img(0.5));
+    assert!((var - 0.02).abs() < 1e-7, "{var}");
+    assert!((mse - 0.01).abs() < 1e-7, "{mse}");
+}
+
+#[test]
+fn base64_matches_the_standard() {
+    use converge::report::base64;
+    assert_eq!(base64(b""), "");
+    assert_eq!(base64(b"f"), "Zg==");
+    assert_eq!(base64(b"fo"), "Zm8=");
+    assert_eq!(base64(b"foo"), "Zm9v");
+    assert_eq!(base64(b"foobar"), "Zm9vYmFy");
 }

@@ -117,21 +117,16 @@ fn effects_section(
                 ""
             )
         });
-        for (effect, on) in full.effects.named().into_iter().take(6) {
+        for (effect, on) in full
+            .effects
+            .named()
+            .into_iter()
+            .take(rtis::converge::TRANSPORT_EFFECTS)
+        {
             if !on {
                 continue;
             }
-            let mut off = full.clone();
-            let mut effects = full.effects;
-            match effect {
-                "shadows" => effects.shadows = false,
-                "reflection" => effects.reflection = false,
-                "refraction" => effects.refraction = false,
-                "indirect" => effects.indirect = false,
-                "ambient" => effects.ambient = false,
-                _ => effects.background = false,
-            }
-            off.set_effects(effects);
+            let off = rtis::converge::effect_off(&full, effect);
             let (t, st) = median_seconds(&off, runs);
             let img = render(&off, &|| {}).image;
             let rmse = rtis::converge::metrics::rmse(&img, &reference);

@@ -2,7 +2,8 @@
 
 use super::{CliError, load};
 use clap::Args;
-use rtis::converge::{self, plot};
+use rtis::converge::{self, plot, report};
+use rtis::render::pass::Pass;
 use rtis::render::{self, output};
 use std::path::PathBuf;
 
@@ -14,8 +15,9 @@ pub struct ConvergeArgs {
     /// A reference image (linear EXR of the same size) instead of rendering one.
     #[arg(long, conflicts_with = "reference_spp")]
     reference: Option<PathBuf>,
-    /// Samples per pixel of the rendered reference (Path, unbounded depth, the scene's model).
-    #[arg(long, default_value_t = 1024)]
+    /// Samples per pixel of the rendered reference (Path, unbounded depth, the scene's model;
+    /// at least 2: its two halves measure its noise).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(2..=1048576))]
     reference_spp: u32,
     /// Output folder for converge.csv, converge.md, converge.png and the reference.
     #[arg(long, default_value = "converge")]
@@ -26,6 +28,9 @@ pub struct ConvergeArgs {
     /// Height (default: from the width and the scene's aspect ratio).
     #[arg(long, allow_negative_numbers = true, value_parser = super::render::side())]
     height: Option<u32>,
+    /// Independent seeds per rung, at least 1 (2 or more for bias and variance).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+    seeds: u32,
     /// Renders per rung, at least 1; the median time is reported.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
     runs: u32,
@@ -41,14 +46,11 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
     film.width = a.width;
     film.height = height;
     *film = film.checked()?;
-    if a.reference_spp == 0 {
-        return Err("--reference-spp must be at least 1".into());
-    }
     std::fs::create_dir_all(&a.out)
         .map_err(|e| format!("{}: cannot create output folder: {e}", a.out.display()))?;
     let prepared = rtis::extract(&scene);
 
-    let reference = match &a.reference {
+    let (reference, reference_noise, mut note) = match &a.reference {
         Some(path) => {
             let img = output::load(path)?;
             if (img.width, img.height) != (prepared.film.width, prepared.film.height) {
@@ -62,51 +64,105 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
                 )
                 .into());
             }
-            img
+            let note = format!("{} (given; its noise is unknown)", path.display());
+            (img, 0.0, note)
         }
         None => {
-            let key = converge::reference_key(&prepared, a.reference_spp);
-            let cached = a.out.join(format!("reference-{key:016x}.exr"));
-            match output::load(&cached) {
-                Ok(img) => {
-                    eprintln!("reference: reusing {}", cached.display());
-                    img
+            let spp = a.reference_spp;
+            let key = converge::reference_key(&prepared, spp);
+            let halves = [0, 1].map(|h| a.out.join(format!("reference-{key:016x}.half{h}.exr")));
+            let cached = halves
+                .iter()
+                .map(|p| Pass::read(p))
+                .collect::<Result<Vec<_>, _>>();
+            let parts = match cached {
+                Ok(parts) => {
+                    eprintln!("reference: reusing {}", halves[0].display());
+                    parts
                 }
                 Err(_) => {
                     eprintln!(
-                        "reference: Path, {:?} model, {} spp at {}x{}...",
-                        prepared.model, a.reference_spp, prepared.film.width, prepared.film.height
+                        "reference: Path, {:?} model, {spp} spp at {}x{}, in two halves...",
+                        prepared.model, prepared.film.width, prepared.film.height
                     );
-                    let s = converge::reference_scene(&prepared, a.reference_spp);
-                    let r = render::render(&s, &|| {});
-                    eprintln!(
-                        "reference: {:.1} s, {:.1} Mrays/s",
-                        r.seconds,
-                        r.mrays_per_second()
-                    );
-                    output::save(&r.image, &cached, Default::default())?;
-                    r.image
+                    let mut parts = Vec::new();
+                    for (h, n) in [spp / 2, spp - spp / 2].into_iter().enumerate() {
+                        let s = converge::reference_half(&prepared, n, h as u64);
+                        let stop = std::sync::atomic::AtomicBool::new(false);
+                        let sums = render::render_pass(&s, 0..n, &|| {}, &stop);
+                        let p = Pass::from_render(&s, 0..n, sums.pixels);
+                        p.write(&halves[h])?;
+                        parts.push(p);
+                    }
+                    parts
                 }
+            };
+            // Two independent renders of the whole pixel footprint (a range of sample indices
+            // would cover only part of it under stratification): var(a - b) = s^2 (1/na +
+            // 1/nb), and the reference, their exact pooled mean, has noise variance s^2 / spp.
+            let (ha, hb) = (parts[0].image(), parts[1].image());
+            let (na, nb) = (parts[0].samples() as f64, parts[1].samples() as f64);
+            let diff = converge::metrics::rmse(&ha, &hb).powi(2);
+            let noise = diff / ((1.0 / na + 1.0 / nb) * spp as f64);
+            let mut pooled = parts[0].sums.clone();
+            for (a, b) in pooled.iter_mut().zip(&parts[1].sums) {
+                *a += *b;
             }
+            let reference = rtis::render::film::Image {
+                width: ha.width,
+                height: ha.height,
+                pixels: pooled.iter().map(|p| p.mean(spp as u64)).collect(),
+            };
+            let note = format!(
+                "Path, unbounded depth, {:?} model, {spp} spp; its own noise (from its two \
+                 independent halves) RMSE {:.5}",
+                prepared.model,
+                noise.sqrt()
+            );
+            (reference, noise, note)
         }
     };
     output::save(&reference, &a.out.join("reference.exr"), Default::default())?;
 
     let rungs = converge::ladder(&prepared);
     eprintln!(
-        "{:<16} {:<10} {:>9} {:>10} {:>9}",
-        "family", "setting", "seconds", "Mrays", "RMSE"
+        "{:<16} {:<10} {:>9} {:>10} {:>9} {:>9}",
+        "family", "setting", "seconds", "Mrays", "RMSE", "FLIP"
     );
-    let rows = converge::sweep(&prepared, &reference, &rungs, a.runs as usize, &mut |r| {
-        eprintln!(
-            "{:<16} {:<10} {:>9.3} {:>10.1} {:>9.5}",
-            r.family,
-            r.label,
-            r.seconds,
-            r.rays as f64 / 1e6,
-            r.rmse
-        )
-    });
+    let measured = converge::sweep(
+        &prepared,
+        &reference,
+        reference_noise,
+        &rungs,
+        a.runs as usize,
+        a.seeds,
+        &mut |r| {
+            eprintln!(
+                "{:<16} {:<10} {:>9.3} {:>10.1} {:>9.5} {:>9.4}",
+                r.family,
+                r.label,
+                r.seconds,
+                r.rays as f64 / 1e6,
+                r.rmse,
+                r.flip
+            )
+        },
+    );
+    let rows: Vec<converge::Row> = measured.iter().map(|m| m.row.clone()).collect();
+    // Say so when the reference's noise is not small against the errors measured.
+    let smallest = rows.iter().map(|r| r.rmse).fold(f64::MAX, f64::min);
+    if reference_noise.sqrt() > 0.3 * smallest {
+        let warning = format!(
+            "the reference's own noise (RMSE {:.5}) is not small against the smallest error \
+             measured ({smallest:.5}): the smallest errors are overestimated; raise \
+             --reference-spp",
+            reference_noise.sqrt()
+        );
+        eprintln!("warning: {warning}");
+        note = format!("{note}. <strong class=\"note\">Warning: {warning}.</strong>");
+    }
+    eprintln!("the price of each effect of the scene's own shader...");
+    let effects = converge::effect_prices(&prepared, &reference, a.runs as usize);
     let write = |name: &str, text: String| output::write_file(&a.out.join(name), text.as_bytes());
     write("converge.csv", converge::to_csv(&rows))?;
     write("converge.md", converge::to_markdown(&rows, prepared.model))?;
@@ -114,16 +170,22 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
         || "cornell.ron".into(),
         |n| n.to_string_lossy().into_owned(),
     );
-    plot::plot(
-        &rows,
-        &format!(
-            "{name}: error vs time, {}x{}, {:?} model",
-            prepared.film.width, prepared.film.height, prepared.model
-        ),
-        &a.out.join("converge.png"),
-    )?;
+    let title = format!(
+        "{name}: error vs time, {}x{}, {:?} model",
+        prepared.film.width, prepared.film.height, prepared.model
+    );
+    plot::plot(&rows, &title, &a.out.join("converge.png"))?;
+    let html = report::html(&report::Report {
+        title,
+        reference: &reference,
+        reference_note: note,
+        rungs: &measured,
+        effects: &effects,
+        transfer: prepared.film.transfer,
+    });
+    write("report.html", html)?;
     eprintln!(
-        "wrote {}/converge.csv, converge.md, converge.png, reference.exr",
+        "wrote {}/converge.csv, converge.md, converge.png, report.html, reference.exr",
         a.out.display()
     );
     Ok(())

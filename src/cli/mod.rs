@@ -7,6 +7,7 @@ mod diff;
 pub mod interrupt;
 mod merge;
 mod render;
+mod warptest;
 
 use clap::{Parser, Subcommand};
 use rtis::scene::{self, Scene, SceneError};
@@ -35,6 +36,8 @@ enum Command {
     Merge(merge::MergeArgs),
     /// Measure error against time for a ladder of shader settings (CSV, table, plot).
     Converge(converge::ConvergeArgs),
+    /// Test every sampler against its pdf (chi-squared), with a page of histograms.
+    Warptest(warptest::WarptestArgs),
     /// Print speed figures: the course's Cornell box under each shader (seconds, Mrays/s, own
     /// peak memory), the price of each effect, and BVH build and ray rates for meshes.
     Bench(bench::BenchArgs),
@@ -56,6 +59,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Converge(args) => converge::run(args),
         Command::Diff(args) => diff::run(args),
         Command::Merge(args) => merge::run(args),
+        Command::Warptest(args) => warptest::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

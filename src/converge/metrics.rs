@@ -75,3 +75,45 @@ pub fn flip(test: &Image, reference: &Image) -> Flip {
     let enc = |i: &Image| crate::render::output::to_rgb8(i, crate::render::output::Transfer::Srgb);
     flip_rgb8(&enc(test), &enc(reference))
 }
+
+/// Over images of one scene rendered with independent seeds: the variance (mean over pixels and
+/// channels of the unbiased per-pixel variance across the images) and the MSE of their
+/// per-pixel mean against `reference`.
+pub fn variance_and_mse_of_mean(images: &[Image], reference: &Image) -> (f64, f64) {
+    let k = images.len().max(1) as f64;
+    let (mut var, mut mse) = (0.0f64, 0.0f64);
+    for (i, r) in reference.pixels.iter().enumerate() {
+        let r = r.as_dvec3();
+        let mean = images
+            .iter()
+            .map(|im| im.pixels[i].as_dvec3())
+            .sum::<glam::DVec3>()
+            / k;
+        if images.len() > 1 {
+            let ss: glam::DVec3 = images
+                .iter()
+                .map(|im| {
+                    let d = im.pixels[i].as_dvec3() - mean;
+                    d * d
+                })
+                .sum();
+            var += (ss / (k - 1.0)).element_sum();
+        }
+        let d = mean - r;
+        mse += d.dot(d);
+    }
+    let n = (3 * reference.pixels.len().max(1)) as f64;
+    (var / n, mse / n)
+}
+
+/// Per-pixel relative squared error `(x - r)^2 / (r^2 + 0.01)`, averaged over channels.
+pub fn rel_se_map(a: &Image, reference: &Image) -> Vec<f32> {
+    a.pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(p, r)| {
+            let (p, r) = (p.as_dvec3(), r.as_dvec3());
+            ((p - r) * (p - r) / (r * r + 0.01)).element_sum() as f32 / 3.0
+        })
+        .collect()
+}

@@ -3,6 +3,8 @@
 
 pub mod metrics;
 pub mod plot;
+pub mod report;
+pub mod warptest;
 
 use crate::material::Model;
 use crate::render::{RenderScene, film::Image, render};
@@ -34,10 +36,21 @@ pub struct Row {
     pub seconds: f64,
     /// Rays traced by one render.
     pub rays: u64,
-    /// Root mean squared error against the reference (linear RGB, all channels).
+    /// Root mean squared error against the reference (linear RGB, all channels), over the
+    /// seeds (the square root of their mean MSE).
     pub rmse: f64,
-    /// Relative MSE: mean of `(x - r)^2 / (r^2 + 0.01)`.
+    /// Relative MSE: mean of `(x - r)^2 / (r^2 + 0.01)`, first seed.
     pub rel_mse: f64,
+    /// Mean FLIP against the reference, first seed.
+    pub flip: f64,
+    /// Independent seeds rendered.
+    pub seeds: u32,
+    /// Variance: the mean over pixels and channels of the per-pixel variance across seeds.
+    pub variance: f64,
+    /// Squared bias: the MSE of the seed mean against the reference, less `variance / seeds`
+    /// and less the reference's own noise variance (an unbiased estimate: it can dip below
+    /// zero by noise when the bias is small).
+    pub bias2: f64,
 }
 
 /// The reference integrator for a scene: an unbounded path tracer under the scene's model.
@@ -136,10 +149,20 @@ pub fn reference_scene(scene: &RenderScene, spp: u32) -> RenderScene {
     }
 }
 
+/// Half `h` (0 or 1) of the reference: `spp` samples of its own independent seed. The two
+/// halves cover the whole pixel footprint each, so their difference measures the reference's
+/// noise; their pooled mean is the reference.
+pub fn reference_half(scene: &RenderScene, spp: u32, h: u64) -> RenderScene {
+    RenderScene {
+        seed: reference_seed(scene.seed ^ h.wrapping_mul(0x9e37_79b9_7f4a_7c15)),
+        ..with_settings(scene, reference_shader(), spp)
+    }
+}
+
 /// A key that changes whenever anything that affects the reference image changes.
 pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
     let text = format!(
-        "reference v2 (own seed)|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
+        "reference v3 (two independent halves)|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
         scene.camera,
         scene.geometry.prims,
         scene.materials,
@@ -154,14 +177,27 @@ pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
     metrics::fnv1a(text.as_bytes())
 }
 
-/// Time and measure every rung: median of `runs` renders, error of the first.
+/// A measured rung: its row and the image of its first seed.
+#[derive(Clone, Debug)]
+pub struct Measured {
+    /// The figures.
+    pub row: Row,
+    /// The first seed's image.
+    pub image: Image,
+}
+
+/// Time and measure every rung: `seeds` independent renders (seeds `scene.seed + k`), the
+/// first timed as the median of `runs`. `reference_noise` is the reference's own noise
+/// variance per pixel and channel, removed from the bias estimate.
 pub fn sweep(
     scene: &RenderScene,
     reference: &Image,
+    reference_noise: f64,
     rungs: &[Rung],
     runs: usize,
+    seeds: u32,
     on_rung: &mut dyn FnMut(&Row),
-) -> Vec<Row> {
+) -> Vec<Measured> {
     rungs
         .iter()
         .map(|r| {
@@ -175,28 +211,60 @@ pub fn sweep(
             }
             times.sort_by(f64::total_cmp);
             let out = first.expect("at least one run");
+            let mut images = vec![out.image.clone()];
+            for k in 1..seeds.max(1) {
+                let other = RenderScene {
+                    seed: scene.seed.wrapping_add(k as u64),
+                    ..s.clone()
+                };
+                images.push(render(&other, &|| {}).image);
+            }
+            let (variance, mse_of_mean) = metrics::variance_and_mse_of_mean(&images, reference);
+            let k = images.len() as f64;
+            let mean_mse = images
+                .iter()
+                .map(|i| metrics::rmse(i, reference).powi(2))
+                .sum::<f64>()
+                / k;
             let row = Row {
                 family: r.family.clone(),
                 label: r.label.clone(),
                 seconds: times[times.len() / 2],
                 rays: out.stats.total(),
-                rmse: metrics::rmse(&out.image, reference),
+                rmse: mean_mse.sqrt(),
                 rel_mse: metrics::rel_mse(&out.image, reference),
+                flip: metrics::flip(&out.image, reference).mean,
+                seeds: images.len() as u32,
+                variance,
+                bias2: mse_of_mean - variance / k - reference_noise,
             };
             on_rung(&row);
-            row
+            Measured {
+                row,
+                image: out.image,
+            }
         })
         .collect()
 }
 
 /// The rows as CSV.
 pub fn to_csv(rows: &[Row]) -> String {
-    let mut s = String::from("family,setting,seconds,rays,rmse,rel_mse\n");
+    let mut s =
+        String::from("family,setting,seconds,rays,rmse,rel_mse,flip,seeds,variance,bias2\n");
     for r in rows {
         let _ = writeln!(
             s,
-            "{},{},{:.4},{},{:.6},{:.6}",
-            r.family, r.label, r.seconds, r.rays, r.rmse, r.rel_mse
+            "{},{},{:.4},{},{:.6},{:.6},{:.6},{},{:.3e},{:.3e}",
+            r.family,
+            r.label,
+            r.seconds,
+            r.rays,
+            r.rmse,
+            r.rel_mse,
+            r.flip,
+            r.seeds,
+            r.variance,
+            r.bias2
         );
     }
     s
@@ -204,21 +272,75 @@ pub fn to_csv(rows: &[Row]) -> String {
 
 /// The rows as a Markdown table.
 pub fn to_markdown(rows: &[Row], model: Model) -> String {
+    let seeds = rows.first().map_or(1, |r| r.seeds);
     let mut s = format!(
-        "Error against the {model:?}-model reference (Path, unbounded depth).\n\n\
-         | family | setting | seconds | Mrays | RMSE | relMSE |\n|---|---|---|---|---|---|\n"
+        "Error against the {model:?}-model reference (Path, unbounded depth); RMSE over {seeds} \
+         seeds, bias^2 and variance from their spread.\n\n\
+         | family | setting | seconds | Mrays | RMSE | relMSE | FLIP | bias^2 | variance |\n\
+         |---|---|---|---|---|---|---|---|---|\n"
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.3} | {:.1} | {:.4} | {:.4} |",
+            "| {} | {} | {:.3} | {:.1} | {:.4} | {:.4} | {:.4} | {:.2e} | {:.2e} |",
             r.family,
             r.label,
             r.seconds,
             r.rays as f64 / 1e6,
             r.rmse,
-            r.rel_mse
+            r.rel_mse,
+            r.flip,
+            r.bias2,
+            r.variance
         );
     }
     s
+}
+
+/// The light-transport effects a scene can switch off (the first six of `Effects::named`).
+pub const TRANSPORT_EFFECTS: usize = 6;
+
+/// `scene` with the transport effect `effect` (a name of `Effects::named`) switched off.
+pub fn effect_off(scene: &RenderScene, effect: &str) -> RenderScene {
+    let mut off = scene.clone();
+    let mut e = scene.effects;
+    match effect {
+        "shadows" => e.shadows = false,
+        "reflection" => e.reflection = false,
+        "refraction" => e.refraction = false,
+        "indirect" => e.indirect = false,
+        "ambient" => e.ambient = false,
+        "background" => e.background = false,
+        _ => {}
+    }
+    off.set_effects(e);
+    off
+}
+
+/// The price of each effect `scene` simulates: the render with all of them, then with each
+/// switched off in turn (median seconds of `runs`), each measured against `reference`.
+pub fn effect_prices(
+    scene: &RenderScene,
+    reference: &Image,
+    runs: usize,
+) -> Vec<report::EffectPrice> {
+    let measure = |name: &str, s: &RenderScene| {
+        let mut outs: Vec<_> = (0..runs.max(1)).map(|_| render(s, &|| {})).collect();
+        outs.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
+        let out = &outs[outs.len() / 2];
+        report::EffectPrice {
+            effect: name.into(),
+            seconds: out.seconds,
+            rays: out.stats.total(),
+            rmse: metrics::rmse(&out.image, reference),
+            flip: metrics::flip(&out.image, reference).mean,
+        }
+    };
+    let mut prices = vec![measure("", scene)];
+    for (name, on) in scene.effects.named().into_iter().take(TRANSPORT_EFFECTS) {
+        if on {
+            prices.push(measure(name, &effect_off(scene, name)));
+        }
+    }
+    prices
 }

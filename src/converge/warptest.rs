@@ -1,0 +1,370 @@
+//! `rtis warptest`: every direction sampler against its pdf, as Nori's warptest and Mitsuba's
+//! `ChiSquareTest` do it.
+//!
+//! For each sampler: draw `n` directions and bin them on the sphere (`z` and `phi` in equal
+//! steps, so every bin has the same solid angle); integrate the pdf over the same bins (a
+//! midpoint rule on a finer grid); pool bins whose expected count is below 5; and run Pearson's
+//! chi-squared test. The null hypothesis, that the samples follow the pdf, is rejected when the
+//! p-value is below the significance level (0.01, Sidak-corrected for the number of tests).
+//! The discrete Fresnel choice of Physical glass (reflect with probability `F`) is tested the
+//! same way over its two outcomes.
+
+use crate::geometry::Frame;
+use crate::material::{Phong, fresnel_dielectric, reflect};
+use crate::sampling::{Sampler, Sampling, hemisphere};
+use crate::shader::path;
+use glam::Vec3A;
+use std::f64::consts::PI;
+use std::fmt::Write;
+
+/// Bins in `z` (cosine of the polar angle, from -1 to 1).
+pub const BINS_Z: usize = 20;
+/// Bins in `phi`.
+pub const BINS_PHI: usize = 40;
+/// Significance level of the whole set of tests.
+pub const ALPHA: f64 = 0.01;
+
+/// Draws one outcome from the random numbers: a bin index, or `None` for a sample the
+/// integrator rejects (below the surface).
+pub type Draw = Box<dyn Fn(&mut Sampler) -> Option<usize>>;
+
+/// A sampler under test: how it draws, and the pdf it claims.
+pub struct Case {
+    /// Its name.
+    pub name: String,
+    /// How it draws.
+    pub draw: Draw,
+    /// The probability the pdf gives to each bin (summing to at most 1).
+    pub expected: Vec<f64>,
+    /// Bins per row for the histogram pages (`BINS_PHI` for directions, 2 for Fresnel).
+    pub columns: usize,
+}
+
+/// The result of one chi-squared test.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The sampler's name.
+    pub name: String,
+    /// Observed counts per bin.
+    pub observed: Vec<f64>,
+    /// Expected counts per bin.
+    pub expected: Vec<f64>,
+    /// Bins per row.
+    pub columns: usize,
+    /// Pearson's statistic.
+    pub chi2: f64,
+    /// Degrees of freedom (pooled bins, less one).
+    pub dof: usize,
+    /// P-value: the probability of a statistic this large if the sampler follows its pdf.
+    pub p_value: f64,
+}
+
+/// The bin of a unit direction on the `BINS_Z x BINS_PHI` grid.
+pub fn direction_bin(w: Vec3A) -> usize {
+    let t = (((w.z + 1.0) * 0.5 * BINS_Z as f32) as usize).min(BINS_Z - 1);
+    let phi = w.y.atan2(w.x).rem_euclid(std::f32::consts::TAU);
+    let p = ((phi / std::f32::consts::TAU * BINS_PHI as f32) as usize).min(BINS_PHI - 1);
+    t * BINS_PHI + p
+}
+
+/// The probability of each bin under a pdf over directions (per steradian), by the midpoint
+/// rule on 64 x 8 points per bin (`z` finer: lobes around the pole vary fastest in `z`).
+pub fn integrate_pdf(pdf: impl Fn(Vec3A) -> f64) -> Vec<f64> {
+    let (sub_z, sub_phi) = (64, 8);
+    let area = (2.0 / BINS_Z as f64) * (2.0 * PI / BINS_PHI as f64);
+    let mut out = vec![0.0; BINS_Z * BINS_PHI];
+    for t in 0..BINS_Z {
+        for p in 0..BINS_PHI {
+            let mut acc = 0.0;
+            for a in 0..sub_z {
+                for b in 0..sub_phi {
+                    let z =
+                        -1.0 + 2.0 * (t as f64 + (a as f64 + 0.5) / sub_z as f64) / BINS_Z as f64;
+                    let phi =
+                        2.0 * PI * (p as f64 + (b as f64 + 0.5) / sub_phi as f64) / BINS_PHI as f64;
+                    let r = (1.0 - z * z).max(0.0).sqrt();
+                    acc += pdf(Vec3A::new(
+                        (r * phi.cos()) as f32,
+                        (r * phi.sin()) as f32,
+                        z as f32,
+                    ));
+                }
+            }
+            out[t * BINS_PHI + p] = acc / (sub_z * sub_phi) as f64 * area;
+        }
+    }
+    out
+}
+
+/// A direction sampler with the pdf of `path::pdf` for `sampling` (normal +z).
+fn direction_case(name: &str, phong: Phong, wo: Vec3A, sampling: Sampling) -> Case {
+    let n = Vec3A::Z;
+    let expected = integrate_pdf(|wi| path::pdf(&phong, wo, n, wi, sampling) as f64);
+    Case {
+        name: name.into(),
+        draw: Box::new(move |s: &mut Sampler| {
+            let (u1, u2) = s.next_2d();
+            let wi = match sampling {
+                Sampling::Uniform => hemisphere::uniform(u1, u2),
+                Sampling::Cosine => hemisphere::cosine(u1, u2),
+                Sampling::Brdf => {
+                    if s.next_f32() < path::diffuse_probability(&phong) {
+                        hemisphere::cosine(u1, u2)
+                    } else {
+                        Frame::from_normal(reflect(wo, n)).to_world(hemisphere::phong_lobe(
+                            u1,
+                            u2,
+                            phong.shininess,
+                        ))
+                    }
+                }
+            };
+            (wi.dot(n) > 0.0).then(|| direction_bin(wi))
+        }),
+        expected,
+        columns: BINS_PHI,
+    }
+}
+
+/// The Phong lobe alone around +z, exponent `s`, against `hemisphere::phong_lobe_pdf`.
+fn lobe_case(s: f32) -> Case {
+    Case {
+        name: format!("Phong lobe, s = {s}"),
+        draw: Box::new(move |r: &mut Sampler| {
+            let (u1, u2) = r.next_2d();
+            Some(direction_bin(hemisphere::phong_lobe(u1, u2, s)))
+        }),
+        expected: integrate_pdf(|w| hemisphere::phong_lobe_pdf(w.z, s) as f64),
+        columns: BINS_PHI,
+    }
+}
+
+/// The Fresnel choice: reflect with probability `F(cos_i, eta)`, refract otherwise.
+fn fresnel_case(cos_i: f32, eta: f32) -> Case {
+    let f = fresnel_dielectric(cos_i, eta) as f64;
+    Case {
+        name: format!("Fresnel choice, cos {cos_i}, eta {eta} (F = {f:.4})"),
+        draw: Box::new(move |s: &mut Sampler| {
+            Some(usize::from(s.next_f32() >= fresnel_dielectric(cos_i, eta)))
+        }),
+        expected: vec![f, 1.0 - f],
+        columns: 2,
+    }
+}
+
+/// Every sampler rtis uses: uniform and cosine hemisphere, the Phong lobe at three exponents,
+/// the BRDF mixture of Path at two materials and views, and the Fresnel choice of glass.
+pub fn cases() -> Vec<Case> {
+    let white = Phong {
+        kd: Vec3A::ONE,
+        ks: Vec3A::ZERO,
+        shininess: 1.0,
+    };
+    vec![
+        direction_case("uniform hemisphere", white, Vec3A::Z, Sampling::Uniform),
+        direction_case("cosine hemisphere", white, Vec3A::Z, Sampling::Cosine),
+        lobe_case(1.0),
+        lobe_case(10.0),
+        lobe_case(100.0),
+        direction_case(
+            "BRDF mixture, kd 0.5, ks 0.5, s = 10",
+            Phong {
+                kd: Vec3A::splat(0.5),
+                ks: Vec3A::splat(0.5),
+                shininess: 10.0,
+            },
+            Vec3A::new(0.6, 0.0, 0.8).normalize(),
+            Sampling::Brdf,
+        ),
+        direction_case(
+            "BRDF mixture, kd 0.1, ks 0.8, s = 60, grazing",
+            Phong {
+                kd: Vec3A::splat(0.1),
+                ks: Vec3A::splat(0.8),
+                shininess: 60.0,
+            },
+            Vec3A::new(0.0, -0.9, 0.436).normalize(),
+            Sampling::Brdf,
+        ),
+        fresnel_case(1.0, 1.0 / 1.5),
+        fresnel_case(0.2, 1.0 / 1.5),
+        fresnel_case(0.95, 1.5),
+    ]
+}
+
+/// `ln Gamma(x)` for `x > 0` (Lanczos, g = 7).
+fn ln_gamma(x: f64) -> f64 {
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        return (PI / (PI * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let t = x + 7.5;
+    let a = C[1..]
+        .iter()
+        .enumerate()
+        .fold(C[0], |a, (i, c)| a + c / (x + i as f64 + 1.0));
+    0.5 * (2.0 * PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// The regularized upper incomplete gamma function `Q(a, x)` (series below `a + 1`, continued
+/// fraction above, as in Numerical Recipes' `gammq`).
+pub fn gamma_q(a: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 1.0;
+    }
+    let lg = ln_gamma(a);
+    if x < a + 1.0 {
+        let (mut sum, mut del, mut ap) = (1.0 / a, 1.0 / a, a);
+        for _ in 0..1000 {
+            ap += 1.0;
+            del *= x / ap;
+            sum += del;
+            if del.abs() < sum.abs() * 1e-15 {
+                break;
+            }
+        }
+        1.0 - sum * (-x + a * x.ln() - lg).exp()
+    } else {
+        let tiny = 1e-300;
+        let mut b = x + 1.0 - a;
+        let mut c = 1.0 / tiny;
+        let mut d = 1.0 / b;
+        let mut h = d;
+        for i in 1..1000 {
+            let an = -(i as f64) * (i as f64 - a);
+            b += 2.0;
+            d = an * d + b;
+            if d.abs() < tiny {
+                d = tiny;
+            }
+            c = b + an / c;
+            if c.abs() < tiny {
+                c = tiny;
+            }
+            d = 1.0 / d;
+            let del = d * c;
+            h *= del;
+            if (del - 1.0).abs() < 1e-15 {
+                break;
+            }
+        }
+        (-x + a * x.ln() - lg).exp() * h
+    }
+}
+
+/// Draw `n` samples of `case` and test them against its pdf.
+pub fn run(case: &Case, n: u64, seed: u64) -> Outcome {
+    let mut observed = vec![0.0; case.expected.len()];
+    let mut s = Sampler::new(seed, 0, 0);
+    for _ in 0..n {
+        if let Some(b) = (case.draw)(&mut s) {
+            observed[b] += 1.0;
+        }
+    }
+    let expected: Vec<f64> = case.expected.iter().map(|p| p * n as f64).collect();
+    // Pool bins expected below 5 into one; a sample where the pdf says none can fall makes
+    // the statistic infinite.
+    let (mut chi2, mut cells, mut pool_o, mut pool_e) = (0.0, 0usize, 0.0, 0.0);
+    for (o, e) in observed.iter().zip(&expected) {
+        if *e < 5.0 {
+            pool_o += o;
+            pool_e += e;
+        } else {
+            chi2 += (o - e) * (o - e) / e;
+            cells += 1;
+        }
+    }
+    if pool_e >= 5.0 {
+        chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+        cells += 1;
+    } else if pool_o > 0.0 && pool_o > 10.0 * pool_e.max(0.5) {
+        chi2 = f64::INFINITY;
+    }
+    let dof = cells.saturating_sub(1).max(1);
+    Outcome {
+        name: case.name.clone(),
+        observed,
+        expected,
+        columns: case.columns,
+        chi2,
+        dof,
+        p_value: gamma_q(dof as f64 / 2.0, chi2 / 2.0),
+    }
+}
+
+/// The per-test significance for `tests` tests at overall level [`ALPHA`] (Sidak).
+pub fn per_test_alpha(tests: usize) -> f64 {
+    1.0 - (1.0 - ALPHA).powf(1.0 / tests.max(1) as f64)
+}
+
+/// A self-contained HTML page: each test's verdict, and its observed and expected histograms
+/// side by side (rows: `z` from -1 at the top to 1; columns: `phi`).
+pub fn html(outcomes: &[Outcome], samples: u64) -> String {
+    let alpha = per_test_alpha(outcomes.len());
+    let mut s = String::from(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>rtis warptest</title>\
+         <style>body{font-family:sans-serif;margin:2em}td,th{padding:2px 8px}\
+         .pass{color:#060}.fail{color:#b00}svg{margin-right:1em;border:1px solid #ccc}</style>\
+         </head><body><h1>rtis warptest</h1>",
+    );
+    let _ = write!(
+        s,
+        "<p>{samples} samples per sampler, Pearson's chi-squared test, significance {ALPHA} \
+         overall ({alpha:.2e} per test, Sidak). Histograms: observed (left) and expected \
+         (right) counts; rows are cos&theta; from -1 (top) to 1, columns &phi; from 0 to \
+         2&pi;.</p>"
+    );
+    for o in outcomes {
+        let pass = o.p_value >= alpha;
+        let _ = write!(
+            s,
+            "<h2>{}</h2><p class=\"{}\">chi<sup>2</sup> = {:.1}, {} degrees of freedom, \
+             p = {:.4}: {}</p><div>{}{}</div>",
+            o.name,
+            if pass { "pass" } else { "fail" },
+            o.chi2,
+            o.dof,
+            o.p_value,
+            if pass { "accepted" } else { "rejected" },
+            histogram(&o.observed, o.columns, &o.expected),
+            histogram(&o.expected, o.columns, &o.expected)
+        );
+    }
+    s.push_str("</body></html>\n");
+    s
+}
+
+/// One histogram as inline SVG, grey levels scaled to the largest expected count.
+fn histogram(v: &[f64], columns: usize, scale: &[f64]) -> String {
+    let max = scale.iter().cloned().fold(0.0, f64::max).max(1e-12);
+    let rows = v.len() / columns;
+    let cell = if columns == 2 { 60 } else { 8 };
+    let mut s = format!(
+        "<svg width=\"{}\" height=\"{}\" xmlns=\"http://www.w3.org/2000/svg\">",
+        columns * cell,
+        rows * cell
+    );
+    for (i, &c) in v.iter().enumerate() {
+        let g = (255.0 * (1.0 - (c / max).min(1.0))) as u8;
+        let _ = write!(
+            s,
+            "<rect x=\"{}\" y=\"{}\" width=\"{cell}\" height=\"{cell}\" fill=\"rgb({g},{g},{g})\">\
+             <title>{c:.1}</title></rect>",
+            (i % columns) * cell,
+            (i / columns) * cell
+        );
+    }
+    s.push_str("</svg>");
+    s
+}

@@ -1,0 +1,108 @@
+//! `rtis warptest` (src/converge/warptest.rs): every sampler passes its chi-squared test, a
+//! sampler with the wrong pdf fails it, and the p-values are right where tables give them.
+
+use glam::Vec3A;
+use rtis::converge::warptest::{self, Case, direction_bin, gamma_q, integrate_pdf};
+use rtis::sampling::hemisphere;
+use std::process::Command;
+
+#[test]
+fn p_values_match_the_tables() {
+    // chi^2 upper 5% points: 3.841 (1 dof), 18.307 (10 dof), 124.342 (100 dof).
+    for (k, x) in [(1.0, 3.841_459), (10.0, 18.307_04), (100.0, 124.342_1)] {
+        let p = gamma_q(k / 2.0, x / 2.0);
+        assert!((p - 0.05).abs() < 1e-5, "k {k}: p {p}");
+    }
+    assert!((gamma_q(1.0, 1.0) - (-1f64).exp()).abs() < 1e-12);
+}
+
+#[test]
+fn every_sampler_follows_its_pdf() {
+    let cases = warptest::cases();
+    let alpha = warptest::per_test_alpha(cases.len());
+    for case in &cases {
+        let o = warptest::run(case, 200_000, 7);
+        assert!(
+            o.p_value >= alpha,
+            "{}: chi2 {} dof {} p {}",
+            o.name,
+            o.chi2,
+            o.dof,
+            o.p_value
+        );
+    }
+}
+
+/// The test has power: cosine samples against the uniform pdf, and the Phong lobe of exponent
+/// 10 against the pdf of exponent 11 (a plausible bug), are both rejected.
+#[test]
+fn a_wrong_pdf_is_rejected() {
+    let wrong = [
+        Case {
+            name: "cosine samples, uniform pdf".into(),
+            draw: Box::new(|s| {
+                let (u1, u2) = s.next_2d();
+                Some(direction_bin(hemisphere::cosine(u1, u2)))
+            }),
+            expected: integrate_pdf(|w| {
+                if w.z > 0.0 {
+                    1.0 / (2.0 * std::f64::consts::PI)
+                } else {
+                    0.0
+                }
+            }),
+            columns: warptest::BINS_PHI,
+        },
+        Case {
+            name: "lobe s = 10, pdf of s = 11".into(),
+            draw: Box::new(|s| {
+                let (u1, u2) = s.next_2d();
+                Some(direction_bin(hemisphere::phong_lobe(u1, u2, 10.0)))
+            }),
+            expected: integrate_pdf(|w: Vec3A| hemisphere::phong_lobe_pdf(w.z, 11.0) as f64),
+            columns: warptest::BINS_PHI,
+        },
+    ];
+    for case in &wrong {
+        let o = warptest::run(case, 200_000, 7);
+        assert!(o.p_value < 1e-6, "{}: p {}", o.name, o.p_value);
+    }
+    let page = warptest::html(&[warptest::run(&wrong[0], 10_000, 1)], 10_000);
+    assert!(page.contains("rejected") && page.contains("<svg"));
+}
+
+#[test]
+fn the_command_prints_and_writes_its_page() {
+    let d = std::env::temp_dir().join(format!("rtis-warp-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let page = d.join("w.html");
+    let o = Command::new(env!("CARGO_BIN_EXE_rtis"))
+        .args([
+            "warptest",
+            "--samples",
+            "100000",
+            "-o",
+            page.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(
+        out.matches("accepted").count(),
+        warptest::cases().len(),
+        "{out}"
+    );
+    assert!(
+        std::fs::read_to_string(&page)
+            .unwrap()
+            .matches("<svg")
+            .count()
+            >= 20
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
