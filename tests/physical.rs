@@ -468,3 +468,60 @@ fn physical_albedo_above_one_is_scaled() {
     let course = rtis::extract(&scene(&text("Course", 1.0, 0.6)));
     assert!(course.warnings.is_empty(), "{:?}", course.warnings);
 }
+
+/// The normalised Phong lobe integrates to its coefficient: at normal incidence the lobe about
+/// the mirror direction lies wholly above the surface, and `int (s + 2) / (2 pi) cos^s cos dw`
+/// is exactly 1, so the albedo is `kd + ks` (midpoint quadrature in `cos theta`, 20000 steps,
+/// several exponents; an exponent off by one gives `(s + 1) / (s + 2)` instead).
+#[test]
+fn phong_lobe_albedo_at_normal_incidence_is_exact() {
+    let n = Vec3A::Z;
+    for s in [0.0f32, 1.0, 10.0, 100.0, 1000.0] {
+        for (kd, ks) in [(0.0f32, 1.0f32), (0.3, 0.6)] {
+            let p = Phong {
+                kd: Vec3A::splat(kd),
+                ks: Vec3A::splat(ks),
+                shininess: s,
+            };
+            // Rotationally symmetric about n: int over phi is 2 pi; midpoint rule in mu.
+            let steps = 20_000;
+            let mut albedo = 0.0f64;
+            for i in 0..steps {
+                let mu = (i as f64 + 0.5) / steps as f64;
+                let wi = Vec3A::new((1.0 - mu * mu).sqrt() as f32, 0.0, mu as f32);
+                albedo += p.brdf(wi, n, n).x as f64 * mu / steps as f64;
+            }
+            albedo *= 2.0 * std::f64::consts::PI;
+            let exact = (kd + ks) as f64;
+            assert!(
+                (albedo - exact).abs() < 2e-3 * exact.max(1.0),
+                "s {s}: {albedo} vs {exact}"
+            );
+        }
+    }
+}
+
+/// Russian roulette from the first bounce stays unbiased: the white furnace (albedo 0.8 under
+/// a sky of 1, cosine sampling) with `rr_depth: 0` converges to 0.8, 5 standard errors.
+#[test]
+fn furnace_with_russian_roulette_from_the_first_bounce() {
+    let r = render_str(
+        r#"Scene(
+            film: (width: 16, height: 16, spp: 64),
+            camera: Perspective(position: (0, 0, -3), look_at: (0, 0, 0), fov: 30),
+            shader: Path(rr_depth: 0, sampling: Cosine),
+            model: Physical,
+            background: (1, 1, 1),
+            entities: [(shape: Sphere(center: (0, 0, 0), radius: 1.5), material: Phong(kd: (0.8, 0.8, 0.8)))],
+        )"#,
+    );
+    // Each path survives its bounce with q = 0.8 and weighs 0.8 / 0.8 = 1 then, 0 otherwise:
+    // a Bernoulli(0.8) per sample, variance 0.16; 64 x 256 samples.
+    let mean = r.image.mean().x as f64;
+    let se = (0.16f64 / (64.0 * 256.0)).sqrt();
+    assert!(
+        (mean - 0.8).abs() < 5.0 * se,
+        "mean {mean}, 5 se = {}",
+        5.0 * se
+    );
+}
