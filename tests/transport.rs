@@ -208,3 +208,60 @@ fn mirror_and_basic_shaders_by_hand() {
         );
     }
 }
+
+/// The course's three spheres on a floor under an open sky, with its sources scaled: `light` on the three point lights' intensity,
+/// `ambient` on Global's a_t, `sky` on the background.
+fn sources(shader: &str, light: f32, ambient: f32, sky: f32) -> rtis::render::Rendered {
+    let shader = shader.replace("AMBIENT", &format!("({ambient}, {ambient}, {ambient})"));
+    let mut s = common::scene(&format!(
+        "Scene(extends: \"spheres.ron\", film: (width: 24, height: 20, spp: 2), shader: {shader},
+          background: ({sky}, {sky}, {sky}))"
+    ));
+    for l in s.world.query_mut::<&mut rtis::world::WorldLight>() {
+        let rtis::world::WorldLight::Point { intensity, .. } = l;
+        *intensity *= light;
+    }
+    common::render_scene(&s)
+}
+
+/// Light transport is linear in its sources, in every shader and model: the image with the
+/// point lights, the ambient term and the sky together is the sum of the three images with one
+/// source each (the random directions do not depend on the sources, so the sums match to
+/// rounding). A term added at the wrong step (direct light at an intermediate bounce of the
+/// n-bounce rule, an escape at depth D) breaks it.
+#[test]
+fn transport_is_linear_in_its_sources() {
+    for shader in [
+        "Direct()",
+        "Global(samples: 4, max_depth: 0, ambient: AMBIENT)",
+        "Global(samples: 4, max_depth: 1, ambient: AMBIENT)",
+        "Global(samples: 4, max_depth: 3, ambient: AMBIENT)",
+        "Path(max_depth: 6)",
+    ] {
+        let all = sources(shader, 1.0, 0.3, 0.5);
+        let parts = [
+            sources(shader, 1.0, 0.0, 0.0),
+            sources(shader, 0.0, 0.3, 0.0),
+            sources(shader, 0.0, 0.0, 0.5),
+        ];
+        // Tolerance: the rounding of a few additions in single precision, about 16 ulp (the
+        // sums agree to 1.8e-7 relative; dropping the direct light at an intermediate
+        // bounce of the n-bounce rule breaks it by 1.7e-5).
+        for (i, p) in all.image.pixels.iter().enumerate() {
+            let sum: Vec3A = parts.iter().map(|r| r.image.pixels[i]).sum();
+            assert!(close(*p, sum, 2e-6), "{shader}: pixel {i}: {p} vs {sum}");
+        }
+        // Each source this shader can see contributes (the test would be empty otherwise):
+        // the lights and the sky always, the ambient term in Global.
+        let sees = [true, shader.contains("AMBIENT"), true];
+        for (k, r) in parts.iter().enumerate() {
+            let contributes = r.image.mean().max_element() > 0.0;
+            assert_eq!(
+                contributes,
+                sees[k],
+                "{shader}: source {k}: mean {}",
+                r.image.mean()
+            );
+        }
+    }
+}
