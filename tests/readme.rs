@@ -30,3 +30,24 @@ fn readme_keeps_its_two_commands() {
         ".ci/run runs the README's test command"
     );
 }
+
+/// The README's example of a located error is what rtis prints for tests/data/broken.ron.
+#[test]
+fn readme_error_example_is_real() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let text = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
+    let start = text
+        .find("error: tests/data/broken.ron")
+        .expect("the example");
+    let example = &text[start..start + text[start..].find("```").unwrap()];
+    let o = Command::new(env!("CARGO_BIN_EXE_rtis"))
+        .args(["check", "tests/data/broken.ron"])
+        .current_dir(root)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim_end(),
+        example.trim_end()
+    );
+}

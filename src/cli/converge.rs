@@ -19,7 +19,7 @@ pub struct ConvergeArgs {
     /// at least 2: its two halves measure its noise).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(2..=1048576))]
     reference_spp: u32,
-    /// Output folder for converge.csv, converge.md, converge.png and the reference.
+    /// Output folder for converge.csv, converge.md, converge.png, report.html and the reference.
     #[arg(long, default_value = "converge")]
     out: PathBuf,
     /// Width of every render (default 180; the height keeps the scene's aspect ratio).

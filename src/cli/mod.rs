@@ -34,7 +34,8 @@ enum Command {
     Diff(diff::DiffArgs),
     /// Merge pass files (`render --pass I/N`) into the image, bit-identical to one render.
     Merge(merge::MergeArgs),
-    /// Measure error against time for a ladder of shader settings (CSV, table, plot).
+    /// Measure error against time for a ladder of shader settings (CSV, table, plot,
+    /// report.html).
     Converge(converge::ConvergeArgs),
     /// Test every sampler against its pdf (chi-squared), with a page of histograms.
     Warptest(warptest::WarptestArgs),
