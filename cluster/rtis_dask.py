@@ -12,9 +12,18 @@ worker that dies, and retries a pass that fails. This driver:
 Workers must see the scene file (and what it extends or loads) at the same path, and an rtis
 binary (`--rtis`, by default target/release/rtis of this checkout).
 
+Sweeps and benchmarks fan out the same way, one task per scene:
+
+- `rtis-dask converge SCENE... --out DIR` runs `rtis converge SCENE --out DIR/NAME` for each
+  scene on a worker and brings back its folder (CSV, table, plot, report.html, reference);
+- `rtis-dask bench SCENE...` runs `rtis bench --json --section effects` on each scene alone and
+  prints the JSON lines, tagged with the worker that measured them.
+
 Usage:
     rtis-dask render SCENE --passes N -o OUT [--workers K | --scheduler ADDRESS]
                    [--threads T] [-- RTIS RENDER ARGS...]
+    rtis-dask converge SCENE... --out DIR [--workers K | --scheduler ADDRESS] [-- ARGS...]
+    rtis-dask bench SCENE... [--workers K | --scheduler ADDRESS] [-- ARGS...]
 """
 
 import argparse
@@ -85,6 +94,72 @@ def render(client, rtis, scene, passes, out, threads=None, extra=(), on_pass=Non
     return time.time() - start
 
 
+def run_converge(rtis, scene, extra):
+    """`rtis converge` of one scene on this worker; its output folder as {file name: bytes}."""
+    with tempfile.TemporaryDirectory() as d:
+        done = subprocess.run([rtis, "converge", scene, "--out", d, *extra],
+                              capture_output=True, text=True)
+        if done.returncode != 0:
+            raise RuntimeError(f"converge {scene} failed: {done.stderr.strip()}")
+        files = {}
+        for name in os.listdir(d):
+            with open(os.path.join(d, name), "rb") as f:
+                files[name] = f.read()
+        return files
+
+
+def run_bench(rtis, scene, extra):
+    """`rtis bench --json --section effects` of one scene alone on this worker; its JSON lines,
+    each tagged with the worker's host name."""
+    import json
+    import socket
+
+    done = subprocess.run([rtis, "bench", "--json", "--section", "effects", "--scenes",
+                           os.path.abspath(scene), *extra], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"bench {scene} failed: {done.stderr.strip()}")
+    host = socket.gethostname()
+    rows = []
+    for line in done.stdout.splitlines():
+        if line.strip():
+            row = json.loads(line)
+            row["host"] = host
+            rows.append(row)
+    return rows
+
+
+def fan_out(client, fn, rtis, scenes, extra, on_done=None):
+    """Run `fn(rtis, scene, extra)` for every scene on the cluster; results in scene order.
+    Lost workers' tasks are rescheduled by Dask, failed ones retried twice."""
+    from distributed import as_completed
+
+    futures = [client.submit(fn, rtis, os.path.abspath(s), list(extra), pure=False, retries=2)
+               for s in scenes]
+    index = {f.key: i for i, f in enumerate(futures)}
+    results = [None] * len(scenes)
+    for done, future in enumerate(as_completed(futures), 1):
+        i = index[future.key]
+        results[i] = future.result()
+        if on_done:
+            on_done(scenes[i], done, len(scenes))
+    return results
+
+
+def converge(client, rtis, scenes, out, extra=()):
+    """Converge sweeps of `scenes` on the cluster, each written to out/NAME/."""
+    def write(scene, done, total):
+        print(f"converge {scene}: {done}/{total}", file=sys.stderr)
+
+    results = fan_out(client, run_converge, rtis, scenes, extra, write)
+    for scene, files in zip(scenes, results):
+        folder = os.path.join(out, os.path.splitext(os.path.basename(scene))[0])
+        os.makedirs(folder, exist_ok=True)
+        for name, data in files.items():
+            with open(os.path.join(folder, name), "wb") as f:
+                f.write(data)
+    return results
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     extra = []
@@ -103,6 +178,16 @@ def main(argv=None):
     g.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     r.add_argument("--threads", type=int, help="rtis threads per pass (default: the worker's cores)")
     r.add_argument("--rtis", default=DEFAULT_RTIS, help="the rtis binary the workers run")
+    for name, help_text in [("converge", "converge sweeps of several scenes, one per worker"),
+                            ("bench", "the effects benchmark of several scenes, one per worker")]:
+        c = sub.add_parser(name, help=help_text)
+        c.add_argument("scenes", nargs="+")
+        if name == "converge":
+            c.add_argument("--out", required=True, help="folder for one sub-folder per scene")
+        g = c.add_mutually_exclusive_group()
+        g.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
+        g.add_argument("--scheduler", help="address of a running Dask scheduler")
+        c.add_argument("--rtis", default=DEFAULT_RTIS, help="the rtis binary the workers run")
     a = ap.parse_args(argv)
 
     from distributed import Client, LocalCluster
@@ -116,13 +201,23 @@ def main(argv=None):
         print(f"pass {i} merged: {done}/{total}", file=sys.stderr)
 
     try:
-        seconds = render(client, a.rtis, a.scene, a.passes, a.output, a.threads, extra, progress)
+        if a.command == "render":
+            seconds = render(client, a.rtis, a.scene, a.passes, a.output, a.threads, extra,
+                             progress)
+            print(f"{a.passes} passes merged in {seconds:.2f} s -> {a.output}", file=sys.stderr)
+        elif a.command == "converge":
+            converge(client, a.rtis, a.scenes, a.out, extra)
+            print(f"{len(a.scenes)} sweeps -> {a.out}/", file=sys.stderr)
+        else:
+            import json
+            for rows in fan_out(client, run_bench, a.rtis, a.scenes, extra):
+                for row in rows:
+                    print(json.dumps(row))
     except RuntimeError as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
     finally:
         client.close()
-    print(f"{a.passes} passes merged in {seconds:.2f} s -> {a.output}", file=sys.stderr)
     return 0
 
 

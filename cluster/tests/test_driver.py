@@ -77,3 +77,40 @@ def test_a_killed_worker_changes_nothing(client, tmp_path):
     assert identical(out, single)
     # The cluster's nanny restarts the worker.
     client.wait_for_workers(3, timeout=60)
+
+
+def csv_errors(path):
+    """(family, setting) -> (rmse, rel_mse, flip, variance, bias2) of a converge.csv."""
+    rows = {}
+    with open(path) as f:
+        next(f)
+        for line in f:
+            c = line.strip().split(",")
+            rows[(c[0], c[1])] = tuple(c[4:7] + c[8:10])
+    return rows
+
+
+def test_converge_sweeps_fan_out_with_the_same_errors(client, tmp_path):
+    """Two scenes' converge sweeps on the cluster, one per worker: every error figure equals a
+    sweep run here (the renders are deterministic; only the seconds differ)."""
+    scenes = [os.path.join(rtis_dask.ROOT, "scenes", s) for s in ["cornell-direct.ron", "spheres.ron"]]
+    args = ["--width", "24", "--runs", "1", "--seeds", "2", "--reference-spp", "8"]
+    rtis_dask.converge(client, RTIS, scenes, str(tmp_path / "cluster"), args)
+    for scene in scenes:
+        name = os.path.splitext(os.path.basename(scene))[0]
+        local = tmp_path / "local" / name
+        subprocess.run([RTIS, "converge", scene, "--out", str(local), *args], check=True,
+                       capture_output=True)
+        remote = tmp_path / "cluster" / name
+        assert (remote / "report.html").exists()
+        assert csv_errors(remote / "converge.csv") == csv_errors(local / "converge.csv")
+
+
+def test_benchmarks_fan_out(client):
+    scenes = [os.path.join(rtis_dask.ROOT, "scenes", s) for s in ["cornell-direct.ron", "spheres.ron"]]
+    results = rtis_dask.fan_out(client, rtis_dask.run_bench, RTIS, scenes, ["--runs", "1", "--shrink", "8"])
+    for scene, rows in zip(scenes, results):
+        effects = [r for r in rows if r["section"] == "effects"]
+        assert {r["scene"] for r in effects} == {os.path.basename(scene)}
+        assert any(r["effect_off"] == "shadows" for r in effects)
+        assert all("host" in r for r in rows)

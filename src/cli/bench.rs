@@ -28,7 +28,7 @@ pub struct BenchArgs {
     /// Which figures.
     #[arg(long, value_enum, default_value_t = Section::All)]
     section: Section,
-    /// Folder of scenes for the effects section.
+    /// Folder of scenes (or one scene file) for the effects section.
     #[arg(long, default_value = "scenes")]
     scenes: std::path::PathBuf,
     /// Print one JSON object per line (machine-readable, for bench/readme_figures.py) instead
@@ -86,11 +86,16 @@ fn effects_section(
             "scene", "effect off", "seconds", "Mrays", "speedup", "RMSE"
         );
     }
-    let mut paths: Vec<_> = std::fs::read_dir(dir)
-        .map_err(|e| format!("{}: {e}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-        .collect();
+    // A folder of scenes, or one scene file.
+    let mut paths: Vec<_> = if dir.is_file() {
+        vec![dir.to_path_buf()]
+    } else {
+        std::fs::read_dir(dir)
+            .map_err(|e| format!("{}: {e}", dir.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+            .collect()
+    };
     paths.sort();
     for path in paths {
         let mut scene = rtis::scene::load_path(&path)?;
