@@ -222,3 +222,45 @@ fn bvh_agrees_with_brute_force() {
     }
     assert!(hits > 1000);
 }
+
+/// Smooth shading by hand: on a triangle with vertex normals n0, n1, n2, the shading normal is
+/// n1 at the second vertex, the normalised mean of the three at the centroid, and the
+/// normalised mean of n0 and n2 at the middle of their edge.
+#[test]
+fn smooth_normals_interpolate_barycentrically() {
+    use rtis::accel::{Geometry, Prim};
+    use rtis::shape::{Shape, Triangle};
+    let (a, b, c) = (
+        Vec3A::new(0.0, 0.0, 0.0),
+        Vec3A::new(2.0, 0.0, 0.0),
+        Vec3A::new(0.0, 3.0, 0.0),
+    );
+    let t = Triangle::new(a, b, c).unwrap();
+    let (n0, n1, n2) = (
+        Vec3A::new(0.0, 0.0, 1.0),
+        Vec3A::new(0.6, 0.0, 0.8),
+        Vec3A::new(0.0, 0.6, 0.8),
+    );
+    let g = Geometry::build(
+        vec![Prim {
+            shape: Shape::Triangle(t),
+            material: 0,
+            smooth: 0,
+        }],
+        vec![[n0, n1, n2]],
+    );
+    let prim = &g.prims[0];
+    let at = |p: Vec3A| g.shading_normal(prim, p, t.n);
+    let near = |x: Vec3A, y: Vec3A| (x - y).length() < 1e-5;
+    assert!(near(at(b), n1), "{}", at(b));
+    assert!(
+        near(at((a + b + c) / 3.0), (n0 + n1 + n2).normalize()),
+        "{}",
+        at((a + b + c) / 3.0)
+    );
+    assert!(
+        near(at((a + c) / 2.0), (n0 + n2).normalize()),
+        "{}",
+        at((a + c) / 2.0)
+    );
+}

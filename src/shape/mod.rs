@@ -59,14 +59,6 @@ impl WorldShape {
         }
     }
 
-    /// Number of render shapes this becomes (a mesh: its faces).
-    pub fn count(&self) -> usize {
-        match self {
-            WorldShape::Mesh(m) => m.faces.len(),
-            _ => 1,
-        }
-    }
-
     /// The render shapes of this shape placed by `at`, each with its vertex normals when
     /// smooth, passed to `push`; returns how many zero-area triangles were dropped (they can
     /// never be hit).
