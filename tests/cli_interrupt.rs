@@ -89,7 +89,8 @@ fn first_ctrl_c_writes_the_partial_image_and_exits_130() {
     let s = scene(&d, "Global(samples: 64, max_depth: 3)");
     let out = d.join("box.png");
     let (mut child, rx) = start(&[s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
-    wait_for(&rx, "estimate:");
+    // The render has started (and Ctrl-C keeps its image) once it says so.
+    wait_for(&rx, "Ctrl-C keeps the image so far");
     std::thread::sleep(Duration::from_millis(300));
     signal(&child, "-INT");
     let status = child.wait().unwrap();
@@ -129,7 +130,7 @@ fn second_ctrl_c_quits_at_once() {
     let s = scene(&d, "Global(samples: 64, max_depth: 3)");
     let out = d.join("box.png");
     let (mut child, rx) = start(&[s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
-    wait_for(&rx, "estimate:");
+    wait_for(&rx, "Ctrl-C keeps the image so far");
     signal(&child, "-INT");
     wait_for(&rx, "press Ctrl-C again");
     signal(&child, "-INT");

@@ -226,6 +226,10 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     }
     let result = {
         let _graceful = Graceful::begin();
+        eprintln!(
+            "rendering {} tiles; Ctrl-C keeps the image so far, twice quits",
+            render::tile_count(&prepared)
+        );
         pool.install(|| render::render_until(&prepared, &tick, &interrupt::STOP))
     };
     bar.finish_and_clear();
