@@ -179,3 +179,47 @@ fn signal_during_the_write_leaves_no_temporary_file() {
     }
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// SIGTERM while the temporary file of the image exists (held by the test hook
+/// `RTIS_TEST_WRITE_PAUSE_MS`): the signal waits for the write to finish, so the image is whole
+/// and no temporary file is left (exit 143, or 0 when the finished render exits first).
+#[test]
+fn sigterm_during_the_write_waits_for_it() {
+    let d = tmp("pause");
+    let s = scene(&d, "Normal");
+    let out = d.join("n.png");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtis"))
+        .args([
+            "render",
+            s.to_str().unwrap(),
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "-o",
+        ])
+        .arg(&out)
+        .env("RTIS_TEST_WRITE_PAUSE_MS", "1500")
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait for the written temporary file (the empty one of the start-up folder check does
+    // not count).
+    let start = std::time::Instant::now();
+    let written =
+        |f: &String| f.ends_with(".tmp") && std::fs::metadata(d.join(f)).is_ok_and(|m| m.len() > 0);
+    while !files(&d).iter().any(written) {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no temporary file appeared"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    signal(&child, "-TERM");
+    let status = child.wait().unwrap();
+    assert!(matches!(status.code(), Some(0 | 143)), "{status:?}");
+    assert_eq!(files(&d), vec!["n.png".to_string()]);
+    let img = image::open(&out).expect("a whole image");
+    assert_eq!((img.width(), img.height()), (64, 48));
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -74,3 +74,31 @@ proptest! {
         }
     }
 }
+
+/// The Fresnel reflectance against the textbook form in angles (Hecht): with Snell's
+/// `sin t = eta sin i`, `R_s = (sin(i - t) / sin(i + t))^2`, `R_p = (tan(i - t) / tan(i + t))^2`
+/// and `F = (R_s + R_p) / 2`, at oblique angles into and out of glass (normal incidence alone
+/// cannot tell the two polarisations' formulas apart).
+#[test]
+fn fresnel_matches_the_angle_form_at_oblique_incidence() {
+    use rtis::material::fresnel_dielectric;
+    for eta in [1.0 / 1.5f64, 1.0 / 2.4, 1.5] {
+        for deg in [10.0f64, 30.0, 45.0, 60.0, 80.0] {
+            let i = deg.to_radians();
+            let sin_t = eta * i.sin();
+            if sin_t >= 1.0 {
+                assert_eq!(fresnel_dielectric(i.cos() as f32, eta as f32), 1.0);
+                continue;
+            }
+            let t = sin_t.asin();
+            let rs = ((i - t).sin() / (i + t).sin()).powi(2);
+            let rp = ((i - t).tan() / (i + t).tan()).powi(2);
+            let want = 0.5 * (rs + rp);
+            let got = fresnel_dielectric(i.cos() as f32, eta as f32) as f64;
+            assert!(
+                (got - want).abs() < 1e-5,
+                "eta {eta}, {deg} deg: {got} vs {want}"
+            );
+        }
+    }
+}

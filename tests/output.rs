@@ -46,3 +46,29 @@ fn eight_bit_values_under_each_transfer() {
     // The course's min(v, 1) * 255, rounded.
     assert_eq!(linear, vec![0, 128, 46, 255]);
 }
+
+/// Reading a PNG undoes the sRGB curve on both of its segments: 10/255 lies on the linear
+/// segment (divide by 12.92), 200/255 on the power segment.
+#[test]
+fn png_values_decode_through_the_inverse_curve() {
+    let dir = std::env::temp_dir().join(format!("rtis-output-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("two.png");
+    image::RgbImage::from_fn(2, 1, |x, _| image::Rgb([if x == 0 { 10 } else { 200 }; 3]))
+        .save(&path)
+        .unwrap();
+    let img = rtis::render::output::load(&path).unwrap();
+    let dark = 10.0f64 / 255.0 / 12.92;
+    let bright = ((200.0f64 / 255.0 + 0.055) / 1.055).powf(2.4);
+    assert!(
+        (img.pixels[0].x as f64 - dark).abs() < 1e-6,
+        "{}",
+        img.pixels[0]
+    );
+    assert!(
+        (img.pixels[1].x as f64 - bright).abs() < 1e-5,
+        "{}",
+        img.pixels[1]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -124,3 +124,31 @@ fn distinct_samples_draw_distinct_streams() {
     let (mut a, mut b) = (Sampler::new(7, 8, 9), Sampler::new(7, 8, 9));
     assert_eq!(a.next_f32(), b.next_f32());
 }
+
+/// Pixel samples are stratified: with 4 samples one falls in each quadrant of the pixel, with
+/// 3 (n-rooks) each third of the pixel holds one sample in x and one in y.
+#[test]
+fn pixel_samples_fill_their_strata() {
+    use rtis::sampling::pixel_sample;
+    for seed in 0..20u64 {
+        let mut s = Sampler::new(seed, 0, 0);
+        let mut quadrants: Vec<(u32, u32)> = (0..4)
+            .map(|i| {
+                let (x, y) = pixel_sample(i, 4, seed, &mut s);
+                assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+                ((x * 2.0) as u32, (y * 2.0) as u32)
+            })
+            .collect();
+        quadrants.sort();
+        assert_eq!(quadrants, vec![(0, 0), (0, 1), (1, 0), (1, 1)]);
+        let (mut xs, mut ys): (Vec<u32>, Vec<u32>) = (0..3)
+            .map(|i| {
+                let (x, y) = pixel_sample(i, 3, seed, &mut s);
+                ((x * 3.0) as u32, (y * 3.0) as u32)
+            })
+            .unzip();
+        xs.sort();
+        ys.sort();
+        assert_eq!((xs, ys), (vec![0, 1, 2], vec![0, 1, 2]));
+    }
+}

@@ -27,6 +27,17 @@ pub fn remove_pending() {
     std::mem::forget(guard);
 }
 
+/// A test hook: with `RTIS_TEST_WRITE_PAUSE_MS` set, hold a finished temporary file that long
+/// before renaming it, so that `tests/cli_interrupt.rs` can interrupt a write at a known moment.
+fn pause_for_tests() {
+    if let Some(ms) = std::env::var("RTIS_TEST_WRITE_PAUSE_MS")
+        .ok()
+        .and_then(|v| v.parse::<u64>().ok())
+    {
+        std::thread::sleep(std::time::Duration::from_millis(ms.min(60_000)));
+    }
+}
+
 /// Run `write` on the temporary file `tmp` of `path`, registered so that an interrupt removes
 /// it, then rename it into place; on any failure the temporary file is removed.
 fn write_via_temp(
@@ -36,7 +47,10 @@ fn write_via_temp(
     let tmp = temp_path(path);
     let mut guard = pending();
     guard.push(tmp.clone());
-    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    let result = write(&tmp).and_then(|()| {
+        pause_for_tests();
+        std::fs::rename(&tmp, path).map_err(|e| e.to_string())
+    });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
