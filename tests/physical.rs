@@ -525,3 +525,19 @@ fn furnace_with_russian_roulette_from_the_first_bounce() {
         5.0 * se
     );
 }
+
+/// BRDF sampling picks the diffuse lobe with probability kd / (kd + ks) (channel sums), and
+/// always for a black material: exact values (a wrong choice would still be unbiased, since
+/// the pdf uses the same probability, but noisier; the warptest cannot see it).
+#[test]
+fn brdf_sampling_picks_lobes_by_their_share() {
+    let p = |kd: f32, ks: f32| Phong {
+        kd: Vec3A::splat(kd),
+        ks: Vec3A::splat(ks),
+        shininess: 10.0,
+    };
+    assert!((path::diffuse_probability(&p(0.1, 0.8)) - 1.0 / 9.0).abs() < 1e-7);
+    assert_eq!(path::diffuse_probability(&p(0.5, 0.5)), 0.5);
+    assert_eq!(path::diffuse_probability(&p(0.0, 0.7)), 0.0);
+    assert_eq!(path::diffuse_probability(&p(0.0, 0.0)), 1.0);
+}
