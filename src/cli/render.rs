@@ -170,11 +170,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         .build()?;
 
     // What it will cost: the shader's rule and a short calibration (for a pass, its share).
-    let est = {
-        let mut share = prepared.clone();
-        share.film.spp = samples.len() as u32;
-        estimate::estimate(&share)
-    };
+    let est = estimate::estimate(&prepared).share(samples.len() as u32, prepared.film.spp);
     eprintln!(
         "estimate: {:.3e} rays, about {} on {threads} threads (calibrated on {} samples{})",
         est.rays(),

@@ -143,10 +143,7 @@ pub fn reference_seed(seed: u64) -> u64 {
 /// The reference render of `scene`: Path with unbounded depth, `spp` samples per pixel, its own
 /// seed ([`reference_seed`]).
 pub fn reference_scene(scene: &RenderScene, spp: u32) -> RenderScene {
-    RenderScene {
-        seed: reference_seed(scene.seed),
-        ..with_settings(scene, reference_shader(), spp)
-    }
+    reference_half(scene, spp, 0)
 }
 
 /// Half `h` (0 or 1) of the reference: `spp` samples of its own independent seed. The two

@@ -92,7 +92,7 @@ impl Ray {
     }
 
     /// A ray leaving the surface of `hit` in unit direction `w` and stopping at `t_max`: it
-    /// starts at [`spawn_origin`] and carries that origin's error bound.
+    /// starts at [`Origins`] and carries that origin's error bound.
     #[inline]
     pub fn spawn(hit: &Hit, w: Vec3A, t_max: f32) -> Self {
         Origins::new(hit).ray(w, t_max)
@@ -134,7 +134,7 @@ pub struct Hit {
     /// for planes, the winding normal for triangles). Shaders orient it towards the viewer.
     pub n: Vec3A,
     /// Bound on the error of `p` in each coordinate across the surface (how far off the
-    /// surface it can be); spawned rays start off the surface by it (see [`spawn_origin`]).
+    /// surface it can be); spawned rays start off the surface by it (see [`Origins`]).
     pub err: f32,
     /// Bound on the error of `p` along the surface (how far from the ray's exact crossing).
     pub err_along: f32,
@@ -194,12 +194,4 @@ impl Origins {
             ..Ray::bare(o, w, t_max)
         }
     }
-}
-
-/// The start of a ray that leaves `hit` in direction `w`, and the bound on its error (see
-/// [`Origins`]).
-#[inline]
-pub fn spawn_origin(hit: &Hit, w: Vec3A) -> (Vec3A, f32) {
-    let r = Origins::new(hit).ray(w, f32::INFINITY);
-    (r.o, r.o_err)
 }

@@ -71,6 +71,14 @@ impl Estimate {
         self.rays_per_sample * self.samples as f64
     }
 
+    /// The estimate for `spp` of the film's `of` samples per pixel (a pass's share).
+    pub fn share(self, spp: u32, of: u32) -> Estimate {
+        Estimate {
+            samples: self.samples / of.max(1) as u64 * spp as u64,
+            ..self
+        }
+    }
+
     /// Wall seconds on `threads` threads (assuming they scale linearly).
     pub fn seconds(&self, threads: usize) -> f64 {
         self.rays() * self.seconds_per_ray / threads.max(1) as f64

@@ -135,15 +135,24 @@ pub fn render_until(
     }
 }
 
-/// A pass: the exact sums of the samples `samples` of every pixel (see [`exact`]).
+/// Render the sample indices `samples` of every pixel, keeping exact sums: passes of one
+/// scene, merged, give the same bits as one render ([`render`]) of all its samples.
+pub fn render_pass(
+    scene: &RenderScene,
+    samples: std::ops::Range<u32>,
+    on_tile: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Tiled<RgbSum> {
+    by_tiles(scene, on_tile, stop, |col, row, stats| {
+        pixel_sum(scene, col, row, samples.clone(), stats)
+    })
+}
+
+/// Per-pixel values of a tiled render (a pass's exact sums, for [`render_pass`]).
 #[derive(Clone, Debug)]
-pub struct PassSums {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Per-pixel sums, row-major.
-    pub pixels: Vec<RgbSum>,
+pub struct Tiled<T> {
+    /// Per-pixel values, row-major.
+    pub pixels: Vec<T>,
     /// Rays traced, by kind.
     pub stats: RayStats,
     /// Wall-clock seconds spent tracing.
@@ -152,37 +161,6 @@ pub struct PassSums {
     pub tiles_done: u64,
     /// Tiles in the image.
     pub tiles: u64,
-}
-
-/// Render the sample indices `samples` of every pixel, keeping exact sums: passes of one
-/// scene, merged, give the same bits as one render ([`render`]) of all its samples.
-pub fn render_pass(
-    scene: &RenderScene,
-    samples: std::ops::Range<u32>,
-    on_tile: &(dyn Fn() + Sync),
-    stop: &AtomicBool,
-) -> PassSums {
-    let t = by_tiles(scene, on_tile, stop, |col, row, stats| {
-        pixel_sum(scene, col, row, samples.clone(), stats)
-    });
-    PassSums {
-        width: scene.film.width,
-        height: scene.film.height,
-        pixels: t.pixels,
-        stats: t.stats,
-        seconds: t.seconds,
-        tiles_done: t.tiles_done,
-        tiles: t.tiles,
-    }
-}
-
-/// Per-pixel values of a tiled render, in row-major order.
-struct Tiled<T> {
-    pixels: Vec<T>,
-    stats: RayStats,
-    seconds: f64,
-    tiles_done: u64,
-    tiles: u64,
 }
 
 /// Run `pixel` over every pixel in 16x16 tiles on the current rayon pool; tiles not started

@@ -44,13 +44,20 @@ fn write_via_temp(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), OutputError> {
+    with_temp(path, |tmp| {
+        write(tmp)?;
+        pause_for_tests();
+        std::fs::rename(tmp, path).map_err(|e| e.to_string())
+    })
+}
+
+/// Run `f` on the temporary file name of `path`, registered in [`PENDING`] (lock held) for the
+/// whole call; the file is removed if `f` fails.
+fn with_temp(path: &Path, f: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), OutputError> {
     let tmp = temp_path(path);
     let mut guard = pending();
     guard.push(tmp.clone());
-    let result = write(&tmp).and_then(|()| {
-        pause_for_tests();
-        std::fs::rename(&tmp, path).map_err(|e| e.to_string())
-    });
+    let result = f(&tmp);
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
@@ -134,15 +141,11 @@ pub fn check_writable(path: &Path) -> Result<(), OutputError> {
 
 /// Check before a long render that the folder of `path` takes new files (any format).
 pub fn check_folder(path: &Path) -> Result<(), OutputError> {
-    let tmp = temp_path(path);
-    let mut guard = pending();
-    guard.push(tmp.clone());
-    let result = std::fs::write(&tmp, b"").and_then(|()| std::fs::remove_file(&tmp));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    guard.retain(|p| p != &tmp);
-    result.map_err(|e| io_err(path, e))
+    with_temp(path, |tmp| {
+        std::fs::write(tmp, b"")
+            .and_then(|()| std::fs::remove_file(tmp))
+            .map_err(|e| e.to_string())
+    })
 }
 
 /// Write `bytes` to `path` through a temporary file and a rename (for text outputs).
