@@ -25,6 +25,8 @@ pub struct Switches {
     pub ambient: Option<bool>,
     /// Background radiance.
     pub background: Option<bool>,
+    /// Light emitted by shapes (area lights).
+    pub emission: Option<bool>,
 }
 
 /// The effects a render simulates.
@@ -43,6 +45,9 @@ pub struct Effects {
     pub ambient: bool,
     /// Escaped rays see a non-black background.
     pub background: bool,
+    /// Emitting shapes (area lights) are seen by rays and sampled for direct light. Off: they
+    /// emit nothing.
+    pub emission: bool,
     /// The scene has spheres (informative: no code depends on it).
     pub spheres: bool,
     /// The scene has infinite planes (informative).
@@ -60,13 +65,14 @@ impl Effects {
         indirect: true,
         ambient: true,
         background: true,
+        emission: true,
         spheres: true,
         planes: true,
         triangles: true,
     };
 
     /// The effects' names and values, in a fixed order.
-    pub fn named(&self) -> [(&'static str, bool); 9] {
+    pub fn named(&self) -> [(&'static str, bool); 10] {
         [
             ("shadows", self.shadows),
             ("reflection", self.reflection),
@@ -74,6 +80,7 @@ impl Effects {
             ("indirect", self.indirect),
             ("ambient", self.ambient),
             ("background", self.background),
+            ("emission", self.emission),
             ("spheres", self.spheres),
             ("planes", self.planes),
             ("triangles", self.triangles),
@@ -89,6 +96,7 @@ impl Effects {
             indirect: self.indirect && !off.indirect,
             ambient: self.ambient && !off.ambient,
             background: self.background && !off.background,
+            emission: self.emission && !off.emission,
             spheres: self.spheres && !off.spheres,
             planes: self.planes && !off.planes,
             triangles: self.triangles && !off.triangles,

@@ -7,8 +7,10 @@
 
 use crate::accel::{FLAT, Geometry, Prim};
 use crate::geometry::Placement;
+use crate::light::{AreaLight, Emitter, Emitters, Emitting, NO_LIGHT};
 use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
+use crate::shape::Shape;
 use crate::world::{Name, Scene, Transform, WorldLight, WorldShape};
 
 /// Build the render data of a loaded scene.
@@ -23,7 +25,8 @@ pub fn extract(scene: &Scene) -> RenderScene {
     let mut materials: Vec<Material> = Vec::new();
     let mut prims = Vec::new();
     let mut normals = Vec::new();
-    for (entity, shape, m, name, transform) in scene
+    let mut area_lights = Vec::new();
+    for (entity, shape, m, name, transform, emitter) in scene
         .world
         .query::<(
             hecs::Entity,
@@ -31,6 +34,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
             &Material,
             Option<&Name>,
             Option<&Transform>,
+            Option<&Emitter>,
         )>()
         .iter()
     {
@@ -50,10 +54,25 @@ pub fn extract(scene: &Scene) -> RenderScene {
                 }
                 None => FLAT,
             };
+            // Each primitive of an emitting shape is one area light.
+            let emitting = match shape {
+                Shape::Sphere(sphere) => Some(Emitting::Sphere(sphere)),
+                Shape::Triangle(t) => Some(Emitting::Triangle(t)),
+                // The loader refuses emitting planes (infinite power).
+                Shape::Plane(_) => None,
+            };
+            let light = match (emitter, emitting) {
+                (Some(&emitter), Some(shape)) => {
+                    area_lights.push(AreaLight { shape, emitter });
+                    (area_lights.len() - 1) as u32
+                }
+                _ => NO_LIGHT,
+            };
             prims.push(Prim {
                 shape,
                 material,
                 smooth,
+                light,
             })
         });
         if dropped > 0 {
@@ -85,6 +104,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
         .map(|l| l.extract(origin))
         .collect();
     let geometry = Geometry::build(prims, normals);
+    let emitters = Emitters::new(area_lights);
 
     // The effects, derived once from the parts, before the render scene is assembled.
     let derived = effects::derive(
@@ -92,6 +112,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
         &geometry,
         &materials,
         &lights,
+        &emitters,
         s.background,
         &s.effects,
     );
@@ -101,6 +122,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
         geometry,
         materials,
         lights,
+        emitters,
         background: s.background,
         shader: s.shader,
         model: s.model,

@@ -18,6 +18,7 @@ fn mesh_prims(n: usize) -> Vec<Prim> {
                 shape: Shape::Triangle(t),
                 material: 0,
                 smooth: FLAT,
+                light: rtis::light::NO_LIGHT,
             })
         })
         .collect()

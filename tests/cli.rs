@@ -110,7 +110,7 @@ fn check_prints_the_scene_in_its_own_terms() {
     assert!(o.status.success(), "{}", stderr(&o));
     let s = String::from_utf8_lossy(&o.stdout);
     for line in [
-        "    shader: Global(samples: 64, max_depth: 2, ambient: (0.3, 0.3, 0.3), max_specular: 32),",
+        "    shader: Global(samples: 64, max_depth: 2, ambient: (0.3, 0.3, 0.3), max_specular: 32, light_samples: 1),",
         "        \"glass\": Transmissive(ior: 1.1, color: (1, 1, 1)),",
         "        (name: \"floor\", shape: InfinitePlane(point: (0, -3, 0), normal: (0, 1, 0)), material: Named(\"grey wall\")),",
         "        (name: \"light far\", light: Point(position: (0, 2, 6), intensity: (7, 7, 7))),",

@@ -50,8 +50,8 @@ fn describe(shader: &Shader) -> String {
     match shader {
         Shader::Global(g) => format!("Global(samples: {}, max_depth: {})", g.samples, g.max_depth),
         Shader::Path(p) => format!(
-            "Path {{ max_depth: {:?}, rr_depth: {}, sampling: {:?} }}",
-            p.max_depth, p.rr_depth, p.sampling
+            "Path {{ max_depth: {:?}, rr_depth: {}, sampling: {:?}, lights: {:?} }}",
+            p.max_depth, p.rr_depth, p.sampling, p.lights
         ),
         s => format!("{s:?}"),
     }
@@ -197,11 +197,13 @@ macro_rules! golden_tests {
 golden_tests! {
     cornell => "cornell.ron",
     cornell_ambient => "cornell-ambient.ron",
+    cornell_area => "cornell-area.ron",
     cornell_direct => "cornell-direct.ron",
     cornell_n_bounce => "cornell-n-bounce.ron",
     cornell_physical => "cornell-physical.ron",
     cornell_two_bounce => "cornell-two-bounce.ron",
     mesh => "mesh.ron",
+    mitsuba_cornell => "mitsuba-cornell.ron",
     spheres => "spheres.ron",
     triangles => "triangles.ron",
 }

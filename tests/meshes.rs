@@ -246,6 +246,7 @@ fn smooth_normals_interpolate_barycentrically() {
             shape: Shape::Triangle(t),
             material: 0,
             smooth: 0,
+            light: rtis::light::NO_LIGHT,
         }],
         vec![[n0, n1, n2]],
     );

@@ -198,6 +198,34 @@ const CASES: &[(&str, &str)] = &[
     ("misspelt shader", "Scene(shader: Normals)"),
     ("lower-case model", "Scene(model: physical)"),
     ("misspelt shader field", "Scene(shader: Global(sample: 16))"),
+    (
+        "emitter without a shape",
+        "Scene(entities: [(name: \"glow\", emitter: Emitter(radiance: (1, 1, 1)))])",
+    ),
+    (
+        "emitting infinite plane",
+        "Scene(entities: [(shape: InfinitePlane(point: (0, 3, 0), normal: (0, -1, 0)), emitter: Emitter(radiance: (1, 1, 1)))])",
+    ),
+    (
+        "rectangle with parallel edges",
+        "Scene(entities: [(shape: Rectangle(corner: (0, 0, 5), u: (1, 0, 0), v: (2, 0, 0)), material: Mirror())])",
+    ),
+    (
+        "negative radiance",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), emitter: Emitter(radiance: (1, -1, 1)))])",
+    ),
+    (
+        "unknown emitter field",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), emitter: Emitter(radiance: (1, 1, 1), twosided: true))])",
+    ),
+    (
+        "unknown light strategy",
+        "Scene(shader: Path(lights: Both))",
+    ),
+    (
+        "zero light samples",
+        "Scene(shader: Direct(light_samples: 0))",
+    ),
     ("lights at the top level", "Scene(lights: [])"),
     (
         "missing required field",

@@ -207,7 +207,7 @@ proptest! {
             .chain([Shape::Plane(Plane::through(Vec3A::new(0.0, -2.0 * s, 0.0), Vec3A::Y))])
             .collect();
         let prims = |shapes: &[Shape]| -> Vec<Prim> {
-            shapes.iter().map(|&shape| Prim { shape, material: 0, smooth: FLAT }).collect()
+            shapes.iter().map(|&shape| Prim { shape, material: 0, smooth: FLAT, light: rtis::light::NO_LIGHT }).collect()
         };
         let packed = Geometry::build(prims(&shapes), Vec::new());
         // Padding the scene to 17 spheres (far away) sends its spheres to the BVH.
@@ -254,6 +254,7 @@ fn unit_sphere_is_hit_at_four_in_every_path() {
         shape: sphere,
         material: 0,
         smooth: FLAT,
+        light: rtis::light::NO_LIGHT,
     };
     let packed = Geometry::build(vec![prim], Vec::new());
     assert_eq!(packed.intersect(&ray).map(|h| h.t), Some(4.0));
@@ -264,6 +265,7 @@ fn unit_sphere_is_hit_at_four_in_every_path() {
         }),
         material: 0,
         smooth: FLAT,
+        light: rtis::light::NO_LIGHT,
     };
     let bvh = Geometry::build(
         std::iter::once(prim).chain((0..20).map(far)).collect(),

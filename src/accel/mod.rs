@@ -19,6 +19,9 @@ pub struct Prim {
     pub material: u32,
     /// Index into [`Geometry::normals`] of a smooth triangle's vertex normals, or [`FLAT`].
     pub smooth: u32,
+    /// Index of the primitive's area light in the render's `Emitters`, or
+    /// [`crate::light::NO_LIGHT`].
+    pub light: u32,
 }
 
 /// [`Prim::smooth`] of a primitive shaded with its geometric normal.

@@ -248,6 +248,7 @@ fn meshes_section(json: bool) {
                     shape: Shape::Triangle(t),
                     material: 0,
                     smooth: FLAT,
+                    light: rtis::light::NO_LIGHT,
                 })
             })
             .collect();
@@ -347,6 +348,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
             max_depth,
             ambient: glam::Vec3A::splat(0.3),
             max_specular: 32,
+            light_samples: 1,
         })
     };
     if !a.json {
@@ -354,7 +356,14 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     }
     case(
         "Direct",
-        &with_settings(&base, Shader::Direct { max_specular: 32 }, 1),
+        &with_settings(
+            &base,
+            Shader::Direct {
+                max_specular: 32,
+                light_samples: 1,
+            },
+            1,
+        ),
         a.runs,
         a.json,
     );

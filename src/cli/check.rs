@@ -10,7 +10,9 @@ use glam::{DVec3, Vec3A};
 use rtis::render::estimate::{self, human_seconds};
 use rtis::scene::{self, Scene};
 use rtis::shader::Shader;
-use rtis::world::{Material, MaterialName, Name, Projection, Transform, WorldLight, WorldShape};
+use rtis::world::{
+    Emitter, Material, MaterialName, Name, Projection, Transform, WorldLight, WorldShape,
+};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
@@ -69,6 +71,14 @@ fn shape(s: &WorldShape) -> String {
                 v3(v[2])
             )
         }
+        WorldShape::Rectangle { corner, u, v } => {
+            format!(
+                "Rectangle(corner: {}, u: {}, v: {})",
+                v3(*corner),
+                v3(*u),
+                v3(*v)
+            )
+        }
         WorldShape::Mesh(m) => {
             let list = |vs: &[DVec3]| vs.iter().map(|v| v3(*v)).collect::<Vec<_>>().join(", ");
             let faces: Vec<String> = m
@@ -102,21 +112,25 @@ fn shader(s: &Shader) -> String {
             rgb(*color)
         ),
         Shader::Normal => "Normal".into(),
-        Shader::Direct { max_specular } => format!("Direct(max_specular: {max_specular})"),
+        Shader::Direct {
+            max_specular,
+            light_samples,
+        } => format!("Direct(max_specular: {max_specular}, light_samples: {light_samples})"),
         Shader::Global(g) => format!(
-            "Global(samples: {}, max_depth: {}, ambient: {}, max_specular: {})",
+            "Global(samples: {}, max_depth: {}, ambient: {}, max_specular: {}, light_samples: {})",
             g.samples,
             g.max_depth,
             rgb(g.ambient),
-            g.max_specular
+            g.max_specular,
+            g.light_samples
         ),
         Shader::Path(p) => {
             let depth = p
                 .max_depth
                 .map_or(String::new(), |d| format!("max_depth: {d}, "));
             format!(
-                "Path({depth}rr_depth: {}, sampling: {:?})",
-                p.rr_depth, p.sampling
+                "Path({depth}rr_depth: {}, sampling: {:?}, lights: {:?})",
+                p.rr_depth, p.sampling, p.lights
             )
         }
     }
@@ -156,6 +170,7 @@ pub fn to_ron(scene: &Scene) -> String {
         ("indirect", e.indirect),
         ("ambient", e.ambient),
         ("background", e.background),
+        ("emission", e.emission),
     ]
     .iter()
     .filter_map(|(k, v)| v.map(|v| format!("{k}: {v}")))
@@ -179,7 +194,7 @@ pub fn to_ron(scene: &Scene) -> String {
 
     // One line per entity, in the order of the file.
     let mut entities: Vec<(hecs::Entity, String)> = Vec::new();
-    for (id, name, sh, m, mname, t, light) in scene
+    for (id, name, sh, m, mname, t, light, emitter) in scene
         .world
         .query::<(
             hecs::Entity,
@@ -189,6 +204,7 @@ pub fn to_ron(scene: &Scene) -> String {
             Option<&MaterialName>,
             Option<&Transform>,
             Option<&WorldLight>,
+            Option<&Emitter>,
         )>()
         .iter()
     {
@@ -223,6 +239,13 @@ pub fn to_ron(scene: &Scene) -> String {
                 "light: Point(position: {}, intensity: {})",
                 v3(*position),
                 rgb(*intensity)
+            ));
+        }
+        if let Some(e) = emitter {
+            fields.push(format!(
+                "emitter: Emitter(radiance: {}, two_sided: {})",
+                rgb(e.radiance),
+                e.two_sided
             ));
         }
         entities.push((id, format!("        ({}),", fields.join(", "))));

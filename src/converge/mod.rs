@@ -8,7 +8,7 @@ pub mod warptest;
 
 use crate::material::Model;
 use crate::render::{RenderScene, film::Image, render};
-use crate::sampling::Sampling;
+use crate::sampling::{LightSampling, Sampling};
 use crate::shader::{Global, Path, Shader};
 use std::fmt::Write as _;
 
@@ -59,13 +59,16 @@ pub fn reference_shader() -> Shader {
         max_depth: None,
         rr_depth: 5,
         sampling: Sampling::Brdf,
+        lights: LightSampling::Mis,
     })
 }
 
 /// The ladder for the scene's shader. Course-family shaders (Direct, Global) get the cheapest
 /// rungs first (Direct, then the ambient-only Global), then Global for n in {4, 16, 64} and
 /// D in {1, 2, 3}, then the Path tracer of the same model at growing spp (the unbiased curve the
-/// Global shader approximates). A Path scene gets spp and max-depth ladders.
+/// Global shader approximates). A Path scene gets spp and max-depth ladders; with area lights
+/// under the Physical model, one spp ladder per light strategy (MIS, light sampling only, BRDF
+/// sampling only), so that the plot shows what MIS buys.
 pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
     let mut rungs = Vec::new();
     let rung = |family: &str, label: String, shader, spp| Rung {
@@ -76,8 +79,20 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
     };
     match scene.shader {
         Shader::Path(p) => {
-            for spp in [1, 4, 16, 64, 256] {
-                rungs.push(rung("Path", format!("spp={spp}"), Shader::Path(p), spp));
+            let strategies = if scene.effects.emission && scene.model == Model::Physical {
+                vec![
+                    ("Path MIS", LightSampling::Mis),
+                    ("Path light", LightSampling::Light),
+                    ("Path BRDF", LightSampling::Brdf),
+                ]
+            } else {
+                vec![("Path", p.lights)]
+            };
+            for (family, lights) in strategies {
+                for spp in [1, 4, 16, 64, 256] {
+                    let shader = Shader::Path(Path { lights, ..p });
+                    rungs.push(rung(family, format!("spp={spp}"), shader, spp));
+                }
             }
             for d in [1, 2, 3, 5] {
                 let shader = Shader::Path(Path {
@@ -88,14 +103,21 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
             }
         }
         other => {
-            let (ambient, max_specular) = match other {
-                Shader::Global(g) => (g.ambient, g.max_specular),
-                _ => (glam::Vec3A::splat(0.3), 32),
+            let (ambient, max_specular, light_samples) = match other {
+                Shader::Global(g) => (g.ambient, g.max_specular, g.light_samples),
+                Shader::Direct {
+                    max_specular,
+                    light_samples,
+                } => (glam::Vec3A::splat(0.3), max_specular, light_samples),
+                _ => (glam::Vec3A::splat(0.3), 32, 1),
             };
             rungs.push(rung(
                 "Direct",
                 "direct".into(),
-                Shader::Direct { max_specular },
+                Shader::Direct {
+                    max_specular,
+                    light_samples,
+                },
                 1,
             ));
             let global = |samples, max_depth| {
@@ -104,6 +126,7 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
                     max_depth,
                     ambient,
                     max_specular,
+                    light_samples,
                 })
             };
             rungs.push(rung("Ambient (D=0)", "D=0".into(), global(1, 0), 1));

@@ -1,10 +1,17 @@
 //! The closed set of lights. Each variant lives in its own file; [`Light`] dispatches by `match`.
 //!
 //! [`WorldLight`] is the ECS component (scene units, double precision); [`WorldLight::extract`]
-//! makes the camera-relative [`Light`] that shaders use.
+//! makes the camera-relative [`Light`] that shaders use. Point lights are summed at every
+//! shading point (the course's Eq. 3). Emitting shapes ([`Emitter`]) become [`AreaLight`]s, one
+//! per primitive, gathered in [`Emitters`], which picks one per light sample in proportion to
+//! its power.
 
+mod area;
+mod emitters;
 mod point;
 
+pub use area::{AreaLight, Emitter, Emitting, LightSample};
+pub use emitters::{Emitters, NO_LIGHT};
 pub use point::PointLight;
 
 use glam::{DVec3, Vec3A};

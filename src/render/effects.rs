@@ -3,7 +3,7 @@
 
 use crate::accel::Geometry;
 use crate::effects::{Effects, Switches};
-use crate::light::Light;
+use crate::light::{Emitters, Light};
 use crate::material::Material;
 use crate::shader::Shader;
 use crate::shape::ShapeKind;
@@ -27,6 +27,7 @@ pub fn derive(
     geometry: &Geometry,
     materials: &[Material],
     lights: &[Light],
+    emitters: &Emitters,
     background: Vec3A,
     wanted: &Switches,
 ) -> Derived {
@@ -44,16 +45,18 @@ pub fn derive(
             Shader::Path(_) => true,
             _ => false,
         };
+    let emission = shading && emitters.lights.iter().any(|l| l.power() > 0.0);
     let ambient = has_phong
         && matches!(shader, Shader::Global(g) if g.ambient != Vec3A::ZERO)
         && any_mat(|m| matches!(m, Material::Phong(p) if p.kd != Vec3A::ZERO));
     let possible = Effects {
-        shadows: shading && !lights.is_empty() && !geometry.is_empty() && has_phong,
+        shadows: shading && (!lights.is_empty() || emission) && !geometry.is_empty() && has_phong,
         reflection: shading && (any_mat(|m| matches!(m, Material::Mirror(_))) || has_glass),
         refraction: shading && has_glass,
         indirect,
         ambient,
         background: background != Vec3A::ZERO,
+        emission,
         spheres: has(ShapeKind::Sphere),
         planes: has(ShapeKind::Plane),
         triangles: has(ShapeKind::Triangle),
@@ -76,6 +79,7 @@ pub fn derive(
         indirect: pick("indirect", possible.indirect, wanted.indirect),
         ambient: pick("ambient", possible.ambient, wanted.ambient),
         background: pick("background", possible.background, wanted.background),
+        emission: pick("emission", possible.emission, wanted.emission),
         ..possible
     };
     Derived {

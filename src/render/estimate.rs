@@ -5,7 +5,8 @@
 //! with `L` point lights (shadow rays when the shadows effect is on), a camera ray that meets
 //! a Phong surface traces `1 + L` rays under Direct, and Global adds `n` hemisphere rays at
 //! the first hit, each of which spawns the two rays of the n-bounce rule at every depth below
-//! `D`: `(1 + L) (1 + n (2^D - 1))` in all. The rule counts a scene where every ray meets a
+//! `D`: `(1 + L) (1 + n (2^D - 1))` in all. Area lights add `light_samples` shadow rays per
+//! Phong hit to `L`. The rule counts a scene where every ray meets a
 //! Phong surface; rays that escape trace fewer, mirror and glass chains more. The calibration
 //! measures the real count on samples spread over the image and scales it; where one sample
 //! would take too long to calibrate, it measures a shallower Global and scales by the rule.
@@ -27,21 +28,26 @@ pub const MAX_RAYS_UNFORCED: f64 = 2e11;
 /// Rays per camera sample by the shader's rule, for a scene where every ray meets a Phong
 /// surface; `None` for Path, whose path lengths Russian roulette and the scene decide.
 pub fn rule_rays_per_sample(scene: &RenderScene) -> Option<f64> {
-    let lights = if scene.effects.shadows {
+    let point = if scene.effects.shadows {
         scene.lights.len() as f64
     } else {
         0.0
     };
+    // Shadow rays per Phong hit: one per point light and one per area-light sample.
+    let lights = |light_samples: u32| {
+        let area = scene.effects.shadows && scene.effects.emission;
+        point + if area { light_samples as f64 } else { 0.0 }
+    };
     match scene.shader {
         Shader::Intersection { .. } | Shader::Depth { .. } | Shader::Normal => Some(1.0),
-        Shader::Direct { .. } => Some(1.0 + lights),
+        Shader::Direct { light_samples, .. } => Some(1.0 + lights(light_samples)),
         Shader::Global(g) => {
             let below = if g.max_depth == 0 || !scene.effects.indirect {
                 0.0
             } else {
                 g.samples as f64 * (2f64.powi(g.max_depth as i32) - 1.0)
             };
-            Some((1.0 + lights) * (1.0 + below))
+            Some((1.0 + lights(g.light_samples)) * (1.0 + below))
         }
         Shader::Path(_) => None,
     }

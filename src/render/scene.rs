@@ -4,7 +4,7 @@ use super::output::Transfer;
 use crate::accel::Geometry;
 use crate::camera::Camera;
 use crate::effects::Effects;
-use crate::light::Light;
+use crate::light::{Emitters, Light};
 use crate::material::{Material, Model};
 use crate::sampling::Sampler;
 use crate::shader::{Shader, Tracer};
@@ -80,8 +80,10 @@ pub struct RenderScene {
     pub geometry: Geometry,
     /// Materials, indexed by `Prim::material`.
     pub materials: Vec<Material>,
-    /// Lights.
+    /// Point lights.
     pub lights: Vec<Light>,
+    /// Area lights (emitting primitives), chosen by power.
+    pub emitters: Emitters,
     /// Radiance of escaped rays (zero when the background effect is off).
     pub background: Vec3A,
     /// The shader with its parameters (Global's ambient zero when the ambient effect is off).
@@ -132,6 +134,7 @@ impl RenderScene {
             geometry: &self.geometry,
             materials: &self.materials,
             lights: &self.lights,
+            emitters: &self.emitters,
             background: self.background,
             model: self.model,
             effects: self.effects,

@@ -4,7 +4,8 @@ pub mod hemisphere;
 mod pixel;
 mod rng;
 mod strategy;
+pub mod warp;
 
 pub use pixel::pixel_sample;
 pub use rng::{Sampler, mix};
-pub use strategy::Sampling;
+pub use strategy::{LightSampling, Sampling, power_heuristic};

@@ -13,3 +13,35 @@ pub enum Sampling {
     #[default]
     Brdf,
 }
+
+/// How the Path integrator gathers light from emitting shapes (area lights). Point lights are
+/// always sampled: no direction can hit them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, Serialize)]
+pub enum LightSampling {
+    /// Next-event estimation and BRDF sampling combined by multiple importance sampling with
+    /// the power heuristic (Veach 1997).
+    #[default]
+    Mis,
+    /// Next-event estimation only: emitters hit by BRDF-sampled rays add nothing (after a
+    /// mirror or glass they still do, as no light sample can reach through them).
+    Light,
+    /// BRDF sampling only: emitters add light only when a sampled ray hits them.
+    Brdf,
+}
+
+/// The power heuristic (exponent 2) weight of a sample drawn with density `pdf` from one
+/// strategy when another would have drawn it with density `other`: `pdf^2 / (pdf^2 + other^2)`.
+/// The weights of the two strategies for the same sample sum to 1.
+#[inline]
+pub fn power_heuristic(pdf: f32, other: f32) -> f32 {
+    if pdf.is_infinite() {
+        return 1.0;
+    }
+    // Scaled by the larger density, so that the squares neither overflow nor underflow.
+    let m = pdf.max(other);
+    if m <= 0.0 || m.is_infinite() {
+        return 0.0;
+    }
+    let (a, b) = ((pdf / m) * (pdf / m), (other / m) * (other / m));
+    a / (a + b)
+}

@@ -11,7 +11,7 @@ use super::values::{
 use crate::camera::{Projection, WorldCamera};
 use crate::effects::Switches;
 use crate::geometry::Transform;
-use crate::light::WorldLight;
+use crate::light::{Emitter, WorldLight};
 use crate::material::{Material, Mirror, Phong, Transmissive};
 use crate::mesh::MeshData;
 use crate::render::{Film, MAX_SIDE, MAX_SPP};
@@ -23,10 +23,12 @@ use std::sync::Arc;
 
 pub use crate::material::Model;
 pub use crate::render::output::Transfer;
-pub use crate::sampling::Sampling;
+pub use crate::sampling::{LightSampling, Sampling};
 
 /// Largest hemisphere sample count of the Global shader.
 pub const MAX_GLOBAL_SAMPLES: u32 = 1 << 16;
+/// Largest area-light sample count per shading point.
+pub const MAX_LIGHT_SAMPLES: u32 = 1 << 16;
 /// Largest `max_depth` of the Global shader: its rays grow as `n * 2^(D-1)` per pixel.
 pub const MAX_GLOBAL_DEPTH: u32 = crate::shader::global::MAX_DEPTH;
 /// Largest `max_depth` and `rr_depth` of the Path shader.
@@ -257,11 +259,16 @@ pub enum ShaderDesc {
     },
     /// The unit normal facing the viewer, mapped to a colour as `(n + 1) / 2`.
     Normal,
-    /// Direct light from point lights at Phong hits (Eq. 3); mirrors and glass are followed.
+    /// Direct light from point and area lights at Phong hits (Eq. 3); mirrors and glass are
+    /// followed; emitters are seen.
     Direct {
         /// Longest chain of consecutive mirror/glass bounces, at most 1024 (default 32).
         #[serde(default = "max_specular")]
         max_specular: UpTo<MAX_SPECULAR>,
+        /// Area-light samples per shading point, 1 to 65536 (default 1): more give smoother soft
+        /// shadows. No effect without emitters.
+        #[serde(default = "one")]
+        light_samples: Count<MAX_LIGHT_SAMPLES>,
     },
     /// The assignment's global shader: Eq. 1 with the ambient (Eq. 2), hemisphere (Eq. 4) and
     /// normal-plus-reflection estimators of the indirect term.
@@ -278,6 +285,10 @@ pub enum ShaderDesc {
         /// Longest chain of consecutive mirror/glass bounces, at most 1024 (default 32).
         #[serde(default = "max_specular")]
         max_specular: UpTo<MAX_SPECULAR>,
+        /// Area-light samples per shading point, 1 to 65536 (default 1). No effect without
+        /// emitters.
+        #[serde(default = "one")]
+        light_samples: Count<MAX_LIGHT_SAMPLES>,
     },
     /// The reference path tracer under the scene's `model`.
     Path {
@@ -290,6 +301,11 @@ pub enum ShaderDesc {
         /// Direction sampling at Phong vertices: `Uniform`, `Cosine` or `Brdf` (default).
         #[serde(default)]
         sampling: Sampling,
+        /// How area lights are gathered under the Physical model: `Mis` (default), `Light`
+        /// (next-event estimation only) or `Brdf` (sampled rays only). The Course model always
+        /// samples lights.
+        #[serde(default)]
+        lights: LightSampling,
     },
 }
 
@@ -327,28 +343,36 @@ impl ShaderDesc {
                 color: rgb(color),
             },
             ShaderDesc::Normal => Shader::Normal,
-            ShaderDesc::Direct { max_specular } => Shader::Direct {
+            ShaderDesc::Direct {
+                max_specular,
+                light_samples,
+            } => Shader::Direct {
                 max_specular: max_specular.0,
+                light_samples: light_samples.0,
             },
             ShaderDesc::Global {
                 samples,
                 max_depth,
                 ambient,
                 max_specular,
+                light_samples,
             } => Shader::Global(Global {
                 samples: samples.0,
                 max_depth: max_depth.0,
                 ambient: rgb(ambient),
                 max_specular: max_specular.0,
+                light_samples: light_samples.0,
             }),
             ShaderDesc::Path {
                 max_depth,
                 rr_depth,
                 sampling,
+                lights,
             } => Shader::Path(Path {
                 max_depth: max_depth.map(|d| d.0),
                 rr_depth: rr_depth.0,
                 sampling,
+                lights,
             }),
         }
     }
@@ -463,6 +487,17 @@ pub enum ShapeDesc {
         /// Third vertex.
         c: Point,
     },
+    /// The parallelogram `corner + s u + t v` for `s, t` in [0, 1] (a rectangle when `u` and `v`
+    /// are perpendicular), visible from both sides, with normal `u x v` (the side a one-sided
+    /// emitter lights). `u` and `v` must not be parallel.
+    Rectangle {
+        /// One corner.
+        corner: Point,
+        /// First edge from the corner.
+        u: Point,
+        /// Second edge from the corner.
+        v: Point,
+    },
     /// Triangles sharing a vertex list: `faces` index `vertices` (counter-clockwise winding).
     TriangleMesh {
         /// Vertex positions.
@@ -499,6 +534,11 @@ impl ShapeDesc {
                 normal: normal.0,
             },
             ShapeDesc::Triangle { a, b, c } => WorldShape::Triangle { v: [a.0, b.0, c.0] },
+            ShapeDesc::Rectangle { corner, u, v } => WorldShape::Rectangle {
+                corner: corner.0,
+                u: u.0,
+                v: v.0,
+            },
             ShapeDesc::TriangleMesh {
                 vertices,
                 faces,
@@ -575,6 +615,29 @@ impl LightDesc {
     }
 }
 
+/// An emitter as written: the entity's shape emits `radiance` from its surface (a diffuse area
+/// light).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(rename = "Emitter", deny_unknown_fields)]
+pub struct EmitterDesc {
+    /// Emitted radiance, W/(m^2 sr) per channel, >= 0.
+    pub radiance: Rgb,
+    /// Emit from both sides (default `false`: only on the side the shape's normal points to,
+    /// outward for spheres, `(b - a) x (c - a)` for triangles, `u x v` for rectangles).
+    #[serde(default)]
+    pub two_sided: bool,
+}
+
+impl EmitterDesc {
+    /// The world's emitter component.
+    pub fn to_world(&self) -> Emitter {
+        Emitter {
+            radiance: self.radiance.0.as_vec3a(),
+            two_sided: self.two_sided,
+        }
+    }
+}
+
 /// Effect switches as written in a scene file: `None` (the default) lets rtis decide from the
 /// scene, `false` switches an effect off to trade accuracy for time, `true` asks for it (a
 /// warning when the scene cannot produce it).
@@ -602,6 +665,9 @@ pub struct EffectsDesc {
     /// Background radiance. Off: escaped rays see black.
     #[serde(default)]
     pub background: Option<bool>,
+    /// Light emitted by shapes (area lights). Off: emitters are dark.
+    #[serde(default)]
+    pub emission: Option<bool>,
 }
 
 impl EffectsDesc {
@@ -614,6 +680,7 @@ impl EffectsDesc {
             indirect: self.indirect,
             ambient: self.ambient,
             background: self.background,
+            emission: self.emission,
         }
     }
 }
@@ -639,6 +706,10 @@ pub struct EntityFields {
     /// A light source.
     #[serde(default)]
     pub light: Option<LightDesc>,
+    /// Makes the `shape` an area light (a sphere, triangle, rectangle or mesh; not an infinite
+    /// plane). Without a `material` the shape reflects nothing (black Phong).
+    #[serde(default)]
+    pub emitter: Option<EmitterDesc>,
     /// Placement of the `shape` (default: as written).
     #[serde(default)]
     pub transform: Option<TransformDesc>,
@@ -652,10 +723,17 @@ impl TryFrom<EntityFields> for EntityDesc {
             .as_deref()
             .map(|n| format!("entity \"{n}\""))
             .unwrap_or_else(|| "this entity".into());
-        match (&e.shape, &e.material, &e.light) {
-            (Some(_), None, _) => Err(format!("{label} has a shape but no material")),
-            (None, Some(_), _) => Err(format!("{label} has a material but no shape")),
-            (None, None, None) => Err(format!("{label} has no shape and no light")),
+        match (&e.shape, &e.material, &e.light, &e.emitter) {
+            (Some(_), None, _, None) => Err(format!("{label} has a shape but no material")),
+            (None, Some(_), _, _) => Err(format!("{label} has a material but no shape")),
+            (None, _, _, Some(_)) => Err(format!(
+                "{label} has an emitter but no shape: an emitter makes a shape glow"
+            )),
+            (None, None, None, None) => Err(format!("{label} has no shape and no light")),
+            (Some(ShapeDesc::InfinitePlane { .. }), _, _, Some(_)) => Err(format!(
+                "{label}: an infinite plane cannot be an emitter (it would emit infinite \
+                 power); use a Rectangle"
+            )),
             _ => {
                 if let (Some(ShapeDesc::Sphere { .. }), Some(t)) = (&e.shape, &e.transform) {
                     let s = t.scale.0.abs();
@@ -681,6 +759,14 @@ impl TryFrom<EntityFields> for EntityDesc {
                          none",
                         normals.len(),
                         vertices.len()
+                    ));
+                }
+                if let Some(ShapeDesc::Rectangle { u, v, .. }) = &e.shape
+                    && u.0.cross(v.0).length_squared() == 0.0
+                {
+                    return Err(format!(
+                        "{label}: a Rectangle needs two edges u and v that are not parallel \
+                         (and not zero)"
                     ));
                 }
                 if let Some(ShapeDesc::TriangleMesh {

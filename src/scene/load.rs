@@ -358,6 +358,9 @@ impl Resolved {
             if let Some(light) = &e.light {
                 b.add(light.to_world());
             }
+            if let Some(emitter) = &e.emitter {
+                b.add(emitter.to_world());
+            }
             match &e.material {
                 Some(MaterialDesc::Named(n)) => match self.materials.get(n) {
                     Some((m, _)) => {
@@ -382,6 +385,14 @@ impl Resolved {
                     if let Some(m) = m.to_world() {
                         b.add(m);
                     }
+                }
+                // An emitter without a material reflects nothing.
+                None if e.emitter.is_some() => {
+                    b.add(Material::Phong(crate::material::Phong {
+                        kd: glam::Vec3A::ZERO,
+                        ks: glam::Vec3A::ZERO,
+                        shininess: 1.0,
+                    }));
                 }
                 None => {}
             }

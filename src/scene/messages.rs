@@ -27,6 +27,10 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
                 "Triangle(a: (0, 0, 0), b: (1, 0, 0), c: (0, 1, 0))",
             ),
             (
+                "Rectangle",
+                "Rectangle(corner: (-1, 2, 4), u: (2, 0, 0), v: (0, 0, 2))",
+            ),
+            (
                 "TriangleMesh",
                 "TriangleMesh(vertices: [(0, 0, 0), (1, 0, 0), (0, 1, 0)], faces: [(0, 1, 2)])",
             ),
@@ -93,6 +97,11 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
             ("Brdf", "Brdf"),
         ],
     ),
+    (
+        "LightSampling",
+        "light strategy",
+        &[("Mis", "Mis"), ("Light", "Light"), ("Brdf", "Brdf")],
+    ),
 ];
 
 /// The example of variant `name` of any enum.
@@ -109,10 +118,13 @@ fn field_form(name: &str) -> Option<&'static str> {
     Some(match name {
         "kd" | "ks" => "a reflectance `(r, g, b)`, each channel from 0 to 1",
         "color" => "a colour `(r, g, b)`",
-        "background" | "ambient" | "intensity" => "a colour `(r, g, b)`, each channel >= 0",
-        "center" | "point" | "position" | "look_at" | "a" | "b" | "c" | "translate" => {
+        "background" | "ambient" | "intensity" | "radiance" => {
+            "a colour `(r, g, b)`, each channel >= 0"
+        }
+        "center" | "point" | "position" | "look_at" | "a" | "b" | "c" | "translate" | "corner" => {
             "a point `(x, y, z)`"
         }
+        "u" | "v" => "an edge vector `(x, y, z)`",
         "rotate" => "three angles in degrees `(x, y, z)`",
         "normal" | "up" => "a direction `(x, y, z)`",
         "scale" => "three scale factors `(x, y, z)`",
@@ -509,8 +521,12 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
                     .join(", "),
                 None => one_of(expected),
             };
+            let kinds = match kind.strip_suffix('y') {
+                Some(stem) => format!("{stem}ies"),
+                None => format!("{kind}s"),
+            };
             format!(
-                "unknown {kind} `{found}`.{} The {kind}s are: {list}",
+                "unknown {kind} `{found}`.{} The {kinds} are: {list}",
                 did_you_mean(&found, expected)
             )
         }
@@ -609,7 +625,7 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
 mod tests {
     use super::*;
     use crate::scene::file::{CameraFields, LightDesc, MaterialDesc, ShaderDesc, ShapeDesc};
-    use crate::scene::{Model, file::Sampling, file::Transfer};
+    use crate::scene::{Model, file::LightSampling, file::Sampling, file::Transfer};
     use serde::de::DeserializeOwned;
 
     fn parses<T: DeserializeOwned>(s: &str) -> bool {
@@ -661,7 +677,12 @@ mod tests {
         check("Model", variants::<Model>(), &parses::<Model>);
         check("Transfer", variants::<Transfer>(), &parses::<Transfer>);
         check("Sampling", variants::<Sampling>(), &parses::<Sampling>);
-        assert_eq!(FORMS.len(), 8);
+        check(
+            "LightSampling",
+            variants::<LightSampling>(),
+            &parses::<LightSampling>,
+        );
+        assert_eq!(FORMS.len(), 9);
     }
 
     #[test]

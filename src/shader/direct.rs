@@ -1,5 +1,6 @@
-//! The direct shader (assignments 3 and 4): point lights with hard shadows at Phong surfaces;
-//! mirrors and glass pass on what their single scattered ray sees.
+//! The direct shader (assignments 3 and 4): point lights with hard shadows at Phong surfaces,
+//! area lights with soft shadows from `light_samples` samples; mirrors and glass pass on what
+//! their single scattered ray sees; emitters are seen directly and through mirrors and glass.
 
 use super::Tracer;
 use super::surface::{ChainEnd, direct_light, follow_specular};
@@ -8,11 +9,13 @@ use crate::stats::RayKind;
 use glam::Vec3A;
 
 /// Radiance along a camera ray under direct lighting only.
-pub fn radiance(tr: &mut Tracer, ray: &Ray, max_specular: u32) -> Vec3A {
-    // Follow mirrors and glass to the first Phong surface, carrying their tint.
-    match follow_specular(tr, ray, RayKind::Camera, max_specular) {
+pub fn radiance(tr: &mut Tracer, ray: &Ray, max_specular: u32, light_samples: u32) -> Vec3A {
+    // Follow mirrors and glass to the first Phong surface, carrying their tint and collecting
+    // the emitters they see.
+    let (end, le) = follow_specular(tr, ray, RayKind::Camera, max_specular, true);
+    le + match end {
         // Eq. 3 at the Phong surface.
-        ChainEnd::Phong { si, phong, beta } => beta * direct_light(tr, &si, &phong),
+        ChainEnd::Phong { si, phong, beta } => beta * direct_light(tr, &si, &phong, light_samples),
         // A ray that leaves the scene sees the background.
         ChainEnd::Escaped { beta } => beta * tr.background,
         ChainEnd::Absorbed => Vec3A::ZERO,

@@ -46,12 +46,16 @@ pub struct Global {
     pub ambient: Vec3A,
     /// Longest chain of consecutive mirror/glass bounces, at most [`super::MAX_SPECULAR`].
     pub max_specular: u32,
+    /// Area-light samples per shading point (Eq. 3 with area lights).
+    pub light_samples: u32,
 }
 
 /// Radiance along a camera ray (depth 0).
 pub fn radiance(tr: &mut Tracer, ray: &Ray, g: &Global) -> Vec3A {
-    // Follow mirrors and glass to the first Phong hit; they keep the depth.
-    match follow_specular(tr, ray, RayKind::Camera, g.max_specular) {
+    // Follow mirrors and glass to the first Phong hit; they keep the depth. The camera sees
+    // the emitters on the way.
+    let (end, le) = follow_specular(tr, ray, RayKind::Camera, g.max_specular, true);
+    le + match end {
         ChainEnd::Phong { si, phong, beta } => beta * first_hit(tr, g, &si, &phong),
         ChainEnd::Escaped { beta } => beta * tr.background,
         ChainEnd::Absorbed => Vec3A::ZERO,
@@ -62,8 +66,8 @@ pub fn radiance(tr: &mut Tracer, ray: &Ray, g: &Global) -> Vec3A {
 fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Vec3A {
     let (wo, n, model) = (si.wo, si.n, tr.model);
 
-    // Eq. 3: direct light from the point lights.
-    let l_dir = direct_light(tr, si, phong);
+    // Eq. 3: direct light from the point lights (and the area lights).
+    let l_dir = direct_light(tr, si, phong, g.light_samples);
 
     // Indirect light.
     let l_ind = if g.max_depth == 0 || !tr.effects.indirect {
@@ -112,8 +116,11 @@ fn incident(tr: &mut Tracer, g: &Global, ray: Ray, stack: &mut Vec<Pending>) -> 
     let mut l = Vec3A::ZERO;
     let model = tr.model;
     while let Some(Pending { ray, beta, depth }) = stack.pop() {
-        // Mirrors and glass keep the depth.
-        let (si, phong, beta) = match follow_specular(tr, &ray, RayKind::Indirect, g.max_specular) {
+        // Mirrors and glass keep the depth. An emitter this ray hits first is the direct light
+        // of the hit it left (counted there); one seen through mirrors or glass counts here.
+        let (end, le) = follow_specular(tr, &ray, RayKind::Indirect, g.max_specular, false);
+        l += beta * le;
+        let (si, phong, beta) = match end {
             ChainEnd::Phong { si, phong, beta: b } => (si, phong, beta * b),
             ChainEnd::Escaped { beta: b } => {
                 l += beta * b * tr.background;
@@ -122,7 +129,7 @@ fn incident(tr: &mut Tracer, g: &Global, ray: Ray, stack: &mut Vec<Pending>) -> 
             ChainEnd::Absorbed => continue,
         };
         // Eq. 3 at this hit.
-        let l_dir = direct_light(tr, &si, &phong);
+        let l_dir = direct_light(tr, &si, &phong, g.light_samples);
         if depth >= g.max_depth || !tr.effects.indirect {
             // Eq. 2: the ambient term ends the path.
             l += beta * (l_dir + g.ambient * phong.kd);

@@ -19,7 +19,7 @@ pub use path::Path;
 use crate::accel::Geometry;
 use crate::effects::Effects;
 use crate::geometry::{Hit, Ray};
-use crate::light::Light;
+use crate::light::{Emitters, Light};
 use crate::material::{Material, Model};
 use crate::sampling::Sampler;
 use crate::stats::{RayKind, RayStats};
@@ -49,6 +49,8 @@ pub enum Shader {
     Direct {
         /// Longest chain of consecutive specular bounces, at most [`MAX_SPECULAR`].
         max_specular: u32,
+        /// Area-light samples per shading point.
+        light_samples: u32,
     },
     /// The assignment's global shader (Eq. 1-4).
     Global(Global),
@@ -63,8 +65,10 @@ pub struct Tracer<'a> {
     pub geometry: &'a Geometry,
     /// Materials, indexed by `Prim::material`.
     pub materials: &'a [Material],
-    /// Lights.
+    /// Point lights.
     pub lights: &'a [Light],
+    /// Area lights, indexed by `Prim::light`.
+    pub emitters: &'a Emitters,
     /// Radiance of escaped rays.
     pub background: Vec3A,
     /// Light-transport model.
@@ -103,7 +107,10 @@ pub fn radiance(shader: &Shader, tr: &mut Tracer, ray: &Ray) -> Vec3A {
             color,
         } => depth::radiance(tr, ray, max_distance, color),
         Shader::Normal => normal::radiance(tr, ray),
-        Shader::Direct { max_specular } => direct::radiance(tr, ray, max_specular),
+        Shader::Direct {
+            max_specular,
+            light_samples,
+        } => direct::radiance(tr, ray, max_specular, light_samples),
         Shader::Global(g) => global::radiance(tr, ray, &g),
         Shader::Path(p) => path::radiance(tr, ray, &p),
     }

@@ -5,6 +5,12 @@
 //! are followed exactly; Russian roulette ends paths after `rr_depth` bounces; escaped rays see
 //! the background.
 //!
+//! Area lights are gathered by the strategy `lights`: one light sample per Phong vertex
+//! (next-event estimation), the emitters that BRDF-sampled rays hit, or both weighted by the
+//! power heuristic (MIS). Under the Course model the indirect weights estimate a different
+//! integral from Eq. 3 (`r / (2 pi)^2`), so the two cannot be combined: area lights are then
+//! light-sampled only, as the course's Eq. 3 treats point lights.
+//!
 //! Under each model a bounce estimates an integral over the hemisphere of `L_i(wi) g(wi) dwi`,
 //! with weight `g(wi) / pdf(wi)`:
 //!
@@ -17,13 +23,16 @@
 //!   by `eta^2 = (n_wo / n_wi)^2`, as radiance does (`docs/transport.md`).
 
 use super::Tracer;
-use super::surface::{Interaction, direct_light, reflectance, specular_bounce};
+use super::surface::{
+    Interaction, area_lights, emitted, point_lights, reflectance, specular_bounce,
+};
+pub use super::surface::{brdf_pdf as pdf, diffuse_probability};
 use crate::geometry::{Frame, Ray};
 use crate::material::{Material, Model, Phong, fresnel_dielectric, reflect};
-use crate::sampling::{Sampling, hemisphere};
+use crate::sampling::{LightSampling, Sampling, hemisphere, power_heuristic};
 use crate::stats::RayKind;
 use glam::Vec3A;
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::TAU;
 
 /// Parameters of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,6 +43,27 @@ pub struct Path {
     pub rr_depth: u32,
     /// Direction sampling at Phong vertices.
     pub sampling: Sampling,
+    /// How area lights are gathered (the Physical model; the Course model samples lights).
+    pub lights: LightSampling,
+}
+
+impl Path {
+    /// The strategy actually used under `model`: [`LightSampling::Light`] under the Course
+    /// model, `lights` under the Physical one.
+    pub fn lights_under(&self, model: Model) -> LightSampling {
+        match model {
+            Model::Course => LightSampling::Light,
+            Model::Physical => self.lights,
+        }
+    }
+}
+
+/// The Phong vertex a BRDF-sampled ray left: where it was and the density of its direction,
+/// for weighting the emitter the ray hits.
+#[derive(Clone, Copy, Debug)]
+struct Scattered {
+    p: Vec3A,
+    pdf: f32,
 }
 
 /// Hard cap on bounces even without `max_depth` (two perfect mirrors facing each other), and
@@ -43,12 +73,16 @@ pub const MAX_DEPTH: u32 = 1024;
 /// Radiance along a camera ray. Scattering into an effect that is off ends the path.
 pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     let model = tr.model;
+    let lights = p.lights_under(model);
     let max_depth = p.max_depth.unwrap_or(MAX_DEPTH).min(MAX_DEPTH);
     let mut l = Vec3A::ZERO;
     let mut beta = Vec3A::ONE;
     let mut ray = *camera_ray;
     let mut kind = RayKind::Camera;
     let mut depth = 0;
+    // The Phong vertex the ray left, if it was BRDF-sampled there (None for camera rays and
+    // after mirrors and glass).
+    let mut scattered: Option<Scattered> = None;
     loop {
         // Escaped rays see the background.
         let Some(hit) = tr.trace(&ray, kind) else {
@@ -56,20 +90,41 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
             break;
         };
         let si = Interaction::new(tr, &ray, hit);
+        // Emitted light L_e, weighted against the light sample that could have found it.
+        let le = emitted(tr, &si);
+        if le != Vec3A::ZERO {
+            let w = match (scattered, lights) {
+                (None, _) | (Some(_), LightSampling::Brdf) => 1.0,
+                (Some(_), LightSampling::Light) => 0.0,
+                (Some(v), LightSampling::Mis) => {
+                    let light = &tr.emitters.lights[si.light as usize];
+                    let pdf_light =
+                        tr.emitters.pmf(si.light as usize) * light.pdf(v.p, si.hit.p, si.hit.n);
+                    power_heuristic(v.pdf, pdf_light)
+                }
+            };
+            l += beta * le * w;
+        }
         if depth >= max_depth {
             break;
         }
         // Scatter: the next ray, its weight g(wi) / pdf(wi) and its kind.
         let (next_ray, weight, next) = match (si.material, model) {
             (Material::Phong(phong), _) => {
-                // Next-event estimation: Eq. 3 under the model.
-                l += beta * direct_light(tr, &si, &phong);
+                // Next-event estimation: Eq. 3 under the model, and one area-light sample.
+                l += beta * point_lights(tr, &si, &phong);
+                let mis = (lights == LightSampling::Mis).then_some(p.sampling);
+                if lights != LightSampling::Brdf {
+                    l += beta * area_lights(tr, &si, &phong, 1, mis);
+                }
                 if !tr.effects.indirect {
                     break;
                 }
-                let Some((wi, weight)) = sample_phong(tr, &phong, &si, model, p.sampling) else {
+                let Some((wi, weight, pdf)) = sample_phong(tr, &phong, &si, model, p.sampling)
+                else {
                     break;
                 };
+                scattered = Some(Scattered { p: si.hit.p, pdf });
                 (si.spawn(wi), weight, RayKind::Indirect)
             }
             // Fresnel-weighted choice between reflection and refraction.
@@ -88,11 +143,15 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                 if !on {
                     break;
                 }
+                scattered = None;
                 (si.spawn(wi), weight, kind)
             }
             // Mirrors, and the course's glass: the one scattered ray, as in Direct and Global.
             _ => match specular_bounce(&si, tr.effects) {
-                Some(bounce) => bounce,
+                Some(bounce) => {
+                    scattered = None;
+                    bounce
+                }
                 None => break,
             },
         };
@@ -112,14 +171,15 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     l
 }
 
-/// Sample a direction at a Phong vertex; `None` when it falls below the surface or has no weight.
+/// Sample a direction at a Phong vertex: the direction, its weight `g / pdf` and its density;
+/// `None` when it falls below the surface or has no weight.
 fn sample_phong(
     tr: &mut Tracer,
     phong: &Phong,
     si: &Interaction,
     model: Model,
     sampling: Sampling,
-) -> Option<(Vec3A, Vec3A)> {
+) -> Option<(Vec3A, Vec3A, f32)> {
     let (wo, n) = (si.wo, si.n);
     let frame = Frame::from_normal(n);
     let (u1, u2) = tr.sampler.next_2d();
@@ -148,28 +208,5 @@ fn sample_phong(
         Model::Course => reflectance(model, phong, wi, wo, n) / (TAU * TAU),
         Model::Physical => reflectance(model, phong, wi, wo, n),
     };
-    Some((wi, g / pdf))
-}
-
-/// Probability of picking the diffuse lobe in BRDF sampling: the lobes' share of `kd + ks`.
-pub fn diffuse_probability(phong: &Phong) -> f32 {
-    let (d, s) = (phong.kd.element_sum(), phong.ks.element_sum());
-    if d + s <= 0.0 { 1.0 } else { d / (d + s) }
-}
-
-/// Density per solid angle of direction `wi` under each strategy.
-pub fn pdf(phong: &Phong, wo: Vec3A, n: Vec3A, wi: Vec3A, sampling: Sampling) -> f32 {
-    let cos_i = wi.dot(n);
-    if cos_i <= 0.0 {
-        return 0.0;
-    }
-    match sampling {
-        Sampling::Uniform => hemisphere::UNIFORM_PDF,
-        Sampling::Cosine => hemisphere::cosine_pdf(cos_i),
-        Sampling::Brdf => {
-            let pd = diffuse_probability(phong);
-            let cos_a = wi.dot(reflect(wo, n));
-            pd * cos_i / PI + (1.0 - pd) * hemisphere::phong_lobe_pdf(cos_a, phong.shininess)
-        }
-    }
+    Some((wi, g / pdf, pdf))
 }

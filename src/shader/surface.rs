@@ -1,13 +1,17 @@
 //! Shading pieces shared by the Direct, Global and Path shaders: the local frame at a hit, the
-//! direct light from point lights (Eq. 3), the reflectance under each model, the single
-//! scattered ray of a mirror or glass, and the loop that follows a chain of them.
+//! direct light from point and area lights (Eq. 3), the light a surface emits, the reflectance
+//! under each model and its sampling densities, the single scattered ray of a mirror or glass,
+//! and the loop that follows a chain of them.
 
 use super::Tracer;
 use crate::effects::Effects;
 use crate::geometry::{Hit, Origins, Ray};
-use crate::material::{Material, Model, Phong};
+use crate::light::NO_LIGHT;
+use crate::material::{Material, Model, Phong, reflect};
+use crate::sampling::{Sampling, hemisphere, power_heuristic};
 use crate::stats::RayKind;
 use glam::Vec3A;
+use std::f32::consts::PI;
 
 /// A hit seen from the ray that found it.
 #[derive(Clone, Copy, Debug)]
@@ -23,6 +27,8 @@ pub struct Interaction {
     pub material: Material,
     /// Where rays leaving the hit start.
     pub origins: Origins,
+    /// The surface's area light, or [`NO_LIGHT`].
+    pub light: u32,
 }
 
 impl Interaction {
@@ -41,6 +47,7 @@ impl Interaction {
             n,
             material: tr.materials[prim.material as usize],
             origins: Origins::new(&hit),
+            light: prim.light,
         }
     }
 
@@ -61,12 +68,29 @@ pub fn reflectance(model: Model, phong: &Phong, wi: Vec3A, wo: Vec3A, n: Vec3A) 
     }
 }
 
+/// Radiance the surface of `si` emits towards the viewer, `L_e(p, wo)`: zero unless it is an
+/// area light facing `wo` (or two-sided) and emission is on.
+#[inline]
+pub fn emitted(tr: &Tracer, si: &Interaction) -> Vec3A {
+    if si.light == NO_LIGHT || !tr.effects.emission {
+        return Vec3A::ZERO;
+    }
+    tr.emitters.lights[si.light as usize].emitted(si.hit.n, si.wo)
+}
+
+/// Eq. 3 with area lights: the point lights' sum ([`point_lights`]) plus the area lights'
+/// integral estimated with `light_samples` samples ([`area_lights`]).
+#[inline]
+pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light_samples: u32) -> Vec3A {
+    point_lights(tr, si, phong) + area_lights(tr, si, phong, light_samples, None)
+}
+
 /// Eq. 3: `L_dir = sum_s L_i^s r(wi^s, wo) V^s` over the point lights. A light counts only when
 /// it is above the surface (`wi.n > 0`) and the shadow ray reaches it.
 ///
 /// Without shadows (`effects: (shadows: false)`) every light facing the point counts.
 #[inline]
-pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
+pub fn point_lights(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
     let mut l_dir = Vec3A::ZERO;
     let model = tr.model;
     for light in tr.lights {
@@ -86,6 +110,79 @@ pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
         }
     }
     l_dir
+}
+
+/// The area lights' share of Eq. 3, `int L_e(wi) r(wi, wo) V(wi) dwi` over the directions that
+/// reach an emitter (`f cos` in place of `r` under the Physical model), estimated with `samples`
+/// light samples: each picks one light by power and a point on it, and weighs
+/// `L_e r V / (P(light) pdf(wi))`.
+///
+/// With `mis` (the BRDF sampling strategy of a path tracer), each sample is also weighted by the
+/// power heuristic against the density with which that strategy would pick `wi`; the path
+/// tracer's BRDF-sampled hits on emitters take the complementary weight.
+#[inline]
+pub fn area_lights(
+    tr: &mut Tracer,
+    si: &Interaction,
+    phong: &Phong,
+    samples: u32,
+    mis: Option<Sampling>,
+) -> Vec3A {
+    if !tr.effects.emission || tr.emitters.is_empty() || samples == 0 {
+        return Vec3A::ZERO;
+    }
+    let model = tr.model;
+    let mut sum = Vec3A::ZERO;
+    for _ in 0..samples {
+        // Choose a light by power, then a point on it.
+        let u = tr.sampler.next_f32();
+        let (u1, u2) = tr.sampler.next_2d();
+        let Some((light, pmf)) = tr.emitters.choose(u) else {
+            break;
+        };
+        let Some(ls) = light.sample(si.hit.p, u1, u2) else {
+            continue;
+        };
+        if ls.le == Vec3A::ZERO || ls.wi.dot(si.n) <= 0.0 {
+            continue;
+        }
+        let pdf = pmf * ls.pdf;
+        // Shadow ray V: stop just short of the sampled point.
+        let visible =
+            !tr.effects.shadows || tr.unoccluded(&si.origins.ray(ls.wi, ls.dist * SHADOW_END));
+        if !visible {
+            continue;
+        }
+        let w = match mis {
+            Some(sampling) => power_heuristic(pdf, brdf_pdf(phong, si.wo, si.n, ls.wi, sampling)),
+            None => 1.0,
+        };
+        sum += ls.le * reflectance(model, phong, ls.wi, si.wo, si.n) * (w / pdf);
+    }
+    sum / samples as f32
+}
+
+/// Probability of picking the diffuse lobe in BRDF sampling: the lobes' share of `kd + ks`.
+pub fn diffuse_probability(phong: &Phong) -> f32 {
+    let (d, s) = (phong.kd.element_sum(), phong.ks.element_sum());
+    if d + s <= 0.0 { 1.0 } else { d / (d + s) }
+}
+
+/// Density per solid angle of direction `wi` at a Phong vertex under each sampling strategy.
+pub fn brdf_pdf(phong: &Phong, wo: Vec3A, n: Vec3A, wi: Vec3A, sampling: Sampling) -> f32 {
+    let cos_i = wi.dot(n);
+    if cos_i <= 0.0 {
+        return 0.0;
+    }
+    match sampling {
+        Sampling::Uniform => hemisphere::UNIFORM_PDF,
+        Sampling::Cosine => hemisphere::cosine_pdf(cos_i),
+        Sampling::Brdf => {
+            let pd = diffuse_probability(phong);
+            let cos_a = wi.dot(reflect(wo, n));
+            pd * cos_i / PI + (1.0 - pd) * hemisphere::phong_lobe_pdf(cos_a, phong.shininess)
+        }
+    }
 }
 
 /// Shadow rays end at this fraction of the distance to the light.
@@ -151,17 +248,32 @@ pub enum ChainEnd {
 /// Trace `ray` (counted as `kind`) and follow mirrors and glass, as a loop carrying the
 /// throughput, until a Phong surface, an escape, or `max_specular` consecutive specular
 /// bounces (the course's model: mirrors reflect, glass refracts or reflects totally, tinted).
+///
+/// Also returns the light emitted towards the ray by the surfaces of the chain, weighted by the
+/// chain's throughput. The first surface's emission counts only when `see_first` (a camera ray;
+/// an indirect ray's emitter is the direct light of the vertex it left, already counted); after
+/// a mirror or glass every emitter counts, as no light sample reaches through them.
 #[inline]
-pub fn follow_specular(tr: &mut Tracer, ray: &Ray, kind: RayKind, max_specular: u32) -> ChainEnd {
+pub fn follow_specular(
+    tr: &mut Tracer,
+    ray: &Ray,
+    kind: RayKind,
+    max_specular: u32,
+    see_first: bool,
+) -> (ChainEnd, Vec3A) {
     let (mut ray, mut kind, mut beta) = (*ray, kind, Vec3A::ONE);
+    let mut le = Vec3A::ZERO;
     // `chain` counts the specular bounces that led to this ray.
     for chain in 0..=max_specular {
         let Some(hit) = tr.trace(&ray, kind) else {
-            return ChainEnd::Escaped { beta };
+            return (ChainEnd::Escaped { beta }, le);
         };
         let si = Interaction::new(tr, &ray, hit);
+        if see_first || chain > 0 {
+            le += beta * emitted(tr, &si);
+        }
         if let Material::Phong(phong) = si.material {
-            return ChainEnd::Phong { si, phong, beta };
+            return (ChainEnd::Phong { si, phong, beta }, le);
         }
         if chain == max_specular {
             break;
@@ -172,5 +284,5 @@ pub fn follow_specular(tr: &mut Tracer, ray: &Ray, kind: RayKind, max_specular: 
         beta *= tint;
         (ray, kind) = (next, next_kind);
     }
-    ChainEnd::Absorbed
+    (ChainEnd::Absorbed, le)
 }

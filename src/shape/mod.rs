@@ -44,6 +44,16 @@ pub enum WorldShape {
         /// Vertices; the normal follows the winding `(v1 - v0) x (v2 - v0)`.
         v: [DVec3; 3],
     },
+    /// The parallelogram `corner + s u + t v`, `s, t` in [0, 1], two-sided, with normal
+    /// `u x v`; rendered as two triangles.
+    Rectangle {
+        /// One corner.
+        corner: DVec3,
+        /// First edge from the corner.
+        u: DVec3,
+        /// Second edge from the corner.
+        v: DVec3,
+    },
     /// Indexed triangles with optional vertex normals (loaded from a file or written inline).
     Mesh(Arc<MeshData>),
 }
@@ -55,6 +65,7 @@ impl WorldShape {
             WorldShape::Sphere { center, .. } => vec![center],
             WorldShape::Plane { point, .. } => vec![point],
             WorldShape::Triangle { v } => v.iter_mut().collect(),
+            WorldShape::Rectangle { corner, .. } => vec![corner],
             WorldShape::Mesh(m) => Arc::make_mut(m).positions.iter_mut().collect(),
         }
     }
@@ -81,6 +92,12 @@ impl WorldShape {
                 push(Shape::Plane(Plane::placed(*point, *normal, at)), None)
             }
             WorldShape::Triangle { v } => triangle(v.map(|p| at.point(p)), None),
+            WorldShape::Rectangle { corner, u, v } => {
+                // Both triangles wind as u x v: (u, u + v) and (u + v, v).
+                let [a, b, c, d] = [*corner, corner + u, corner + u + v, corner + v];
+                triangle([a, b, c].map(|p| at.point(p)), None);
+                triangle([a, c, d].map(|p| at.point(p)), None);
+            }
             WorldShape::Mesh(m) => {
                 let v: Vec<Vec3A> = m.positions.iter().map(|p| at.point(*p)).collect();
                 let n: Vec<Vec3A> = m.normals.iter().map(|d| at.normal(*d)).collect();

@@ -8,6 +8,7 @@
 //! - [`MaterialName`]: the `materials` table entry the material came from.
 //! - [`Transform`]: placement of the entity's shape.
 //! - [`WorldLight`]: a light source in scene units.
+//! - [`Emitter`]: makes the entity's shape an area light.
 //!
 //! Nothing here knows the file format or rays; the extraction step (`extract.rs`) turns a
 //! [`Scene`] into render data.
@@ -15,7 +16,7 @@
 pub use crate::camera::{Projection, WorldCamera};
 pub use crate::effects::Switches;
 pub use crate::geometry::Transform;
-pub use crate::light::WorldLight;
+pub use crate::light::{Emitter, WorldLight};
 pub use crate::material::{Material, Model};
 pub use crate::render::Film;
 pub use crate::shader::Shader;
@@ -55,7 +56,10 @@ impl Default for Settings {
                 look_at: DVec3::Z,
                 up: DVec3::Y,
             },
-            shader: Shader::Direct { max_specular: 32 },
+            shader: Shader::Direct {
+                max_specular: 32,
+                light_samples: 1,
+            },
             background: Vec3A::ZERO,
             seed: 0,
             model: Model::Course,

@@ -1,0 +1,171 @@
+//! Area lights: shapes that emit a constant radiance from their surface (diffuse emitters).
+//!
+//! Each emitting primitive (a sphere, or one triangle of a rectangle or mesh) is one
+//! [`AreaLight`]. Spheres are sampled by the cone of directions they subtend (uniformly in solid
+//! angle, pbrt-v4's method) from outside, and uniformly by area from inside; triangles uniformly
+//! by area. Every pdf here is per unit solid angle at the shaded point.
+
+use crate::sampling::warp::{cone_one_minus_cos, uniform_sphere, uniform_triangle};
+use crate::shape::{Sphere, Triangle};
+use glam::Vec3A;
+use std::f32::consts::{PI, TAU};
+
+/// The emitter component of an entity: its shape emits `radiance` on the side its normal points
+/// to (outward for spheres, `(b - a) x (c - a)` for triangles, `u x v` for rectangles), or on
+/// both sides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emitter {
+    /// Emitted radiance, W/(m^2 sr) per channel, >= 0.
+    pub radiance: Vec3A,
+    /// Emit from both sides of the surface.
+    pub two_sided: bool,
+}
+
+/// The shape of an area light, in render coordinates.
+#[derive(Clone, Copy, Debug)]
+pub enum Emitting {
+    /// A sphere.
+    Sphere(Sphere),
+    /// A triangle (of a triangle, rectangle or mesh).
+    Triangle(Triangle),
+}
+
+/// One emitting primitive.
+#[derive(Clone, Copy, Debug)]
+pub struct AreaLight {
+    /// Its shape.
+    pub shape: Emitting,
+    /// Its emission.
+    pub emitter: Emitter,
+}
+
+/// A point sampled on an area light, seen from the shaded point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shaded point towards the sampled point.
+    pub wi: Vec3A,
+    /// Distance to the sampled point.
+    pub dist: f32,
+    /// Radiance the light emits towards the shaded point (zero from a one-sided light's back).
+    pub le: Vec3A,
+    /// Density of `wi` per unit solid angle.
+    pub pdf: f32,
+}
+
+impl AreaLight {
+    /// Surface area.
+    pub fn area(&self) -> f32 {
+        match self.shape {
+            Emitting::Sphere(s) => 4.0 * PI * s.r * s.r,
+            Emitting::Triangle(t) => triangle_area(&t),
+        }
+    }
+
+    /// Emitted power of a Lambertian emitter, `pi A L` per side, averaged over the channels:
+    /// the weight of this light when one is chosen per shading point.
+    pub fn power(&self) -> f32 {
+        let sides = if self.emitter.two_sided { 2.0 } else { 1.0 };
+        PI * self.area() * sides * self.emitter.radiance.element_sum() / 3.0
+    }
+
+    /// Radiance leaving the surface of geometric normal `n` in direction `w` (unit, away from
+    /// the surface).
+    #[inline]
+    pub fn emitted(&self, n: Vec3A, w: Vec3A) -> Vec3A {
+        if self.emitter.two_sided || n.dot(w) > 0.0 {
+            self.emitter.radiance
+        } else {
+            Vec3A::ZERO
+        }
+    }
+
+    /// Sample a direction from `p` towards the light with `u1, u2` uniform in [0, 1); `None`
+    /// when the sample has no density (`p` on the light, an edge-on triangle).
+    #[inline]
+    pub fn sample(&self, p: Vec3A, u1: f32, u2: f32) -> Option<LightSample> {
+        let (q, nq, pdf) = match self.shape {
+            Emitting::Sphere(s) => {
+                let f = s.c - p;
+                let d2 = f.length_squared();
+                let r2 = s.r * s.r;
+                if d2 <= r2 {
+                    // Inside: uniform by area, converted to solid angle below.
+                    let n = uniform_sphere(u1, u2);
+                    (s.c + s.r * n, n, None)
+                } else {
+                    // Outside: uniform in the cone of directions the sphere subtends.
+                    let sin2_max = r2 / d2;
+                    let one_minus_cos_max = cone_one_minus_cos(sin2_max);
+                    // theta: the angle of wi from the axis towards the centre.
+                    let sin2 = u1 * (2.0 - one_minus_cos_max * u1) * one_minus_cos_max;
+                    let cos_t = 1.0 - u1 * one_minus_cos_max;
+                    // alpha: the angle at the centre between the axis back to p and the
+                    // sampled point's normal (pbrt-v4, Sphere::Sample).
+                    let sin_max = sin2_max.sqrt();
+                    let cos_a = sin2 / sin_max + cos_t * (1.0 - sin2 / sin2_max).max(0.0).sqrt();
+                    let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
+                    let (sin_p, cos_p) = (TAU * u2).sin_cos();
+                    let frame = crate::geometry::Frame::from_normal(-f / d2.sqrt());
+                    let n = frame
+                        .to_world(Vec3A::new(sin_a * cos_p, sin_a * sin_p, cos_a))
+                        .normalize();
+                    (s.c + s.r * n, n, Some(1.0 / (TAU * one_minus_cos_max)))
+                }
+            }
+            Emitting::Triangle(t) => {
+                let [b0, b1, b2] = uniform_triangle(u1, u2);
+                (b0 * t.v[0] + b1 * t.v[1] + b2 * t.v[2], t.n, None)
+            }
+        };
+        let to = q - p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 || !d2.is_finite() {
+            return None;
+        }
+        let dist = d2.sqrt();
+        let wi = to / dist;
+        let pdf = match pdf {
+            Some(pdf) => pdf,
+            None => area_to_solid_angle(self.area(), d2, nq.dot(wi).abs())?,
+        };
+        Some(LightSample {
+            wi,
+            dist,
+            le: self.emitted(nq, -wi),
+            pdf,
+        })
+    }
+
+    /// Density per unit solid angle with which [`AreaLight::sample`] from `p` picks the
+    /// direction towards `q`, a point of this light with geometric normal `nq` (the nearest hit
+    /// of the ray from `p`); 0 when it cannot.
+    #[inline]
+    pub fn pdf(&self, p: Vec3A, q: Vec3A, nq: Vec3A) -> f32 {
+        let to = q - p;
+        let d2 = to.length_squared();
+        if d2 == 0.0 || !d2.is_finite() {
+            return 0.0;
+        }
+        if let Emitting::Sphere(s) = self.shape {
+            let dc2 = (s.c - p).length_squared();
+            if dc2 > s.r * s.r {
+                return 1.0 / (TAU * cone_one_minus_cos(s.r * s.r / dc2));
+            }
+        }
+        let cos_q = nq.dot(to).abs() / d2.sqrt();
+        area_to_solid_angle(self.area(), d2, cos_q).unwrap_or(0.0)
+    }
+}
+
+/// The solid-angle density of a point uniform on area `a`, seen at squared distance `d2` at
+/// cosine `cos_q` to its surface: `d^2 / (a cos)`; `None` edge-on.
+#[inline]
+fn area_to_solid_angle(a: f32, d2: f32, cos_q: f32) -> Option<f32> {
+    let pdf = d2 / (a * cos_q);
+    (cos_q > 0.0 && pdf.is_finite()).then_some(pdf)
+}
+
+/// Area of a triangle.
+fn triangle_area(t: &Triangle) -> f32 {
+    0.5 * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).length()
+}

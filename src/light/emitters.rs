@@ -1,0 +1,67 @@
+//! The scene's area lights, chosen one per light sample in proportion to their power.
+
+use super::AreaLight;
+
+/// [`crate::light`]'s index of a primitive that emits nothing.
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// Every area light of a render, with the cumulative distribution of their powers.
+#[derive(Clone, Debug, Default)]
+pub struct Emitters {
+    /// The lights; a primitive refers to its light by index here.
+    pub lights: Vec<AreaLight>,
+    /// `cdf[i]`: the power of lights `0..=i` over the total; the last is 1.
+    cdf: Vec<f32>,
+}
+
+impl Emitters {
+    /// The set of `lights`, each chosen with probability proportional to its power (uniformly
+    /// if none has any).
+    pub fn new(lights: Vec<AreaLight>) -> Self {
+        let powers: Vec<f64> = lights.iter().map(|l| l.power() as f64).collect();
+        let total: f64 = powers.iter().sum();
+        let mut acc = 0.0;
+        let mut cdf: Vec<f32> = powers
+            .iter()
+            .map(|&w| {
+                acc += if total > 0.0 { w / total } else { 1.0 };
+                acc as f32
+            })
+            .collect();
+        let n = cdf.len() as f32;
+        if total <= 0.0 {
+            cdf.iter_mut().for_each(|c| *c /= n);
+        }
+        if let Some(last) = cdf.last_mut() {
+            *last = 1.0;
+        }
+        Emitters { lights, cdf }
+    }
+
+    /// True when the scene has no area light.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.lights.is_empty()
+    }
+
+    /// Probability that [`Emitters::choose`] picks light `i`.
+    #[inline]
+    pub fn pmf(&self, i: usize) -> f32 {
+        let below = if i == 0 { 0.0 } else { self.cdf[i - 1] };
+        self.cdf[i] - below
+    }
+
+    /// The light that `u`, uniform in [0, 1), picks, with its probability: the first whose
+    /// cumulative share exceeds `u` (a light of zero power is never picked).
+    #[inline]
+    pub fn choose(&self, u: f32) -> Option<(&AreaLight, f32)> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .min(self.lights.len() - 1);
+        Some((&self.lights[i], self.pmf(i)))
+    }
+}

@@ -1,0 +1,41 @@
+//! Warps onto shapes, for sampling area lights: the whole sphere, a cone of directions, and a
+//! triangle, each uniform in its own measure.
+
+use glam::Vec3A;
+use std::f32::consts::TAU;
+
+/// Uniform direction on the unit sphere: `z = 1 - 2 u1`, `phi = 2 pi u2`. Density `1 / (4 pi)`.
+#[inline]
+pub fn uniform_sphere(u1: f32, u2: f32) -> Vec3A {
+    let z = 1.0 - 2.0 * u1;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (sin_p, cos_p) = (TAU * u2).sin_cos();
+    Vec3A::new(r * cos_p, r * sin_p, z)
+}
+
+/// Uniform barycentric coordinates `(b0, b1, b2)` on a triangle (Heitz 2019, the low-distortion
+/// map pbrt-v4 uses): a point `b0 v0 + b1 v1 + b2 v2` is uniform in area.
+#[inline]
+pub fn uniform_triangle(u1: f32, u2: f32) -> [f32; 3] {
+    let (b0, b1) = if u1 < u2 {
+        let b0 = u1 / 2.0;
+        (b0, u2 - b0)
+    } else {
+        let b1 = u2 / 2.0;
+        (u1 - b1, b1)
+    };
+    [b0, b1, (1.0 - b0 - b1).max(0.0)]
+}
+
+/// `1 - cos(theta_max)` of the cone a sphere of radius `r` subtends from a point at squared
+/// distance `d2 > r^2` from its centre, with `sin^2(theta_max) = r^2 / d2`. For small cones the
+/// direct form cancels; below `sin^2 = 6.9e-4` (pbrt-v4's threshold) the Taylor series
+/// `sin^2 / 2` is exact to f32.
+#[inline]
+pub fn cone_one_minus_cos(sin2_max: f32) -> f32 {
+    if sin2_max < 0.00068523 {
+        sin2_max / 2.0
+    } else {
+        1.0 - (1.0 - sin2_max).max(0.0).sqrt()
+    }
+}
