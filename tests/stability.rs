@@ -199,6 +199,23 @@ mod random_scenes {
                 at(s, t, b),
                 at(s, t, c)
             )),
+            (unit_point(), unit_point(), unit_point()).prop_filter_map(
+                "parallel edges",
+                move |(c, u, v)| {
+                    (u.cross(v).length() > 1e-3).then(|| {
+                        format!(
+                            "Rectangle(corner: {}, u: ({}, {}, {}), v: ({}, {}, {}))",
+                            at(s, t, c),
+                            num(u.x * s),
+                            num(u.y * s),
+                            num(u.z * s),
+                            num(v.x * s),
+                            num(v.y * s),
+                            num(v.z * s)
+                        )
+                    })
+                }
+            ),
             (unit_point(), 0.1f64..1.0).prop_map(move |(c, r)| {
                 // An octahedron: a closed mesh.
                 let v: Vec<String> = [
@@ -227,14 +244,17 @@ mod random_scenes {
             Just("Intersection()".to_string()),
             Just(format!("Depth(max_distance: {})", num(20.0 * s))),
             Just("Normal".to_string()),
-            (0u32..40).prop_map(|m| format!("Direct(max_specular: {m})")),
+            (0u32..40, 1u32..4)
+                .prop_map(|(m, k)| format!("Direct(max_specular: {m}, light_samples: {k})")),
             (
                 1u32..4,
                 0u32..4,
-                prop_oneof![Just(0.0), Just(0.3), Just(1e6)]
+                prop_oneof![Just(0.0), Just(0.3), Just(1e6)],
+                1u32..3,
             )
-                .prop_map(|(n, d, a)| format!(
-                    "Global(samples: {n}, max_depth: {d}, ambient: ({}, {}, {}), max_specular: 16)",
+                .prop_map(|(n, d, a, k)| format!(
+                    "Global(samples: {n}, max_depth: {d}, ambient: ({}, {}, {}), max_specular: 16, \
+                     light_samples: {k})",
                     num(a),
                     num(a),
                     num(a)
@@ -245,16 +265,18 @@ mod random_scenes {
                     (0u32..8).prop_map(|d| format!("Some({d})"))
                 ],
                 0u32..6,
-                prop_oneof![Just("Uniform"), Just("Cosine"), Just("Brdf")]
+                prop_oneof![Just("Uniform"), Just("Cosine"), Just("Brdf")],
+                prop_oneof![Just("Mis"), Just("Light"), Just("Brdf")],
             )
-                .prop_map(|(d, rr, smp)| format!(
-                    "Path(max_depth: {d}, rr_depth: {rr}, sampling: {smp})"
+                .prop_map(|(d, rr, smp, lights)| format!(
+                    "Path(max_depth: {d}, rr_depth: {rr}, sampling: {smp}, lights: {lights})"
                 )),
         ]
     }
 
     prop_compose! {
-        /// A random scene: a room of five planes (or none), shapes inside, point lights,
+        /// A random scene: a room of five planes (or none), shapes inside (some emitting), point
+        /// lights,
         /// a perspective or orthographic camera, any shader and model, at scale `s` from 1e-4
         /// to 1e4 and offset up to 1e6.
         fn random_scene()(
@@ -267,7 +289,14 @@ mod random_scenes {
             s in Just(s),
             t in Just(t),
             room in any::<bool>(),
-            shapes in proptest::collection::vec((shape(s, t), material()), 0..5),
+            shapes in proptest::collection::vec(
+                (
+                    shape(s, t),
+                    material(),
+                    proptest::option::of((prop_oneof![Just(1e-3), Just(1.0), Just(1e6)], any::<bool>())),
+                ),
+                0..5,
+            ),
             lights in proptest::collection::vec((unit_point(), prop_oneof![Just(1e-3), Just(7.0), Just(1e6)]), 0..3),
             ortho in any::<bool>(),
             shader in shader(s),
@@ -293,9 +322,17 @@ mod random_scenes {
             } else {
                 String::new()
             };
+            // Any shape but a plane may emit.
             let things: String = shapes
                 .iter()
-                .map(|(sh, m)| format!("(shape: {sh}, material: {m}),"))
+                .map(|(sh, m, e)| match e {
+                    Some((l, two)) if !sh.starts_with("InfinitePlane") => format!(
+                        "(shape: {sh}, material: {m}, emitter: Emitter(radiance: ({l}, {l}, {l}), \
+                         two_sided: {two})),",
+                        l = num(*l)
+                    ),
+                    _ => format!("(shape: {sh}, material: {m}),"),
+                })
                 .collect();
             let lamps: String = lights
                 .iter()

@@ -7,12 +7,15 @@
 //! chi-squared test. The null hypothesis, that the samples follow the pdf, is rejected when the
 //! p-value is below the significance level (0.01, Sidak-corrected for the number of tests).
 //! The discrete Fresnel choice of Physical glass (reflect with probability `F`) is tested the
-//! same way over its two outcomes.
+//! same way over its two outcomes. Area-light sampling (choose a light by power, then a
+//! direction towards it) is tested against `Emitters::pdf_direction` from a point.
 
 use crate::geometry::Frame;
+use crate::light::{AreaLight, Emitter, Emitters, Emitting};
 use crate::material::{Phong, fresnel_dielectric, reflect};
 use crate::sampling::{Sampler, Sampling, hemisphere};
 use crate::shader::path;
+use crate::shape::{Sphere, Triangle};
 use glam::Vec3A;
 use std::f64::consts::PI;
 use std::fmt::Write;
@@ -70,30 +73,53 @@ pub fn direction_bin(w: Vec3A) -> usize {
 /// The probability of each bin under a pdf over directions (per steradian), by the midpoint
 /// rule on 64 x 8 points per bin (`z` finer: lobes around the pole vary fastest in `z`).
 pub fn integrate_pdf(pdf: impl Fn(Vec3A) -> f64) -> Vec<f64> {
-    let (sub_z, sub_phi) = (64, 8);
-    let area = (2.0 / BINS_Z as f64) * (2.0 * PI / BINS_PHI as f64);
-    let mut out = vec![0.0; BINS_Z * BINS_PHI];
-    for t in 0..BINS_Z {
-        for p in 0..BINS_PHI {
-            let mut acc = 0.0;
-            for a in 0..sub_z {
-                for b in 0..sub_phi {
-                    let z =
-                        -1.0 + 2.0 * (t as f64 + (a as f64 + 0.5) / sub_z as f64) / BINS_Z as f64;
-                    let phi =
-                        2.0 * PI * (p as f64 + (b as f64 + 0.5) / sub_phi as f64) / BINS_PHI as f64;
-                    let r = (1.0 - z * z).max(0.0).sqrt();
-                    acc += pdf(Vec3A::new(
-                        (r * phi.cos()) as f32,
-                        (r * phi.sin()) as f32,
-                        z as f32,
-                    ));
-                }
+    (0..BINS_Z * BINS_PHI)
+        .map(|bin| integrate_bin(&pdf, bin, 64, 8))
+        .collect()
+}
+
+/// As [`integrate_pdf`], for a pdf with edges (a light's outline): bins where a coarse 8 x 4
+/// grid sees density, and their neighbours, are integrated on 256 x 64 points, so that a bin
+/// the outline only clips still gets its share; the others have none.
+pub fn integrate_pdf_with_edges(pdf: impl Fn(Vec3A) -> f64) -> Vec<f64> {
+    let coarse: Vec<bool> = (0..BINS_Z * BINS_PHI)
+        .map(|bin| integrate_bin(&pdf, bin, 8, 4) > 0.0)
+        .collect();
+    let lit = |t: isize, p: isize| {
+        (0..BINS_Z as isize).contains(&t)
+            && coarse[t as usize * BINS_PHI + p.rem_euclid(BINS_PHI as isize) as usize]
+    };
+    (0..BINS_Z * BINS_PHI)
+        .map(|bin| {
+            let (t, p) = ((bin / BINS_PHI) as isize, (bin % BINS_PHI) as isize);
+            let near = (-1..=1).any(|dt| (-1..=1).any(|dp| lit(t + dt, p + dp)));
+            if near {
+                integrate_bin(&pdf, bin, 256, 64)
+            } else {
+                0.0
             }
-            out[t * BINS_PHI + p] = acc / (sub_z * sub_phi) as f64 * area;
+        })
+        .collect()
+}
+
+/// The midpoint rule over one bin on `sub_z x sub_phi` points.
+fn integrate_bin(pdf: &impl Fn(Vec3A) -> f64, bin: usize, sub_z: usize, sub_phi: usize) -> f64 {
+    let (t, p) = (bin / BINS_PHI, bin % BINS_PHI);
+    let area = (2.0 / BINS_Z as f64) * (2.0 * PI / BINS_PHI as f64);
+    let mut acc = 0.0;
+    for a in 0..sub_z {
+        for b in 0..sub_phi {
+            let z = -1.0 + 2.0 * (t as f64 + (a as f64 + 0.5) / sub_z as f64) / BINS_Z as f64;
+            let phi = 2.0 * PI * (p as f64 + (b as f64 + 0.5) / sub_phi as f64) / BINS_PHI as f64;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            acc += pdf(Vec3A::new(
+                (r * phi.cos()) as f32,
+                (r * phi.sin()) as f32,
+                z as f32,
+            ));
         }
     }
-    out
+    acc / (sub_z * sub_phi) as f64 * area
 }
 
 /// A direction sampler with the pdf of `path::pdf` for `sampling` (normal +z).
@@ -152,8 +178,94 @@ fn fresnel_case(cos_i: f32, eta: f32) -> Case {
     }
 }
 
+/// Light sampling from the origin towards `lights`, against the density it claims.
+fn light_case(name: &str, lights: Vec<AreaLight>) -> Case {
+    let emitters = Emitters::new(lights);
+    let expected = integrate_pdf_with_edges(|w| emitters.pdf_direction(Vec3A::ZERO, w) as f64);
+    Case {
+        name: name.into(),
+        draw: Box::new(move |s: &mut Sampler| {
+            let u = s.next_f32();
+            let (u1, u2) = s.next_2d();
+            let (light, _) = emitters.choose(u)?;
+            let ls = light.sample(Vec3A::ZERO, u1, u2)?;
+            Some(direction_bin(ls.wi))
+        }),
+        expected,
+        columns: BINS_PHI,
+    }
+}
+
+/// An emitting sphere, one-sided, of radiance `l`.
+fn sphere_light(c: Vec3A, r: f32, l: f32) -> AreaLight {
+    AreaLight {
+        shape: Emitting::Sphere(Sphere { c, r }),
+        emitter: Emitter {
+            radiance: Vec3A::splat(l),
+            two_sided: false,
+        },
+    }
+}
+
+/// An emitting triangle, two-sided, of radiance `l`.
+fn triangle_light(v: [Vec3A; 3], l: f32) -> AreaLight {
+    AreaLight {
+        shape: Emitting::Triangle(Triangle::new(v[0], v[1], v[2]).expect("a triangle")),
+        emitter: Emitter {
+            radiance: Vec3A::splat(l),
+            two_sided: true,
+        },
+    }
+}
+
+/// The light samplers: a sphere's cone from near and far, a sphere from inside (by area), a
+/// triangle by area, and a rectangle (two triangles) with a sphere chosen by power.
+fn light_cases() -> Vec<Case> {
+    let quad = |c: Vec3A, u: Vec3A, v: Vec3A, l| {
+        [
+            triangle_light([c, c + u, c + u + v], l),
+            triangle_light([c, c + u + v, c + v], l),
+        ]
+    };
+    let mut mixed = quad(
+        Vec3A::new(-1.0, 1.0, -0.5),
+        Vec3A::new(2.0, 0.0, 0.0),
+        Vec3A::new(0.0, 0.0, 1.5),
+        1.0,
+    )
+    .to_vec();
+    mixed.push(sphere_light(Vec3A::new(0.3, -0.2, -1.5), 0.7, 2.0));
+    vec![
+        light_case(
+            "sphere light, near (cone of 64 deg)",
+            vec![sphere_light(Vec3A::new(0.2, 0.4, 1.0), 1.0, 1.0)],
+        ),
+        light_case(
+            "sphere light, far (cone of 17 deg)",
+            vec![sphere_light(Vec3A::new(-2.0, 2.0, 1.5), 1.0, 1.0)],
+        ),
+        light_case(
+            "sphere light, from inside (by area)",
+            vec![sphere_light(Vec3A::new(0.3, -0.2, 0.1), 1.0, 1.0)],
+        ),
+        light_case(
+            "triangle light (by area)",
+            vec![triangle_light(
+                [
+                    Vec3A::new(-1.0, -0.5, 0.8),
+                    Vec3A::new(1.5, -0.2, 0.5),
+                    Vec3A::new(0.2, 1.2, 0.3),
+                ],
+                1.0,
+            )],
+        ),
+        light_case("rectangle and sphere, chosen by power", mixed),
+    ]
+}
+
 /// Every sampler rtis uses: uniform and cosine hemisphere, the Phong lobe at three exponents,
-/// the BRDF mixture of Path at two materials and views, and the Fresnel choice of glass.
+/// the BRDF mixture of Path at two materials and views, the Fresnel choice of glass, and the
+/// area-light samplers.
 pub fn cases() -> Vec<Case> {
     let white = Phong {
         kd: Vec3A::ONE,
@@ -190,6 +302,9 @@ pub fn cases() -> Vec<Case> {
         fresnel_case(0.2, 1.0 / 1.5),
         fresnel_case(0.95, 1.5),
     ]
+    .into_iter()
+    .chain(light_cases())
+    .collect()
 }
 
 /// `ln Gamma(x)` for `x > 0` (Lanczos, g = 7).

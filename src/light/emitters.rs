@@ -1,6 +1,8 @@
 //! The scene's area lights, chosen one per light sample in proportion to their power.
 
 use super::AreaLight;
+use crate::geometry::Ray;
+use glam::Vec3A;
 
 /// [`crate::light`]'s index of a primitive that emits nothing.
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -63,5 +65,22 @@ impl Emitters {
             .partition_point(|&c| c <= u)
             .min(self.lights.len() - 1);
         Some((&self.lights[i], self.pmf(i)))
+    }
+
+    /// Density per unit solid angle with which one light sample from `p` (choose a light, then
+    /// sample it) picks direction `w`: the sum over the lights the ray from `p` meets of the
+    /// chance of choosing each times its density. For tests and `rtis warptest`; shaders ask
+    /// the one light a ray hit.
+    pub fn pdf_direction(&self, p: Vec3A, w: Vec3A) -> f32 {
+        let ray = Ray::new(p, w);
+        let mut pdf = 0.0;
+        for (i, light) in self.lights.iter().enumerate() {
+            let shape = light.shape.shape();
+            if let Some(t) = shape.intersect(&ray) {
+                let q = shape.surface(&ray, t);
+                pdf += self.pmf(i) * light.pdf(p, q.p, q.n);
+            }
+        }
+        pdf
     }
 }
