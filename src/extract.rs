@@ -10,6 +10,7 @@ use crate::geometry::Placement;
 use crate::light::{AreaLight, Emitter, Emitters, Emitting, NO_LIGHT};
 use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
+use crate::shader::Shader;
 use crate::shape::Shape;
 use crate::world::{Name, Scene, Transform, WorldLight, WorldShape};
 
@@ -117,6 +118,17 @@ pub fn extract(scene: &Scene) -> RenderScene {
         &s.effects,
     );
     warnings.extend(derived.warnings);
+    if let Shader::Path(p) = s.shader
+        && derived.effects.emission
+        && p.lights_under(s.model) != p.lights
+    {
+        warnings.push(format!(
+            "Path(lights: {:?}) under the Course model: area lights are light-sampled there (the \
+             course's Eq. 3; its indirect weights estimate another integral), so the strategy \
+             applies only under `model: Physical`",
+            p.lights
+        ));
+    }
     let mut render = RenderScene {
         camera,
         geometry,

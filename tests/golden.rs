@@ -203,6 +203,7 @@ golden_tests! {
     cornell_physical => "cornell-physical.ron",
     cornell_two_bounce => "cornell-two-bounce.ron",
     mesh => "mesh.ron",
+    mis => "mis.ron",
     mitsuba_cornell => "mitsuba-cornell.ron",
     spheres => "spheres.ron",
     triangles => "triangles.ron",
