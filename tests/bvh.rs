@@ -103,9 +103,31 @@ fn bvh_holds_every_primitive_once_in_nested_boxes_and_beats_a_median_split() {
             "a primitive is missing or repeated"
         );
         let median = median_cost(&mut boxes, root_area);
+        // Measured: 27.0 against 35.5 at 2k triangles. A builder that never finds a split
+        // better than a leaf falls back to the median split and ties it.
         assert!(
-            cost <= median,
+            cost <= 0.9 * median,
             "{n} triangles: SAH cost {cost} against a median split's {median}"
         );
     }
+}
+
+/// Leaves hold at most 4 primitives even when no split separates them (every centroid the
+/// same: 100 copies of one triangle, split at the median instead), and a set that a leaf
+/// serves best (2 overlapping triangles) stays one leaf.
+#[test]
+fn leaves_stay_small_when_no_split_helps() {
+    let t = Triangle::new(Vec3::ZERO.into(), Vec3::X.into(), Vec3::Y.into()).unwrap();
+    let prim = Prim {
+        shape: Shape::Triangle(t),
+        material: 0,
+        smooth: FLAT,
+        light: rtis::light::NO_LIGHT,
+    };
+    let g = Geometry::build(vec![prim; 100], Vec::new());
+    let leaves: Vec<u32> = g.bvh.nodes.iter().filter(|n| n.count > 0).map(|n| n.count).collect();
+    assert_eq!(leaves.iter().sum::<u32>(), 100);
+    assert!(leaves.iter().all(|&c| c <= 4), "leaf sizes {leaves:?}");
+    let g = Geometry::build(vec![prim; 2], Vec::new());
+    assert_eq!(g.bvh.nodes.len(), 1, "two primitives: one leaf");
 }

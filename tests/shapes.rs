@@ -274,3 +274,76 @@ fn unit_sphere_is_hit_at_four_in_every_path() {
     assert!(bvh.in_bvh > 0);
     assert_eq!(bvh.intersect(&ray).map(|h| h.t), Some(4.0));
 }
+
+fn tri(a: (f32, f32), b: (f32, f32), c: (f32, f32)) -> Triangle {
+    let p = |(x, y): (f32, f32)| Vec3A::new(x, y, 0.0);
+    Triangle::new(p(a), p(b), p(c)).unwrap()
+}
+
+/// Which of `tris` a ray along `dz` (+1 or -1) through `(x, y)` meets.
+fn owners(tris: &[Triangle], x: f32, y: f32, dz: f32) -> Vec<usize> {
+    let ray = Ray::new(Vec3A::new(x, y, -dz), Vec3A::new(0.0, 0.0, dz));
+    (0..tris.len())
+        .filter(|&i| Shape::Triangle(tris[i]).intersect(&ray).is_some())
+        .collect()
+}
+
+/// A ray exactly through an edge shared by two triangles meets exactly one of them, from both
+/// sides, and the owner is the triangle for which the edge is a top or left edge in the ray's
+/// sheared frame. Worked by hand for a ray along +z through (0.5, 0.5), on the diagonal of
+/// the unit square split into A = (0,0),(1,0),(1,1) and B = (0,0),(1,1),(0,1): both
+/// determinants are -1; A's edge function on the diagonal is zero with the edge vector
+/// (1, 1) after the sign flip, a left edge (y up), so A keeps it; B sees the edge as (-1, -1)
+/// and drops it. A horizontal edge, (0,0)-(1,0), shared by A' above and B' below: A' sees it
+/// as (-1, 0), a top edge; B' as (1, 0), not one. Vertices shared by a fan of triangles belong
+/// to exactly one of them too.
+#[test]
+fn shared_edges_and_vertices_have_exactly_one_owner() {
+    let diagonal = [tri((0., 0.), (1., 0.), (1., 1.)), tri((0., 0.), (1., 1.), (0., 1.))];
+    assert_eq!(owners(&diagonal, 0.5, 0.5, 1.0), vec![0], "diagonal from below");
+    assert_eq!(owners(&diagonal, 0.25, 0.25, -1.0).len(), 1, "diagonal from above");
+    let horizontal = [
+        tri((0., 0.), (1., 0.), (0.5, 1.)),
+        tri((1., 0.), (0., 0.), (0.5, -1.)),
+    ];
+    assert_eq!(owners(&horizontal, 0.5, 0.0, 1.0), vec![0], "horizontal edge from below");
+    assert_eq!(owners(&horizontal, 0.25, 0.0, -1.0).len(), 1, "horizontal edge from above");
+    // A 2 x 2 grid of squares, each split on its diagonal: 8 triangles around (1, 1), with
+    // shared edges along x, along y and diagonal, crossed from both sides at dyadic points.
+    let mut grid = Vec::new();
+    for (i, j) in [(0., 0.), (1., 0.), (0., 1.), (1., 1.)] {
+        grid.push(tri((i, j), (i + 1., j), (i + 1., j + 1.)));
+        grid.push(tri((i, j), (i + 1., j + 1.), (i, j + 1.)));
+    }
+    for dz in [1.0, -1.0] {
+        for (x, y) in [
+            (1.0, 1.0),
+            (0.5, 1.0),
+            (1.5, 1.0),
+            (1.0, 0.5),
+            (1.0, 1.5),
+            (0.5, 0.5),
+            (1.25, 1.25),
+            (0.75, 1.75),
+        ] {
+            let hit = owners(&grid, x, y, dz);
+            assert_eq!(hit.len(), 1, "({x}, {y}) along z {dz}: met by {hit:?}");
+        }
+    }
+}
+
+/// Hits are accepted in `(0, t_max]`: a ray whose `t_max` is exactly the distance to a shape
+/// still meets it (a shadow ray may end on its light), and one a hair shorter does not.
+#[test]
+fn t_max_is_inclusive() {
+    let shapes = [
+        Shape::Triangle(Triangle::new(Vec3A::new(-1., -1., 4.), Vec3A::new(1., -1., 4.), Vec3A::new(0., 1., 4.)).unwrap()),
+        Shape::Plane(Plane::through(Vec3A::new(0., 0., 4.), Vec3A::Z)),
+        Shape::Sphere(Sphere { c: Vec3A::new(0., 0., 5.), r: 1.0 }),
+    ];
+    for shape in shapes {
+        let at = |t_max: f32| shape.intersect(&Ray::segment(Vec3A::ZERO, Vec3A::Z, t_max));
+        assert_eq!(at(4.0), Some(4.0), "{shape:?}");
+        assert_eq!(at(4.0f32.next_down()), None, "{shape:?}");
+    }
+}
