@@ -118,8 +118,11 @@ pub fn extract(scene: &Scene) -> RenderScene {
         &s.effects,
     );
     warnings.extend(derived.warnings);
+    // Warn when a scene asks for a strategy the Course model cannot use (not for the default,
+    // `Mis`, which every Path scene has unless it says otherwise).
     if let Shader::Path(p) = s.shader
         && derived.effects.emission
+        && p.lights == crate::sampling::LightSampling::Brdf
         && p.lights_under(s.model) != p.lights
     {
         warnings.push(format!(

@@ -36,7 +36,19 @@ const SHADERS: &[(&str, &str, f64)] = &[
     ("Path(max_depth: 1, lights: Mis)", "Physical", 1.0),
     ("Path(max_depth: 1, lights: Light)", "Physical", 1.0),
     ("Path(max_depth: 1, lights: Brdf)", "Physical", 1.0),
-    ("Path(max_depth: 1, lights: Brdf)", "Course", PI),
+    // Under Course the path tracer light-samples whatever `lights` says.
+    ("Path(max_depth: 1, lights: Mis)", "Course", PI),
+    // Indirect light off: the light sample carries everything, whatever the strategy.
+    (
+        "Path(lights: Mis), effects: (indirect: false)",
+        "Physical",
+        1.0,
+    ),
+    (
+        "Path(lights: Brdf), effects: (indirect: false)",
+        "Physical",
+        1.0,
+    ),
     (
         "Global(samples: 2, max_depth: 1, ambient: (0, 0, 0), light_samples: 3)",
         "Course",
@@ -48,7 +60,12 @@ const SHADERS: &[(&str, &str, f64)] = &[
 /// y = 0, kd 0.5) lit by `light` (an entity), under each of [`SHADERS`], and check the mean
 /// against `physical` (times the model's factor) within 5 standard errors plus 1e-5 relative.
 fn check_floor_radiance(light: &str, physical: f64, spp: u32) {
-    for &(shader, model, factor) in SHADERS {
+    check_floor_radiance_with(light, physical, spp, &|_| true)
+}
+
+/// As [`check_floor_radiance`], for the shaders `with` keeps.
+fn check_floor_radiance_with(light: &str, physical: f64, spp: u32, with: &dyn Fn(&str) -> bool) {
+    for &(shader, model, factor) in SHADERS.iter().filter(|(s, m, _)| with(&format!("{s} {m}"))) {
         let text = format!(
             "Scene(film: (width: 32, height: 32, spp: {spp}),
                camera: Perspective(position: (3, 1, -0.5), look_at: (0, 0, 0), fov: 0.001),
@@ -72,13 +89,28 @@ fn check_floor_radiance(light: &str, physical: f64, spp: u32) {
 /// A sphere of radius R and radiance L whose centre is at height h above a point of a plane
 /// gives it the irradiance `E = pi L (R / h)^2` (it subtends the cone of `sin^2 = (R/h)^2`, the
 /// whole cap above the horizon). A Lambertian floor of kd reflects `kd / pi E = kd L (R/h)^2`.
+/// Also for a tiny, far sphere (`sin^2 = 2.5e-5`), where `1 - cos(theta_max)` would cancel;
+/// BRDF sampling alone almost never finds it (one sample in 40000), so only the strategies
+/// that sample the light are checked there.
 #[test]
 fn irradiance_from_a_spherical_emitter_is_exact() {
-    let (r, h, l, kd) = (0.5, 2.0, 3.0, 0.5);
-    let light = format!(
-        "(shape: Sphere(center: (0, {h}, 0), radius: {r}), emitter: Emitter(radiance: ({l}, {l}, {l})))"
+    let light = |r: f64, h: f64, l: f64| {
+        format!(
+            "(shape: Sphere(center: (0, {h}, 0), radius: {r}), emitter: Emitter(radiance: ({l}, {l}, {l})))"
+        )
+    };
+    let kd = 0.5;
+    let (r, h, l) = (0.5, 2.0, 3.0);
+    check_floor_radiance(&light(r, h, l), kd * l * (r / h) * (r / h), 16);
+    let (r, h, l) = (0.01, 2.0, 5000.0);
+    let samples_light =
+        |s: &str| !(s.contains("Brdf") && s.contains("Physical") && !s.contains("indirect"));
+    check_floor_radiance_with(
+        &light(r, h, l),
+        kd * l * (r / h) * (r / h),
+        16,
+        &samples_light,
     );
-    check_floor_radiance(&light, kd * l * (r / h) * (r / h), 16);
 }
 
 /// The form factor from a patch to a parallel rectangle a x b at height c with one corner
@@ -105,6 +137,13 @@ fn form_factor_to_a_parallel_rectangle_is_exact() {
     };
     check_floor_radiance(&flipped(false), 0.0, 4);
     check_floor_radiance(&flipped(true), kd * l * f, 16);
+    // Mirrored by a negative scale (x -> -x), the rectangle covers x in [-a, 0], which has the
+    // same form factor, and still emits downwards: the mirror keeps the transformed normal.
+    let mirrored = format!(
+        "(shape: Rectangle(corner: (0, {c}, 0), u: ({a}, 0, 0), v: (0, 0, {b})), \
+         transform: (scale: (-1, 1, 1)), emitter: Emitter(radiance: ({l}, {l}, {l})))"
+    );
+    check_floor_radiance(&mirrored, kd * l * f, 16);
 }
 
 /// A white furnace of light: inside a sphere that emits L from its inner surface and reflects
@@ -228,11 +267,11 @@ fn lights_are_chosen_by_power() {
         Emitting::Sphere(_)
     ));
     assert!(matches!(
-        e.choose(s0 * 0.999).unwrap().0.shape,
+        e.choose(s0 as f64 * 0.999).unwrap().0.shape,
         Emitting::Sphere(_)
     ));
     assert!(matches!(
-        e.choose(s0 * 1.001).unwrap().0.shape,
+        e.choose(s0 as f64 * 1.001).unwrap().0.shape,
         Emitting::Triangle(_)
     ));
     assert!(matches!(
@@ -261,7 +300,7 @@ fn a_wrong_light_pdf_is_rejected() {
     let case = Case {
         name: "cone of radius 1 claimed as 1.1".into(),
         draw: Box::new(move |s| {
-            let u = s.next_f32();
+            let u = s.next_f64();
             let (u1, u2) = s.next_2d();
             let (l, _) = drawn.choose(u)?;
             Some(direction_bin(l.sample(Vec3A::ZERO, u1, u2)?.wi))
@@ -294,44 +333,64 @@ proptest! {
     }
 
     /// The MIS weights of the two ways to find one direction sum to 1: the density a light
-    /// sample reports (`sample`) equals the one the path tracer computes when a BRDF-sampled
-    /// ray hits the same point (`pdf` at the traced hit), for spheres seen from outside and
-    /// inside and for triangles, from random points.
+    /// sample reports (the chance of choosing its light times `sample`'s density) equals the
+    /// one the path tracer computes when a BRDF-sampled ray meets the same point (the chance
+    /// of the light it hit times `pdf` there). Two lights of different power (a sphere and a
+    /// triangle), from random points, some within the sphere's band of area sampling.
     #[test]
     fn light_sample_and_hit_densities_agree(
         p in point(), c in point(), r in 0.2f32..1.5, v in (point(), point()),
-        u in (0.0f32..1.0, 0.0f32..1.0), kd in 0.0f32..1.0,
+        u in (0.0f64..1.0, 0.0f32..1.0, 0.0f32..1.0), kd in 0.0f32..1.0,
+        near in proptest::option::of((-0.004f32..0.004, (coord(), coord(), coord()))),
     ) {
-        let sphere = AreaLight {
-            shape: Emitting::Sphere(Sphere { c, r }),
-            emitter: Emitter { radiance: Vec3A::ONE, two_sided: true },
+        // Some points lie just inside or outside the sphere, where it is sampled by area.
+        let p = match near {
+            Some((k, w)) => {
+                let w = Vec3A::new(w.0, w.1, w.2).normalize_or(Vec3A::X);
+                c + w * r * (1.0 + k)
+            }
+            None => p,
         };
-        let lights = std::iter::once(sphere).chain(
-            Triangle::new(c, v.0, v.1).map(|t| AreaLight {
-                shape: Emitting::Triangle(t),
+        let Some(triangle) = Triangle::new(c + Vec3A::splat(2.0), v.0, v.1) else {
+            return Ok(());
+        };
+        let emitters = Emitters::new(vec![
+            AreaLight {
+                shape: Emitting::Sphere(Sphere { c, r }),
                 emitter: Emitter { radiance: Vec3A::ONE, two_sided: true },
-            }),
+            },
+            AreaLight {
+                shape: Emitting::Triangle(triangle),
+                emitter: Emitter { radiance: Vec3A::splat(3.0), two_sided: true },
+            },
+        ]);
+        prop_assert!((emitters.pmf(0) - emitters.pmf(1)).abs() > 1e-3 || r > 1.0);
+        let Some((light, pmf)) = emitters.choose(u.0) else { return Ok(()) };
+        let Some(ls) = light.sample(p, u.1, u.2) else { return Ok(()) };
+        let pdf_light = pmf * ls.pdf;
+        // The BRDF side: trace the direction against both lights, take the nearest.
+        let ray = Ray::new(p, ls.wi);
+        let nearest = (0..2)
+            .filter_map(|i| {
+                let shape: Shape = emitters.lights[i].shape.shape();
+                shape.intersect(&ray).map(|t| (i, t, shape))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        let Some((i, t, shape)) = nearest else { return Ok(()) };
+        // Only a sample the ray meets first can be found by a BRDF-sampled ray.
+        if (t - ls.dist).abs() > 1e-3 * ls.dist.max(1.0) { return Ok(()) }
+        let q = shape.surface(&ray, t);
+        let cos = q.n.dot(ls.wi).abs();
+        // Grazing samples are ill-conditioned in f32: compare where the cosine is sane.
+        if cos < 1e-2 { return Ok(()) }
+        let pdf_hit = emitters.pmf(i) * emitters.lights[i].pdf(p, q.p, q.n);
+        prop_assert!(
+            (pdf_hit - pdf_light).abs() <= 2e-3 * pdf_light,
+            "light {i}: sample pdf {pdf_light} vs hit pdf {pdf_hit}"
         );
-        for light in lights {
-            let Some(ls) = light.sample(p, u.0, u.1) else { continue };
-            let shape: Shape = light.shape.shape();
-            let ray = Ray::new(p, ls.wi);
-            let Some(t) = shape.intersect(&ray) else { continue };
-            // Only a sample the ray meets first can be found by a BRDF-sampled ray.
-            if (t - ls.dist).abs() > 1e-3 * ls.dist.max(1.0) { continue }
-            let q = shape.surface(&ray, t);
-            let at_hit = light.pdf(p, q.p, q.n);
-            // Grazing samples are ill-conditioned in f32: compare where the cosine is sane.
-            let cos = q.n.dot(ls.wi).abs();
-            if cos < 1e-2 { continue }
-            prop_assert!(
-                (at_hit - ls.pdf).abs() <= 2e-3 * ls.pdf,
-                "{:?}: sample pdf {} vs hit pdf {}", light.shape, ls.pdf, at_hit
-            );
-            let brdf = kd * cos / std::f32::consts::PI;
-            let w = power_heuristic(ls.pdf, brdf) + power_heuristic(brdf, at_hit);
-            prop_assert!((w - 1.0).abs() < 2e-3, "weights sum to {w}");
-        }
+        let brdf = kd * cos / std::f32::consts::PI;
+        let w = power_heuristic(pdf_light, brdf) + power_heuristic(brdf, pdf_hit);
+        prop_assert!((w - 1.0).abs() < 2e-3, "weights sum to {w}");
     }
 }
 
@@ -339,7 +398,7 @@ proptest! {
 /// with the reference by `bench/mitsuba_area_reference.py`: 4096 spp, per-pixel noise RMSE
 /// 0.00497, mirrored left-right). Rendered twice (A, B) with different seeds and compared on
 /// 4 x 4 blocks: if both estimate the same image, mean((A+B)/2 - R)^2 = var_ours / 2 +
-/// var_ref; we allow 1.5 times that. Blocks that see the light itself (a reference pixel
+/// var_ref; we allow 1.3 times that. Blocks that see the light itself (a reference pixel
 /// above 3) are left out: their error is the antialiasing of an edge between 0 and 18, a
 /// heavy-tailed noise that one pair of renders estimates poorly (at 32 spp five such blocks
 /// held half the squared error); the light's inside is checked apart, within 1%. The image
@@ -402,7 +461,8 @@ fn mitsuba_cornell_box_with_an_area_light() {
     let var_ours = d_ab / n / 2.0;
     let var_ref = 0.00497f64.powi(2) / 16.0;
     let mse = d_ref / n;
-    let allowed = 1.5 * (var_ours / 2.0 + var_ref);
+    // About 1000 blocks: the MSE's own relative spread is about 5%; 1.3 is six of those.
+    let allowed = 1.3 * (var_ours / 2.0 + var_ref);
     eprintln!(
         "block MSE vs Mitsuba {mse:.3e}; noise explains {:.3e}; allowed {allowed:.3e}",
         var_ours / 2.0 + var_ref
@@ -424,11 +484,13 @@ fn mitsuba_cornell_box_with_an_area_light() {
     );
 }
 
-/// What MIS buys, on Veach's scene (`scenes/mis.ron`, 120 x 80, 16 spp): its RMSE over the
-/// plates against a 512-spp MIS reference is below both light sampling's (large lights on
-/// sharp plates) and BRDF sampling's (small lights on rough plates), by a margin far beyond
-/// the seed noise (measured when added: MIS 0.271, light 0.551, BRDF 0.598; required: MIS
-/// below 0.7 of each).
+/// What MIS buys, on Veach's scene (`scenes/mis.ron`, 120 x 80, 16 spp): its relative MSE
+/// over the plates is below both light sampling's (large lights on sharp plates) and BRDF
+/// sampling's (small lights on rough plates), by a margin far beyond the seed noise
+/// (required: MIS below half of each). The reference is the mean of light-only and BRDF-only renders at 512 spp,
+/// which never use the MIS weights, so a bias in them would show as error. (The images'
+/// means are too heavy-tailed at 16 spp to compare: small bright lights found by BRDF
+/// sampling are rare and large; the exact tests above check each strategy's expectation.)
 #[test]
 fn mis_beats_both_strategies_on_veachs_scene() {
     let text = std::fs::read_to_string(scenes_dir().join("mis.ron")).unwrap();
@@ -440,24 +502,47 @@ fn mis_beats_both_strategies_on_veachs_scene() {
         s.settings.seed = seed;
         render_scene(&s).image
     };
-    let reference = render_with("Mis", 512, 99);
+    let (a, b) = (render_with("Light", 512, 98), render_with("Brdf", 512, 99));
+    let mut reference = a.clone();
+    for (r, x) in reference.pixels.iter_mut().zip(&b.pixels) {
+        *r = 0.5 * (*r + *x);
+    }
     // The plates: the image below its top third (above it, the lights themselves, whose
     // antialiased outlines would dominate the error).
-    let rmse = |lights: &str| {
+    let start = (reference.width * reference.height / 3) as usize;
+    let plates_mean = |img: &rtis::render::film::Image| {
+        img.pixels[start..]
+            .iter()
+            .map(|p| p.element_sum() as f64)
+            .sum::<f64>()
+    };
+    // Relative MSE, (x - r)^2 / (r^2 + 0.01) per pixel and channel, as `rtis converge` and
+    // Mitsuba's tests use it: robust to the rare bright samples a plain MSE is made of here.
+    let rel_mse = |lights: &str| {
         let img = render_with(lights, 16, 1);
-        let start = (img.width * img.height / 3) as usize;
         let pairs = img.pixels[start..].iter().zip(&reference.pixels[start..]);
-        let n = pairs.len() as f64;
-        let mse: f64 = pairs
-            .map(|(a, b)| ((*a - *b).length_squared() / 3.0) as f64)
+        let n = pairs.len() as f64 * 3.0;
+        let e: f64 = pairs
+            .map(|(a, b)| {
+                let d = *a - *b;
+                (d * d / (*b * *b + Vec3A::splat(0.01))).element_sum() as f64
+            })
             .sum::<f64>()
             / n;
-        mse.sqrt()
+        (e, plates_mean(&img))
     };
-    let (mis, light, brdf) = (rmse("Mis"), rmse("Light"), rmse("Brdf"));
-    eprintln!("RMSE at 16 spp: MIS {mis:.4}, light {light:.4}, BRDF {brdf:.4}");
+    let ((mis, m_mis), (light, m_light), (brdf, m_brdf)) =
+        (rel_mse("Mis"), rel_mse("Light"), rel_mse("Brdf"));
+    let m_ref = plates_mean(&reference);
+    eprintln!(
+        "plates: MIS {m_mis:.1}, light {m_light:.1}, BRDF {m_brdf:.1}; reference {m_ref:.1} \
+         (light {:.1}, BRDF {:.1})",
+        plates_mean(&a),
+        plates_mean(&b)
+    );
+    eprintln!("relMSE at 16 spp: MIS {mis:.4}, light {light:.4}, BRDF {brdf:.4}");
     assert!(
-        mis < 0.7 * light && mis < 0.7 * brdf,
+        mis < 0.5 * light && mis < 0.5 * brdf,
         "MIS {mis:.4}, light {light:.4}, BRDF {brdf:.4}"
     );
 }

@@ -113,7 +113,10 @@ fn rays_starting_on_a_sphere_meet_only_its_far_side() {
                 );
             }
         } else {
-            assert_eq!(paths, [None; 3], "outward ray from the sphere (r {r}, c {c}) met it");
+            assert_eq!(
+                paths, [None; 3],
+                "outward ray from the sphere (r {r}, c {c}) met it"
+            );
         }
         checked += 1;
     }
@@ -137,7 +140,11 @@ fn rays_starting_on_a_plane_do_not_meet_it() {
             continue;
         }
         let ray = Ray::new(o, d);
-        assert_eq!(Shape::Plane(plane).intersect(&ray), None, "{plane:?} from {o}");
+        assert_eq!(
+            Shape::Plane(plane).intersect(&ray),
+            None,
+            "{plane:?} from {o}"
+        );
         let g = Geometry::build(vec![prim(Shape::Plane(plane))], Vec::new());
         assert!(g.intersect(&ray).is_none(), "packet: {plane:?} from {o}");
     }
@@ -201,11 +208,19 @@ fn error_bounds_scale_exactly_with_the_scene() {
             let at_k: Surface = shape_k.surface(&ray_k, t * k);
             assert_eq!(at_k.p, at.p * k, "{shape:?}: point at 2^{e}");
             assert_eq!(at_k.err, at.err * k, "{shape:?}: err at 2^{e}");
-            assert_eq!(at_k.err_along, at.err_along * k, "{shape:?}: err_along at 2^{e}");
+            assert_eq!(
+                at_k.err_along,
+                at.err_along * k,
+                "{shape:?}: err_along at 2^{e}"
+            );
             match (shape, shape_k) {
                 (Shape::Sphere(a), Shape::Sphere(b)) => {
                     let f2 = (ray.o - a.c).length_squared();
-                    assert_eq!(b.band(&ray_k, f2 * k * k), a.band(&ray, f2) * k * k, "sphere band");
+                    assert_eq!(
+                        b.band(&ray_k, f2 * k * k),
+                        a.band(&ray, f2) * k * k,
+                        "sphere band"
+                    );
                 }
                 (Shape::Plane(a), Shape::Plane(b)) => {
                     assert_eq!(b.band(&ray_k), a.band(&ray) * k, "plane band");
@@ -230,7 +245,10 @@ fn hit_points_lie_within_their_bounds() {
         };
         let t = shape.intersect(&ray).unwrap();
         let hit = shape.surface(&ray, t);
-        assert!(hit.err >= 0.0 && hit.err_along >= 0.0, "{shape:?}: negative bound");
+        assert!(
+            hit.err >= 0.0 && hit.err_along >= 0.0,
+            "{shape:?}: negative bound"
+        );
         let (o, d) = (ray.o.as_dvec3(), ray.d.as_dvec3());
         // The exact hit: the root nearest t of the exact equation.
         let t_exact = match shape {
@@ -240,7 +258,11 @@ fn hit_points_lie_within_their_bounds() {
                 let cc = f.length_squared() - (sp.r as f64).powi(2);
                 let q = (b * b - cc).max(0.0).sqrt();
                 let (t0, t1) = (-b - q, -b + q);
-                if (t0 - t as f64).abs() < (t1 - t as f64).abs() { t0 } else { t1 }
+                if (t0 - t as f64).abs() < (t1 - t as f64).abs() {
+                    t0
+                } else {
+                    t1
+                }
             }
             Shape::Plane(p) => {
                 let n = p.n.as_dvec3();

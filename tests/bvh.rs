@@ -125,7 +125,13 @@ fn leaves_stay_small_when_no_split_helps() {
         light: rtis::light::NO_LIGHT,
     };
     let g = Geometry::build(vec![prim; 100], Vec::new());
-    let leaves: Vec<u32> = g.bvh.nodes.iter().filter(|n| n.count > 0).map(|n| n.count).collect();
+    let leaves: Vec<u32> = g
+        .bvh
+        .nodes
+        .iter()
+        .filter(|n| n.count > 0)
+        .map(|n| n.count)
+        .collect();
     assert_eq!(leaves.iter().sum::<u32>(), 100);
     assert!(leaves.iter().all(|&c| c <= 4), "leaf sizes {leaves:?}");
     let g = Geometry::build(vec![prim; 2], Vec::new());

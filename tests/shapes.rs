@@ -299,15 +299,34 @@ fn owners(tris: &[Triangle], x: f32, y: f32, dz: f32) -> Vec<usize> {
 /// to exactly one of them too.
 #[test]
 fn shared_edges_and_vertices_have_exactly_one_owner() {
-    let diagonal = [tri((0., 0.), (1., 0.), (1., 1.)), tri((0., 0.), (1., 1.), (0., 1.))];
-    assert_eq!(owners(&diagonal, 0.5, 0.5, 1.0), vec![0], "diagonal from below");
-    assert_eq!(owners(&diagonal, 0.25, 0.25, -1.0).len(), 1, "diagonal from above");
+    let diagonal = [
+        tri((0., 0.), (1., 0.), (1., 1.)),
+        tri((0., 0.), (1., 1.), (0., 1.)),
+    ];
+    assert_eq!(
+        owners(&diagonal, 0.5, 0.5, 1.0),
+        vec![0],
+        "diagonal from below"
+    );
+    assert_eq!(
+        owners(&diagonal, 0.25, 0.25, -1.0).len(),
+        1,
+        "diagonal from above"
+    );
     let horizontal = [
         tri((0., 0.), (1., 0.), (0.5, 1.)),
         tri((1., 0.), (0., 0.), (0.5, -1.)),
     ];
-    assert_eq!(owners(&horizontal, 0.5, 0.0, 1.0), vec![0], "horizontal edge from below");
-    assert_eq!(owners(&horizontal, 0.25, 0.0, -1.0).len(), 1, "horizontal edge from above");
+    assert_eq!(
+        owners(&horizontal, 0.5, 0.0, 1.0),
+        vec![0],
+        "horizontal edge from below"
+    );
+    assert_eq!(
+        owners(&horizontal, 0.25, 0.0, -1.0).len(),
+        1,
+        "horizontal edge from above"
+    );
     // A 2 x 2 grid of squares, each split on its diagonal: 8 triangles around (1, 1), with
     // shared edges along x, along y and diagonal, crossed from both sides at dyadic points.
     let mut grid = Vec::new();
@@ -337,9 +356,19 @@ fn shared_edges_and_vertices_have_exactly_one_owner() {
 #[test]
 fn t_max_is_inclusive() {
     let shapes = [
-        Shape::Triangle(Triangle::new(Vec3A::new(-1., -1., 4.), Vec3A::new(1., -1., 4.), Vec3A::new(0., 1., 4.)).unwrap()),
+        Shape::Triangle(
+            Triangle::new(
+                Vec3A::new(-1., -1., 4.),
+                Vec3A::new(1., -1., 4.),
+                Vec3A::new(0., 1., 4.),
+            )
+            .unwrap(),
+        ),
         Shape::Plane(Plane::through(Vec3A::new(0., 0., 4.), Vec3A::Z)),
-        Shape::Sphere(Sphere { c: Vec3A::new(0., 0., 5.), r: 1.0 }),
+        Shape::Sphere(Sphere {
+            c: Vec3A::new(0., 0., 5.),
+            r: 1.0,
+        }),
     ];
     for shape in shapes {
         let at = |t_max: f32| shape.intersect(&Ray::segment(Vec3A::ZERO, Vec3A::Z, t_max));

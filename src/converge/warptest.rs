@@ -185,7 +185,7 @@ fn light_case(name: &str, lights: Vec<AreaLight>) -> Case {
     Case {
         name: name.into(),
         draw: Box::new(move |s: &mut Sampler| {
-            let u = s.next_f32();
+            let u = s.next_f64();
             let (u1, u2) = s.next_2d();
             let (light, _) = emitters.choose(u)?;
             let ls = light.sample(Vec3A::ZERO, u1, u2)?;

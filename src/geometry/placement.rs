@@ -76,6 +76,14 @@ impl Placement {
         (self.normal_matrix * n).normalize().as_vec3a()
     }
 
+    /// True if the transform mirrors (a negative determinant: an odd number of negative
+    /// scales). A triangle's winding then reverses, so its vertices are swapped to keep its
+    /// normal, and with it the side a one-sided emitter lights, the transformed normal.
+    #[inline]
+    pub fn mirrors(&self) -> bool {
+        self.affine.matrix3.determinant() < 0.0
+    }
+
     /// A length under a uniform scale (the radius of a sphere).
     #[inline]
     pub fn length(&self, l: f64) -> f32 {

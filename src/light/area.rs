@@ -187,7 +187,7 @@ impl AreaLight {
 #[inline]
 fn area_to_solid_angle(a: f32, d2: f32, cos_q: f32) -> Option<f32> {
     let pdf = d2 / (a * cos_q);
-    (cos_q > 0.0 && pdf.is_finite()).then_some(pdf)
+    (cos_q > 0.0 && pdf.is_finite() && pdf > 0.0).then_some(pdf)
 }
 
 /// Area of a triangle.

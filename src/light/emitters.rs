@@ -12,32 +12,36 @@ pub const NO_LIGHT: u32 = u32::MAX;
 pub struct Emitters {
     /// The lights; a primitive refers to its light by index here.
     pub lights: Vec<AreaLight>,
-    /// `cdf[i]`: the power of lights `0..=i` over the total; the last is 1.
-    cdf: Vec<f32>,
+    /// `cdf[i]`: the power of lights `0..=i` over the total; the last is 1. Double precision,
+    /// and sampled with 53-bit numbers, so that a light whose share is below f32's 2^-24 grid
+    /// (one small triangle of a million) is still chosen as often as [`Emitters::pmf`] says.
+    cdf: Vec<f64>,
+    /// Each light's probability, `power / total`.
+    pmf: Vec<f32>,
 }
 
 impl Emitters {
     /// The set of `lights`, each chosen with probability proportional to its power (uniformly
     /// if none has any).
     pub fn new(lights: Vec<AreaLight>) -> Self {
-        let powers: Vec<f64> = lights.iter().map(|l| l.power() as f64).collect();
+        let mut powers: Vec<f64> = lights.iter().map(|l| l.power() as f64).collect();
+        if powers.iter().sum::<f64>() <= 0.0 {
+            powers.iter_mut().for_each(|w| *w = 1.0);
+        }
         let total: f64 = powers.iter().sum();
+        let pmf = powers.iter().map(|w| (w / total) as f32).collect();
         let mut acc = 0.0;
-        let mut cdf: Vec<f32> = powers
+        let mut cdf: Vec<f64> = powers
             .iter()
             .map(|&w| {
-                acc += if total > 0.0 { w / total } else { 1.0 };
-                acc as f32
+                acc += w / total;
+                acc
             })
             .collect();
-        let n = cdf.len() as f32;
-        if total <= 0.0 {
-            cdf.iter_mut().for_each(|c| *c /= n);
-        }
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
-        Emitters { lights, cdf }
+        Emitters { lights, cdf, pmf }
     }
 
     /// True when the scene has no area light.
@@ -49,14 +53,13 @@ impl Emitters {
     /// Probability that [`Emitters::choose`] picks light `i`.
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
-        let below = if i == 0 { 0.0 } else { self.cdf[i - 1] };
-        self.cdf[i] - below
+        self.pmf[i]
     }
 
     /// The light that `u`, uniform in [0, 1), picks, with its probability: the first whose
     /// cumulative share exceeds `u` (a light of zero power is never picked).
     #[inline]
-    pub fn choose(&self, u: f32) -> Option<(&AreaLight, f32)> {
+    pub fn choose(&self, u: f64) -> Option<(&AreaLight, f32)> {
         if self.lights.is_empty() {
             return None;
         }

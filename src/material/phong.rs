@@ -39,6 +39,12 @@ impl Phong {
         self.kd * cos_i + self.ks * cos_r.powf(self.shininess)
     }
 
+    /// True if the material reflects nothing (`kd = ks = 0`, as an emitter without a material).
+    #[inline]
+    pub fn is_black(&self) -> bool {
+        self.kd == Vec3A::ZERO && self.ks == Vec3A::ZERO
+    }
+
     /// This material scaled so that `kd + ks <= 1` in every channel, or `None` if it already
     /// is. The normalised Phong BRDF reflects at most `kd + ks` of the light it receives, so
     /// under the physically based model a sum above one would create energy, and a path tracer

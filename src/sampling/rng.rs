@@ -34,6 +34,14 @@ impl Sampler {
         (self.rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
     }
 
+    /// A uniform number in `[0, 1)` with 53 random bits (two draws), for choices among many
+    /// options whose probabilities are finer than `next_f32`'s grid of 2^-24.
+    #[inline]
+    pub fn next_f64(&mut self) -> f64 {
+        let bits = ((self.rng.next_u32() as u64) << 21) ^ (self.rng.next_u32() as u64 >> 11);
+        bits as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
     /// Two uniform numbers in `[0, 1)`.
     #[inline]
     pub fn next_2d(&mut self) -> (f32, f32) {

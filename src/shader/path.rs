@@ -111,14 +111,17 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
         // Scatter: the next ray, its weight g(wi) / pdf(wi) and its kind.
         let (next_ray, weight, next) = match (si.material, model) {
             (Material::Phong(phong), _) => {
-                // Next-event estimation: Eq. 3 under the model, and one area-light sample.
+                // Next-event estimation: Eq. 3 under the model, and one area-light sample. When
+                // no ray continues (indirect light off) the light sample carries all of the
+                // area lights, whatever the strategy.
                 l += beta * point_lights(tr, &si, &phong);
+                if !tr.effects.indirect {
+                    l += beta * area_lights(tr, &si, &phong, 1, None);
+                    break;
+                }
                 let mis = (lights == LightSampling::Mis).then_some(p.sampling);
                 if lights != LightSampling::Brdf {
                     l += beta * area_lights(tr, &si, &phong, 1, mis);
-                }
-                if !tr.effects.indirect {
-                    break;
                 }
                 let Some((wi, weight, pdf)) = sample_phong(tr, &phong, &si, model, p.sampling)
                 else {
@@ -208,5 +211,9 @@ fn sample_phong(
         Model::Course => reflectance(model, phong, wi, wo, n) / (TAU * TAU),
         Model::Physical => reflectance(model, phong, wi, wo, n),
     };
+    // A direction that carries nothing ends the path (a black surface).
+    if g == Vec3A::ZERO {
+        return None;
+    }
     Some((wi, g / pdf, pdf))
 }

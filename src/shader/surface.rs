@@ -92,6 +92,10 @@ pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light_samp
 #[inline]
 pub fn point_lights(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
     let mut l_dir = Vec3A::ZERO;
+    if phong.is_black() {
+        // Reflects nothing: no shadow ray can change that.
+        return l_dir;
+    }
     let model = tr.model;
     for light in tr.lights {
         let Some(inc) = light.incident(si.hit.p) else {
@@ -128,14 +132,14 @@ pub fn area_lights(
     samples: u32,
     mis: Option<Sampling>,
 ) -> Vec3A {
-    if !tr.effects.emission || tr.emitters.is_empty() || samples == 0 {
+    if !tr.effects.emission || tr.emitters.is_empty() || samples == 0 || phong.is_black() {
         return Vec3A::ZERO;
     }
     let model = tr.model;
     let mut sum = Vec3A::ZERO;
     for _ in 0..samples {
         // Choose a light by power, then a point on it.
-        let u = tr.sampler.next_f32();
+        let u = tr.sampler.next_f64();
         let (u1, u2) = tr.sampler.next_2d();
         let Some((light, pmf)) = tr.emitters.choose(u) else {
             break;
@@ -147,6 +151,9 @@ pub fn area_lights(
             continue;
         }
         let pdf = pmf * ls.pdf;
+        if !(pdf > 0.0) {
+            continue;
+        }
         // Shadow ray V: stop just short of the sampled point.
         let visible =
             !tr.effects.shadows || tr.unoccluded(&si.origins.ray(ls.wi, ls.dist * SHADOW_END));

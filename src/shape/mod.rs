@@ -79,11 +79,19 @@ impl WorldShape {
         push: &mut dyn FnMut(Shape, Option<[Vec3A; 3]>),
     ) -> usize {
         let mut dropped = 0;
-        let mut triangle =
-            |v: [Vec3A; 3], n: Option<[Vec3A; 3]>| match Triangle::new(v[0], v[1], v[2]) {
+        // A mirroring transform reverses the winding: swap two vertices to keep the normal.
+        let mirrors = at.mirrors();
+        let mut triangle = |v: [Vec3A; 3], n: Option<[Vec3A; 3]>| {
+            let (v, n) = if mirrors {
+                ([v[0], v[2], v[1]], n.map(|n| [n[0], n[2], n[1]]))
+            } else {
+                (v, n)
+            };
+            match Triangle::new(v[0], v[1], v[2]) {
                 Some(t) => push(Shape::Triangle(t), n),
                 None => dropped += 1,
-            };
+            }
+        };
         match self {
             WorldShape::Sphere { center, radius } => {
                 push(Shape::Sphere(Sphere::placed(*center, *radius, at)), None)
