@@ -151,7 +151,8 @@ pub fn area_lights(
             continue;
         }
         let pdf = pmf * ls.pdf;
-        if !(pdf > 0.0) {
+        // A density of zero (or NaN) cannot weigh a sample.
+        if pdf.is_nan() || pdf <= 0.0 {
             continue;
         }
         // Shadow ray V: stop just short of the sampled point.
