@@ -137,3 +137,42 @@ fn leaves_stay_small_when_no_split_helps() {
     let g = Geometry::build(vec![prim; 2], Vec::new());
     assert_eq!(g.bvh.nodes.len(), 1, "two primitives: one leaf");
 }
+
+/// The leaf-or-split choice for small sets follows the SAH: four tiny triangles at the corners
+/// of a large box split (each side's area is a sliver of the parent's, so a visit costs less
+/// than four tests), three nearly coincident ones stay one leaf (splitting them costs more
+/// than testing all three).
+#[test]
+fn small_sets_split_only_when_the_sah_says_so() {
+    let tri = |o: Vec3, s: f32| {
+        let a = o;
+        Prim {
+            shape: Shape::Triangle(
+                Triangle::new(a.into(), (a + Vec3::X * s).into(), (a + Vec3::Y * s).into())
+                    .unwrap(),
+            ),
+            material: 0,
+            smooth: FLAT,
+            light: rtis::light::NO_LIGHT,
+        }
+    };
+    let corners: Vec<Prim> = [
+        Vec3::ZERO,
+        Vec3::new(10., 0., 0.),
+        Vec3::new(0., 10., 0.),
+        Vec3::new(10., 10., 10.),
+    ]
+    .iter()
+    .map(|&o| tri(o, 0.01))
+    .collect();
+    let g = Geometry::build(corners, Vec::new());
+    assert!(
+        g.bvh.nodes.len() > 1,
+        "four far-apart triangles in one leaf"
+    );
+    let close: Vec<Prim> = (0..3)
+        .map(|i| tri(Vec3::splat(i as f32 * 1e-3), 1.0))
+        .collect();
+    let g = Geometry::build(close, Vec::new());
+    assert_eq!(g.bvh.nodes.len(), 1, "three overlapping triangles split");
+}

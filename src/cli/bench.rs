@@ -35,6 +35,15 @@ pub struct BenchArgs {
     /// of tables.
     #[arg(long)]
     json: bool,
+    /// Mesh sizes of the meshes section, in triangles (default 10000, 100000 and 1000000).
+    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(8..=16_000_000))]
+    triangles: Vec<u32>,
+    /// Write each mesh and its ray sets to this folder as raw little-endian arrays, for
+    /// another engine to trace the same work (bench/embree_compare.py): `mesh-N.vertices.f32`
+    /// (x y z per vertex), `mesh-N.faces.u32` (three indices per triangle),
+    /// `mesh-N.coherent.f32` and `mesh-N.incoherent.f32` (ox oy oz dx dy dz per ray).
+    #[arg(long)]
+    dump: Option<std::path::PathBuf>,
 }
 
 /// One figure of the bench: a table row, or with `--json` a JSON line.
@@ -222,7 +231,11 @@ fn rate(rays: &[Ray], f: impl Fn(&Ray) -> bool + Sync) -> (f64, usize) {
 
 /// BVH build time, memory per triangle and ray rates for procedural meshes of 10k, 100k and
 /// 1M triangles (a displaced sphere of radius 1 at the origin).
-fn meshes_section(json: bool) {
+fn meshes_section(
+    json: bool,
+    sizes: &[u32],
+    dump: Option<&std::path::Path>,
+) -> Result<(), CliError> {
     if !json {
         println!("-- meshes: displaced sphere, 1M rays of each kind");
         println!(
@@ -237,8 +250,13 @@ fn meshes_section(json: bool) {
             "incoherent"
         );
     }
-    for n in [10_000usize, 100_000, 1_000_000] {
-        let mesh = displaced_sphere(n, Vec3::ZERO, 1.0, 0.05);
+    let sizes = if sizes.is_empty() {
+        &[10_000, 100_000, 1_000_000][..]
+    } else {
+        sizes
+    };
+    for &n in sizes {
+        let mesh = displaced_sphere(n as usize, Vec3::ZERO, 1.0, 0.05);
         let prims: Vec<Prim> = mesh
             .faces
             .iter()
@@ -269,7 +287,7 @@ fn meshes_section(json: bool) {
                 Ray::new(eye, (Vec3A::new(1.2 * x, 1.2 * y, 3.0)).normalize())
             })
             .collect();
-        let (cam_rate, _) = rate(&camera, |r| g.intersect(r).is_some());
+        let (cam_rate, cam_hits) = rate(&camera, |r| g.intersect(r).is_some());
         // Shadow rays from the visible surface towards a light at (2, 3, -3).
         let light = Vec3A::new(2.0, 3.0, -3.0);
         let shadow: Vec<Ray> = camera
@@ -296,13 +314,18 @@ fn meshes_section(json: bool) {
                 Ray::new(o, d)
             })
             .collect();
-        let (inc_rate, _) = rate(&incoherent, |r| g.intersect(r).is_some());
+        let (inc_rate, inc_hits) = rate(&incoherent, |r| g.intersect(r).is_some());
         let prim_bytes = std::mem::size_of::<Prim>();
+        if let Some(dir) = dump {
+            dump_work(dir, n, &mesh, &camera, &incoherent)?;
+        }
         let row = serde_json::json!({
-            "section": "meshes", "triangles": count, "build_s": build, "nodes": nodes,
+            "section": "meshes", "engine": "rtis", "triangles": count, "build_s": build,
+            "nodes": nodes, "threads": rayon::current_num_threads(),
             "bvh_bytes_per_triangle": bvh_bytes, "primitive_bytes": prim_bytes,
-            "camera_mrays": cam_rate, "shadow_mrays": shadow_rate,
-            "incoherent_mrays": inc_rate,
+            "bytes_per_triangle": bvh_bytes + prim_bytes as f64,
+            "camera_mrays": cam_rate, "coherent_mrays": cam_rate, "shadow_mrays": shadow_rate,
+            "incoherent_mrays": inc_rate, "coherent_hits": cam_hits, "incoherent_hits": inc_hits,
         });
         emit(json, row, || {
             format!(
@@ -311,6 +334,46 @@ fn meshes_section(json: bool) {
             )
         });
     }
+    Ok(())
+}
+
+/// Write a mesh and its ray sets as raw little-endian arrays (see `BenchArgs::dump`), each
+/// through a temporary file.
+fn dump_work(
+    dir: &std::path::Path,
+    n: u32,
+    mesh: &rtis::mesh::MeshData,
+    coherent: &[Ray],
+    incoherent: &[Ray],
+) -> Result<(), CliError> {
+    let write = |name: String, floats: Vec<[u8; 4]>| -> Result<(), CliError> {
+        let bytes: Vec<u8> = floats.concat();
+        let path = dir.join(name);
+        rtis::render::output::write_file(&path, &bytes)?;
+        Ok(())
+    };
+    let f = |v: f32| v.to_le_bytes();
+    write(
+        format!("mesh-{n}.vertices.f32"),
+        mesh.positions
+            .iter()
+            .flat_map(|p| p.as_vec3().to_array().map(f))
+            .collect(),
+    )?;
+    write(
+        format!("mesh-{n}.faces.u32"),
+        mesh.faces
+            .iter()
+            .flat_map(|t| t.map(|i| i.to_le_bytes()))
+            .collect(),
+    )?;
+    let rays = |rs: &[Ray]| -> Vec<[u8; 4]> {
+        rs.iter()
+            .flat_map(|r| [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z].map(f))
+            .collect()
+    };
+    write(format!("mesh-{n}.coherent.f32"), rays(coherent))?;
+    write(format!("mesh-{n}.incoherent.f32"), rays(incoherent))
 }
 
 /// Run `rtis bench`.
@@ -330,7 +393,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     });
     let wants = |s: Section| a.section == Section::All || a.section == s;
     if wants(Section::Meshes) {
-        meshes_section(a.json);
+        meshes_section(a.json, &a.triangles, a.dump.as_deref())?;
     }
     if wants(Section::Effects) {
         effects_section(&a.scenes, a.runs, a.shrink, a.json)?;
