@@ -91,7 +91,9 @@ fn rays_starting_on_a_sphere_meet_only_its_far_side() {
         let k = [-10, 0, 10][i as usize % 3];
         let scale = 2f32.powi(k);
         let r = log_uniform(s, 0.05, 20.0) * scale;
-        let c = within(s, 50.0) * scale;
+        // A third of the spheres sit at the origin, where the origin's own rounding is as
+        // small as the sphere's: the band's terms in r^2 then decide.
+        let c = if i % 9 < 3 { Vec3A::ZERO } else { within(s, 50.0) * scale };
         let n = unit(s);
         let o = c + r * n;
         let d = unit(s);
@@ -130,8 +132,16 @@ fn rays_starting_on_a_sphere_meet_only_its_far_side() {
 fn rays_starting_on_a_plane_do_not_meet_it() {
     for i in 0..4000 {
         let s = &mut rng(2, i);
-        let n = unit(s);
-        let plane = Plane::through(within(s, 1e4), n);
+        // Half the planes are nearly axis-aligned and far along their axis, where the origin's
+        // coordinates and the plane's distance are of one size and the band's two terms meet.
+        let (n, point) = if i % 2 == 0 {
+            (unit(s), within(s, 1e4))
+        } else {
+            let axis = [Vec3A::X, Vec3A::Y, Vec3A::Z][i as usize % 3];
+            let n = (axis + within(s, 0.01)).normalize();
+            (n, axis * log_uniform(s, 10.0, 1e4) + within(s, 5.0))
+        };
+        let plane = Plane::through(point, n);
         // The point of the plane nearest q, exact in double precision, rounded once.
         let (q, nd) = (within(s, 1e4).as_dvec3(), n.as_dvec3());
         let o = (q - (nd.dot(q) - plane.dist as f64) / nd.length_squared() * nd).as_vec3a();
@@ -152,6 +162,16 @@ fn rays_starting_on_a_plane_do_not_meet_it() {
 
 /// A random shape and a ray from afar that hits it, at scale 1.
 fn random_hit(s: &mut Sampler, kind: usize) -> Option<(Shape, Ray)> {
+    if kind == 3 {
+        // A far plane seen from the origin: the rounding of `o + t d` then outweighs the error
+        // of `t` from the plane's distance, which is exact.
+        let n = unit(s);
+        let plane = Plane::through(n * log_uniform(s, 10.0, 1e4), n);
+        let d = (n + within(s, 0.5)).normalize();
+        let ray = Ray::new(Vec3A::ZERO, d);
+        let shape = Shape::Plane(plane);
+        return shape.intersect(&ray).map(|_| (shape, ray));
+    }
     let target = within(s, 3.0);
     let shape = match kind {
         0 => Shape::Sphere(Sphere {
@@ -240,7 +260,7 @@ fn error_bounds_scale_exactly_with_the_scene() {
 fn hit_points_lie_within_their_bounds() {
     for i in 0..6000 {
         let s = &mut rng(4, i);
-        let Some((shape, ray)) = random_hit(s, i as usize % 3) else {
+        let Some((shape, ray)) = random_hit(s, i as usize % 4) else {
             continue;
         };
         let t = shape.intersect(&ray).unwrap();
