@@ -149,5 +149,6 @@ pub fn extract(scene: &Scene) -> RenderScene {
         warnings,
     };
     render.set_effects(derived.effects);
+    render.set_shader(s.shader);
     render
 }

@@ -546,3 +546,63 @@ fn mis_beats_both_strategies_on_veachs_scene() {
         "MIS {mis:.4}, light {light:.4}, BRDF {brdf:.4}"
     );
 }
+
+/// One light per vertex, chosen by power among point and area lights, estimates the same
+/// direct light as summing the point lights: a floor lit by two point lights (`I cos / d^2`
+/// each) and the rectangle of the form-factor test (`kd L F`), under every light strategy.
+#[test]
+fn one_light_per_vertex_is_unbiased() {
+    let (a, b, c, l, kd) = (1.0f64, 2.0f64, 1.0f64, 2.0, 0.5);
+    let (x, y) = (a / c, b / c);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    let f = (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * PI);
+    let points = [
+        ((-0.5f64, 2.0f64, -0.5f64), 3.0f64),
+        ((-1.0, 1.5, -0.5), 1.0),
+    ];
+    let e_points: f64 = points
+        .iter()
+        .map(|&((px, py, pz), i)| {
+            let d2 = px * px + py * py + pz * pz;
+            i * (py / d2.sqrt()) / d2
+        })
+        .sum();
+    let want = kd / PI * e_points + kd * l * f;
+    for shader in [
+        "Path(max_depth: 1, lights_per_vertex: One, lights: Mis)",
+        "Path(max_depth: 1, lights_per_vertex: One, lights: Light)",
+        "Path(max_depth: 1, lights_per_vertex: One, lights: Brdf)",
+        "Path(max_depth: 1, lights_per_vertex: All)",
+    ] {
+        let lamps: String = points
+            .iter()
+            .map(|&((px, py, pz), i)| {
+                format!("(light: Point(position: ({px}, {py}, {pz}), intensity: ({i}, {i}, {i}))),")
+            })
+            .collect();
+        let text = format!(
+            "Scene(film: (width: 32, height: 32, spp: 16),
+               camera: Perspective(position: (3, 1, -0.5), look_at: (0, 0, 0), fov: 0.001),
+               model: Physical, shader: {shader},
+               entities: [
+                 (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)), material: Phong(kd: ({kd}, {kd}, {kd}))),
+                 (shape: Rectangle(corner: (0, {c}, 0), u: ({a}, 0, 0), v: (0, 0, {b})), emitter: Emitter(radiance: ({l}, {l}, {l}))),
+                 {lamps}
+               ])"
+        );
+        let r = render_scene(&scene(&text));
+        let (mean, se) = mean_and_se(&r);
+        let tol = 5.0 * se + 1e-5 * want;
+        assert!(
+            (mean - want).abs() <= tol,
+            "{shader}: {mean:.6} vs exact {want:.6} (tolerance {tol:.2e})"
+        );
+        // One light per vertex traces one shadow ray per camera ray; all lights, three.
+        let shadow = r.stats.shadow as f64 / r.stats.camera as f64;
+        let expect = if shader.contains("One") { 1.0 } else { 3.0 };
+        assert!(
+            shadow <= expect + 1e-9,
+            "{shader}: {shadow} shadow rays per camera ray"
+        );
+    }
+}

@@ -93,7 +93,11 @@ fn rays_starting_on_a_sphere_meet_only_its_far_side() {
         let r = log_uniform(s, 0.05, 20.0) * scale;
         // A third of the spheres sit at the origin, where the origin's own rounding is as
         // small as the sphere's: the band's terms in r^2 then decide.
-        let c = if i % 9 < 3 { Vec3A::ZERO } else { within(s, 50.0) * scale };
+        let c = if i % 9 < 3 {
+            Vec3A::ZERO
+        } else {
+            within(s, 50.0) * scale
+        };
         let n = unit(s);
         let o = c + r * n;
         let d = unit(s);

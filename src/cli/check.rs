@@ -129,8 +129,8 @@ fn shader(s: &Shader) -> String {
                 .max_depth
                 .map_or(String::new(), |d| format!("max_depth: {d}, "));
             format!(
-                "Path({depth}rr_depth: {}, sampling: {:?}, lights: {:?})",
-                p.rr_depth, p.sampling, p.lights
+                "Path({depth}rr_depth: {}, sampling: {:?}, lights: {:?}, lights_per_vertex: {:?})",
+                p.rr_depth, p.sampling, p.lights, p.lights_per_vertex
             )
         }
     }

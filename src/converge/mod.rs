@@ -8,7 +8,7 @@ pub mod warptest;
 
 use crate::material::Model;
 use crate::render::{RenderScene, film::Image, render};
-use crate::sampling::{LightSampling, Sampling};
+use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
 use crate::shader::{Global, Path, Shader};
 use std::fmt::Write as _;
 
@@ -60,6 +60,7 @@ pub fn reference_shader() -> Shader {
         rr_depth: 5,
         sampling: Sampling::Brdf,
         lights: LightSampling::Mis,
+        lights_per_vertex: LightsPerVertex::All,
     })
 }
 
@@ -151,7 +152,7 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
 /// Render `scene` with another shader and spp.
 pub fn with_settings(scene: &RenderScene, shader: Shader, spp: u32) -> RenderScene {
     let mut s = scene.clone();
-    s.shader = shader;
+    s.set_shader(shader);
     s.film.spp = spp;
     s
 }

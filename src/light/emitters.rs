@@ -7,7 +7,18 @@ use glam::Vec3A;
 /// [`crate::light`]'s index of a primitive that emits nothing.
 pub const NO_LIGHT: u32 = u32::MAX;
 
-/// Every area light of a render, with the cumulative distribution of their powers.
+/// The light one light sample picks, with the probability of picking it.
+#[derive(Clone, Copy, Debug)]
+pub enum Chosen<'a> {
+    /// An area light.
+    Area(&'a AreaLight, f32),
+    /// Point light number `index` of the render (only when the point lights take part).
+    Point(usize, f32),
+}
+
+/// Every area light of a render, with the cumulative distribution of their powers; when one
+/// light is chosen per vertex (`Path(lights_per_vertex: One)`), the point lights' powers take
+/// part too, after the area lights.
 #[derive(Clone, Debug, Default)]
 pub struct Emitters {
     /// The lights; a primitive refers to its light by index here.
@@ -16,7 +27,7 @@ pub struct Emitters {
     /// and sampled with 53-bit numbers, so that a light whose share is below f32's 2^-24 grid
     /// (one small triangle of a million) is still chosen as often as [`Emitters::pmf`] says.
     cdf: Vec<f64>,
-    /// Each light's probability, `power / total`.
+    /// Each light's probability, `power / total` (area lights, then point lights).
     pmf: Vec<f32>,
 }
 
@@ -24,7 +35,18 @@ impl Emitters {
     /// The set of `lights`, each chosen with probability proportional to its power (uniformly
     /// if none has any).
     pub fn new(lights: Vec<AreaLight>) -> Self {
-        let mut powers: Vec<f64> = lights.iter().map(|l| l.power() as f64).collect();
+        Self::with_points(lights, &[])
+    }
+
+    /// The area `lights` and point lights of powers `points`, each chosen in proportion to its
+    /// power.
+    pub fn with_points(lights: Vec<AreaLight>, points: &[f32]) -> Self {
+        let mut powers: Vec<f64> = lights
+            .iter()
+            .map(|l| l.power())
+            .chain(points.iter().copied())
+            .map(f64::from)
+            .collect();
         if powers.iter().sum::<f64>() <= 0.0 {
             powers.iter_mut().for_each(|w| *w = 1.0);
         }
@@ -50,24 +72,50 @@ impl Emitters {
         self.lights.is_empty()
     }
 
+    /// True when point lights take part in the choice.
+    #[inline]
+    pub fn with_point_lights(&self) -> bool {
+        self.pmf.len() > self.lights.len()
+    }
+
+    /// The same area lights, chosen with the point lights of powers `points` (none: among
+    /// themselves).
+    pub fn rechosen(&self, points: &[f32]) -> Self {
+        Self::with_points(self.lights.clone(), points)
+    }
+
     /// Probability that [`Emitters::choose`] picks light `i`.
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
         self.pmf[i]
     }
 
-    /// The light that `u`, uniform in [0, 1), picks, with its probability: the first whose
-    /// cumulative share exceeds `u` (a light of zero power is never picked).
+    /// The area light that `u`, uniform in [0, 1), picks, with its probability: the first
+    /// whose cumulative share exceeds `u` (a light of zero power is never picked); `None` if
+    /// `u` picks a point light, or there is no light.
     #[inline]
     pub fn choose(&self, u: f64) -> Option<(&AreaLight, f32)> {
-        if self.lights.is_empty() {
+        match self.choose_any(u)? {
+            Chosen::Area(l, pmf) => Some((l, pmf)),
+            Chosen::Point(..) => None,
+        }
+    }
+
+    /// The light, area or point, that `u` picks, with its probability.
+    #[inline]
+    pub fn choose_any(&self, u: f64) -> Option<Chosen<'_>> {
+        if self.cdf.is_empty() {
             return None;
         }
         let i = self
             .cdf
             .partition_point(|&c| c <= u)
-            .min(self.lights.len() - 1);
-        Some((&self.lights[i], self.pmf(i)))
+            .min(self.cdf.len() - 1);
+        let pmf = self.pmf[i];
+        Some(match self.lights.get(i) {
+            Some(l) => Chosen::Area(l, pmf),
+            None => Chosen::Point(i - self.lights.len(), pmf),
+        })
     }
 
     /// Density per unit solid angle with which one light sample from `p` (choose a light, then

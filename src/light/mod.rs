@@ -11,7 +11,7 @@ mod emitters;
 mod point;
 
 pub use area::{AreaLight, Emitter, Emitting, LightSample};
-pub use emitters::{Emitters, NO_LIGHT};
+pub use emitters::{Chosen, Emitters, NO_LIGHT};
 pub use point::PointLight;
 
 use glam::{DVec3, Vec3A};
@@ -63,6 +63,13 @@ pub enum Light {
 }
 
 impl Light {
+    /// Emitted power, averaged over the channels.
+    pub fn power(&self) -> f32 {
+        match self {
+            Light::Point(l) => l.power(),
+        }
+    }
+
     /// Light arriving at `p` from this light, ignoring occlusion; `None` when `p` coincides
     /// with the light.
     #[inline]

@@ -13,6 +13,12 @@ pub struct PointLight {
 }
 
 impl PointLight {
+    /// Emitted power `4 pi I`, averaged over the channels: its weight when one light is chosen
+    /// per vertex.
+    pub fn power(&self) -> f32 {
+        4.0 * std::f32::consts::PI * self.intensity.element_sum() / 3.0
+    }
+
     /// `L_i = I / d^2` along the unit direction to the light.
     #[inline]
     pub fn incident(&self, p: Vec3A) -> Option<Incident> {

@@ -118,6 +118,21 @@ impl RenderScene {
         self.effects = effects;
     }
 
+    /// Render with `shader`: the light choice follows it (point lights join the area lights'
+    /// power distribution when the path tracer chooses one light per vertex).
+    pub fn set_shader(&mut self, shader: Shader) {
+        self.shader = shader;
+        let one = matches!(shader, Shader::Path(p) if p.one_light_under(self.model));
+        if one != self.emitters.with_point_lights() {
+            let powers: Vec<f32> = if one {
+                self.lights.iter().map(Light::power).collect()
+            } else {
+                Vec::new()
+            };
+            self.emitters = self.emitters.rechosen(&powers);
+        }
+    }
+
     /// The same render with every effect on except those the scene switched off on purpose:
     /// for checking that the derived effects change no pixel.
     pub fn with_every_effect(&self) -> RenderScene {

@@ -8,4 +8,4 @@ pub mod warp;
 
 pub use pixel::pixel_sample;
 pub use rng::{Sampler, mix};
-pub use strategy::{LightSampling, Sampling, power_heuristic};
+pub use strategy::{LightSampling, LightsPerVertex, Sampling, power_heuristic};

@@ -45,3 +45,14 @@ pub fn power_heuristic(pdf: f32, other: f32) -> f32 {
     let (a, b) = ((pdf / m) * (pdf / m), (other / m) * (other / m));
     a / (a + b)
 }
+
+/// How many lights the Path integrator samples at each vertex.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, Serialize)]
+pub enum LightsPerVertex {
+    /// Every point light (one shadow ray each, the course's Eq. 3) and one area-light sample.
+    #[default]
+    All,
+    /// One light, point or area, chosen in proportion to its power (Mitsuba's and pbrt's
+    /// default): one shadow ray per vertex whatever the number of lights, at some more noise.
+    One,
+}

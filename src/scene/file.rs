@@ -23,7 +23,7 @@ use std::sync::Arc;
 
 pub use crate::material::Model;
 pub use crate::render::output::Transfer;
-pub use crate::sampling::{LightSampling, Sampling};
+pub use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
 
 /// Largest hemisphere sample count of the Global shader.
 pub const MAX_GLOBAL_SAMPLES: u32 = 1 << 16;
@@ -306,6 +306,11 @@ pub enum ShaderDesc {
         /// samples lights.
         #[serde(default)]
         lights: LightSampling,
+        /// Lights sampled at each vertex under the Physical model: `All` (default: every point
+        /// light, one shadow ray each, and one area-light sample) or `One` (one light of all,
+        /// chosen by power: one shadow ray). The Course model sums its point lights.
+        #[serde(default)]
+        lights_per_vertex: LightsPerVertex,
     },
 }
 
@@ -368,11 +373,13 @@ impl ShaderDesc {
                 rr_depth,
                 sampling,
                 lights,
+                lights_per_vertex,
             } => Shader::Path(Path {
                 max_depth: max_depth.map(|d| d.0),
                 rr_depth: rr_depth.0,
                 sampling,
                 lights,
+                lights_per_vertex,
             }),
         }
     }

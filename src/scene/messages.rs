@@ -102,6 +102,11 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
         "light strategy",
         &[("Mis", "Mis"), ("Light", "Light"), ("Brdf", "Brdf")],
     ),
+    (
+        "LightsPerVertex",
+        "light choice",
+        &[("All", "All"), ("One", "One")],
+    ),
 ];
 
 /// The example of variant `name` of any enum.
@@ -625,7 +630,9 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
 mod tests {
     use super::*;
     use crate::scene::file::{CameraFields, LightDesc, MaterialDesc, ShaderDesc, ShapeDesc};
-    use crate::scene::{Model, file::LightSampling, file::Sampling, file::Transfer};
+    use crate::scene::{
+        Model, file::LightSampling, file::LightsPerVertex, file::Sampling, file::Transfer,
+    };
     use serde::de::DeserializeOwned;
 
     fn parses<T: DeserializeOwned>(s: &str) -> bool {
@@ -682,7 +689,12 @@ mod tests {
             variants::<LightSampling>(),
             &parses::<LightSampling>,
         );
-        assert_eq!(FORMS.len(), 9);
+        check(
+            "LightsPerVertex",
+            variants::<LightsPerVertex>(),
+            &parses::<LightsPerVertex>,
+        );
+        assert_eq!(FORMS.len(), 10);
     }
 
     #[test]

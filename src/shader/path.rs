@@ -24,12 +24,12 @@
 
 use super::Tracer;
 use super::surface::{
-    Interaction, area_lights, emitted, point_lights, reflectance, specular_bounce,
+    Interaction, area_lights, emitted, one_light, point_lights, reflectance, specular_bounce,
 };
 pub use super::surface::{brdf_pdf as pdf, diffuse_probability};
 use crate::geometry::{Frame, Ray};
 use crate::material::{Material, Model, Phong, fresnel_dielectric, reflect};
-use crate::sampling::{LightSampling, Sampling, hemisphere, power_heuristic};
+use crate::sampling::{LightSampling, LightsPerVertex, Sampling, hemisphere, power_heuristic};
 use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::TAU;
@@ -45,6 +45,9 @@ pub struct Path {
     pub sampling: Sampling,
     /// How area lights are gathered (the Physical model; the Course model samples lights).
     pub lights: LightSampling,
+    /// Every point light and one area-light sample per vertex, or one light of all chosen by
+    /// power (the Physical model; the Course model's Eq. 3 sums its point lights).
+    pub lights_per_vertex: LightsPerVertex,
 }
 
 impl Path {
@@ -55,6 +58,11 @@ impl Path {
             Model::Course => LightSampling::Light,
             Model::Physical => self.lights,
         }
+    }
+
+    /// True if one light of all is chosen per vertex under `model`.
+    pub fn one_light_under(&self, model: Model) -> bool {
+        model == Model::Physical && self.lights_per_vertex == LightsPerVertex::One
     }
 }
 
@@ -74,6 +82,7 @@ pub const MAX_DEPTH: u32 = 1024;
 pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     let model = tr.model;
     let lights = p.lights_under(model);
+    let one_light_mode = p.one_light_under(model);
     let max_depth = p.max_depth.unwrap_or(MAX_DEPTH).min(MAX_DEPTH);
     let mut l = Vec3A::ZERO;
     let mut beta = Vec3A::ONE;
@@ -114,14 +123,21 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                 // Next-event estimation: Eq. 3 under the model, and one area-light sample. When
                 // no ray continues (indirect light off) the light sample carries all of the
                 // area lights, whatever the strategy.
-                l += beta * point_lights(tr, &si, &phong);
-                if !tr.effects.indirect {
-                    l += beta * area_lights(tr, &si, &phong, 1, None);
-                    break;
+                let mis =
+                    (lights == LightSampling::Mis && tr.effects.indirect).then_some(p.sampling);
+                let sample_area = lights != LightSampling::Brdf || !tr.effects.indirect;
+                if one_light_mode {
+                    // One light of all, chosen by power. Under `Brdf` the area lights are
+                    // left to the sampled rays, and a chosen area light adds nothing.
+                    l += beta * one_light(tr, &si, &phong, mis, sample_area);
+                } else {
+                    l += beta * point_lights(tr, &si, &phong);
+                    if sample_area {
+                        l += beta * area_lights(tr, &si, &phong, 1, mis);
+                    }
                 }
-                let mis = (lights == LightSampling::Mis).then_some(p.sampling);
-                if lights != LightSampling::Brdf {
-                    l += beta * area_lights(tr, &si, &phong, 1, mis);
+                if !tr.effects.indirect {
+                    break;
                 }
                 let Some((wi, weight, pdf)) = sample_phong(tr, &phong, &si, model, p.sampling)
                 else {

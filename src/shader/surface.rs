@@ -6,7 +6,7 @@
 use super::Tracer;
 use crate::effects::Effects;
 use crate::geometry::{Hit, Origins, Ray};
-use crate::light::NO_LIGHT;
+use crate::light::{AreaLight, Chosen, Light, NO_LIGHT};
 use crate::material::{Material, Model, Phong, reflect};
 use crate::sampling::{Sampling, hemisphere, power_heuristic};
 use crate::stats::RayKind;
@@ -91,29 +91,35 @@ pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light_samp
 /// Without shadows (`effects: (shadows: false)`) every light facing the point counts.
 #[inline]
 pub fn point_lights(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
-    let mut l_dir = Vec3A::ZERO;
     if phong.is_black() {
         // Reflects nothing: no shadow ray can change that.
-        return l_dir;
+        return Vec3A::ZERO;
     }
-    let model = tr.model;
-    for light in tr.lights {
-        let Some(inc) = light.incident(si.hit.p) else {
-            continue;
-        };
-        if inc.wi.dot(si.n) <= 0.0 {
-            continue;
-        }
-        // Shadow ray V^s: stop just short of the light, so that a surface the light sits on
-        // does not block it.
-        let visible = !tr.effects.shadows || {
-            tr.unoccluded(&si.origins.ray(inc.wi, inc.dist * SHADOW_END))
-        };
-        if visible {
-            l_dir += inc.li * reflectance(model, phong, inc.wi, si.wo, si.n);
-        }
+    let lights = tr.lights;
+    lights
+        .iter()
+        .map(|light| point_light(tr, si, phong, light))
+        .sum()
+}
+
+/// One point light's term of Eq. 3: `L_i r(wi, wo) V`.
+#[inline]
+fn point_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light: &Light) -> Vec3A {
+    let Some(inc) = light.incident(si.hit.p) else {
+        return Vec3A::ZERO;
+    };
+    if inc.wi.dot(si.n) <= 0.0 {
+        return Vec3A::ZERO;
     }
-    l_dir
+    // Shadow ray V^s: stop just short of the light, so that a surface the light sits on does
+    // not block it.
+    let visible =
+        !tr.effects.shadows || tr.unoccluded(&si.origins.ray(inc.wi, inc.dist * SHADOW_END));
+    if visible {
+        inc.li * reflectance(tr.model, phong, inc.wi, si.wo, si.n)
+    } else {
+        Vec3A::ZERO
+    }
 }
 
 /// The area lights' share of Eq. 3, `int L_e(wi) r(wi, wo) V(wi) dwi` over the directions that
@@ -135,39 +141,81 @@ pub fn area_lights(
     if !tr.effects.emission || tr.emitters.is_empty() || samples == 0 || phong.is_black() {
         return Vec3A::ZERO;
     }
-    let model = tr.model;
     let mut sum = Vec3A::ZERO;
     for _ in 0..samples {
         // Choose a light by power, then a point on it.
         let u = tr.sampler.next_f64();
         let (u1, u2) = tr.sampler.next_2d();
-        let Some((light, pmf)) = tr.emitters.choose(u) else {
-            break;
-        };
-        let Some(ls) = light.sample(si.hit.p, u1, u2) else {
-            continue;
-        };
-        if ls.le == Vec3A::ZERO || ls.wi.dot(si.n) <= 0.0 {
-            continue;
+        if let Some((light, pmf)) = tr.emitters.choose(u) {
+            sum += area_sample(tr, si, phong, light, pmf, (u1, u2), mis);
         }
-        let pdf = pmf * ls.pdf;
-        // A density of zero (or NaN) cannot weigh a sample.
-        if pdf.is_nan() || pdf <= 0.0 {
-            continue;
-        }
-        // Shadow ray V: stop just short of the sampled point.
-        let visible =
-            !tr.effects.shadows || tr.unoccluded(&si.origins.ray(ls.wi, ls.dist * SHADOW_END));
-        if !visible {
-            continue;
-        }
-        let w = match mis {
-            Some(sampling) => power_heuristic(pdf, brdf_pdf(phong, si.wo, si.n, ls.wi, sampling)),
-            None => 1.0,
-        };
-        sum += ls.le * reflectance(model, phong, ls.wi, si.wo, si.n) * (w / pdf);
     }
     sum / samples as f32
+}
+
+/// One light of all, point or area, chosen in proportion to its power and divided by the
+/// chance of choosing it (the path tracer's `lights_per_vertex: One`): one shadow ray. With
+/// `area` false a chosen area light adds nothing (BRDF-sampled rays gather area lights).
+#[inline]
+pub fn one_light(
+    tr: &mut Tracer,
+    si: &Interaction,
+    phong: &Phong,
+    mis: Option<Sampling>,
+    area: bool,
+) -> Vec3A {
+    if phong.is_black() {
+        return Vec3A::ZERO;
+    }
+    let u = tr.sampler.next_f64();
+    let (u1, u2) = tr.sampler.next_2d();
+    match tr.emitters.choose_any(u) {
+        Some(Chosen::Point(j, pmf)) => {
+            let light = tr.lights[j];
+            point_light(tr, si, phong, &light) / pmf
+        }
+        Some(Chosen::Area(light, pmf)) if area && tr.effects.emission => {
+            area_sample(tr, si, phong, light, pmf, (u1, u2), mis)
+        }
+        _ => Vec3A::ZERO,
+    }
+}
+
+/// One sample of `light`, chosen with probability `pmf`, from the random numbers `u`:
+/// `L_e r V w / (pmf pdf)`, with `w` the power heuristic's weight against BRDF sampling under
+/// `mis` (else 1).
+#[inline]
+fn area_sample(
+    tr: &mut Tracer,
+    si: &Interaction,
+    phong: &Phong,
+    light: &AreaLight,
+    pmf: f32,
+    (u1, u2): (f32, f32),
+    mis: Option<Sampling>,
+) -> Vec3A {
+    let Some(ls) = light.sample(si.hit.p, u1, u2) else {
+        return Vec3A::ZERO;
+    };
+    if ls.le == Vec3A::ZERO || ls.wi.dot(si.n) <= 0.0 {
+        return Vec3A::ZERO;
+    }
+    let pdf = pmf * ls.pdf;
+    // A density of zero (or NaN) cannot weigh a sample.
+    if pdf.is_nan() || pdf <= 0.0 {
+        return Vec3A::ZERO;
+    }
+    // Shadow ray V: stop just short of the sampled point.
+    let visible =
+        !tr.effects.shadows || tr.unoccluded(&si.origins.ray(ls.wi, ls.dist * SHADOW_END));
+    if !visible {
+        return Vec3A::ZERO;
+    }
+    let w = match mis {
+        Some(sampling) => power_heuristic(pdf, brdf_pdf(phong, si.wo, si.n, ls.wi, sampling)),
+        None => 1.0,
+    };
+    ls.le * reflectance(tr.model, phong, ls.wi, si.wo, si.n) * (w / pdf)
 }
 
 /// Probability of picking the diffuse lobe in BRDF sampling: the lobes' share of `kd + ks`.
