@@ -320,39 +320,9 @@ fn cornell_box_matches_mitsuba() {
         (a.image.width, a.image.height),
         (reference.width, reference.height)
     );
-    let block = |img: &rtis::render::film::Image, bx: u32, by: u32| {
-        let mut s = Vec3A::ZERO;
-        for y in 0..4 {
-            for x in 0..4 {
-                s += img.get(bx * 4 + x, by * 4 + y);
-            }
-        }
-        s / 16.0
-    };
-    let (bw, bh) = (a.image.width / 4, a.image.height / 4);
-    let (mut d_ab, mut d_ref, mut n) = (0.0f64, 0.0f64, 0.0f64);
-    for by in 0..bh {
-        for bx in 0..bw {
-            let (pa, pb, pr) = (
-                block(&a.image, bx, by),
-                block(&b.image, bx, by),
-                block(&reference, bx, by),
-            );
-            let ab = pa - pb;
-            let m = 0.5 * (pa + pb) - pr;
-            d_ab += ab.dot(ab) as f64 / 3.0;
-            d_ref += m.dot(m) as f64 / 3.0;
-            n += 1.0;
-        }
-    }
-    let var_ours = d_ab / n / 2.0;
-    let var_ref = 0.0069f64.powi(2) / 16.0;
-    let mse = d_ref / n;
-    let allowed = 1.5 * (var_ours / 2.0 + var_ref);
-    eprintln!(
-        "block MSE vs Mitsuba {mse:.3e}; noise explains {:.3e}; allowed {allowed:.3e}",
-        var_ours / 2.0 + var_ref
-    );
+    let (mse, noise) = common::block_mse(&a.image, &b.image, &reference, 0.0069, &|_, _| false);
+    let allowed = 1.5 * noise;
+    eprintln!("block MSE vs Mitsuba {mse:.3e}; noise explains {noise:.3e}; allowed {allowed:.3e}");
     assert!(
         mse < allowed,
         "block MSE {mse:.3e} exceeds {allowed:.3e}: the images differ beyond noise"
@@ -365,15 +335,6 @@ fn cornell_box_matches_mitsuba() {
         ((ma - mr) / mr).abs().max_element() < 0.01,
         "mean {ma} vs Mitsuba {mr}"
     );
-}
-
-/// Mean and standard error of the mean over an image's pixels (first channel).
-fn mean_and_se(r: &rtis::render::Rendered) -> (f64, f64) {
-    let v: Vec<f64> = r.image.pixels.iter().map(|p| p.x as f64).collect();
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
 }
 
 /// Physical glass carries radiance across an interface by `(n_wo / n_wi)^2`. A camera in air
@@ -394,7 +355,7 @@ fn physical_glass_half_space_from_air() {
         ));
         let f = ((n - 1.0) / (n + 1.0)).powi(2);
         let expected = f + (1.0 - f) / (n * n);
-        let (mean, se) = mean_and_se(&r);
+        let (mean, se) = common::mean_and_se(&r);
         let reflected =
             r.stats.reflection as f64 / (r.stats.reflection + r.stats.refraction) as f64;
         assert!(
@@ -422,7 +383,7 @@ fn physical_glass_ball_from_inside() {
             shader: Path(),
             entities: [(shape: Sphere(center: (0, 0, 0), radius: 1), material: Transmissive(ior: {n}))])"#
         ));
-        let (mean, _) = mean_and_se(&r);
+        let (mean, _) = common::mean_and_se(&r);
         assert!(
             (mean / (n * n) - 1.0).abs() < 1e-3,
             "n = {n}: {mean}, expected {}",

@@ -303,30 +303,26 @@ fn shared_edges_and_vertices_have_exactly_one_owner() {
         tri((0., 0.), (1., 0.), (1., 1.)),
         tri((0., 0.), (1., 1.), (0., 1.)),
     ];
-    assert_eq!(
-        owners(&diagonal, 0.5, 0.5, 1.0),
-        vec![0],
-        "diagonal from below"
-    );
-    assert_eq!(
-        owners(&diagonal, 0.25, 0.25, -1.0).len(),
-        1,
-        "diagonal from above"
-    );
     let horizontal = [
         tri((0., 0.), (1., 0.), (0.5, 1.)),
         tri((1., 0.), (0., 0.), (0.5, -1.)),
     ];
-    assert_eq!(
-        owners(&horizontal, 0.5, 0.0, 1.0),
-        vec![0],
-        "horizontal edge from below"
-    );
-    assert_eq!(
-        owners(&horizontal, 0.25, 0.0, -1.0).len(),
-        1,
-        "horizontal edge from above"
-    );
+    // From below, the owner worked by hand; from above, exactly one.
+    for (name, pair, below, above) in [
+        ("diagonal", diagonal, (0.5, 0.5), (0.25, 0.25)),
+        ("horizontal edge", horizontal, (0.5, 0.0), (0.25, 0.0)),
+    ] {
+        assert_eq!(
+            owners(&pair, below.0, below.1, 1.0),
+            vec![0],
+            "{name} from below"
+        );
+        assert_eq!(
+            owners(&pair, above.0, above.1, -1.0).len(),
+            1,
+            "{name} from above"
+        );
+    }
     // A 2 x 2 grid of squares, each split on its diagonal: 8 triangles around (1, 1), with
     // shared edges along x, along y and diagonal, crossed from both sides at dyadic points.
     let mut grid = Vec::new();

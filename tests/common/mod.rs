@@ -44,3 +44,54 @@ pub fn render_str(text: &str) -> Rendered {
 pub fn close(a: Vec3A, b: Vec3A, rel: f32) -> bool {
     (a - b).abs().max_element() <= rel * b.abs().max_element().max(1e-6)
 }
+
+/// Two renders `a` and `b` of one scene with different seeds against an independent reference
+/// `r` whose per-pixel noise RMSE is `ref_noise`, on 4 x 4 blocks (blocks where `skip` holds
+/// are left out): returns the block MSE of `(a + b) / 2` against `r`, and what noise alone
+/// explains, `var_ours / 2 + var_ref` (our block variance estimated from `a - b`). If both
+/// estimate the same image, the first is about the second.
+pub fn block_mse(
+    a: &rtis::render::film::Image,
+    b: &rtis::render::film::Image,
+    r: &rtis::render::film::Image,
+    ref_noise: f64,
+    skip: &dyn Fn(u32, u32) -> bool,
+) -> (f64, f64) {
+    assert_eq!((a.width, a.height), (r.width, r.height));
+    let block = |img: &rtis::render::film::Image, bx: u32, by: u32| {
+        let mut s = Vec3A::ZERO;
+        for y in 0..4 {
+            for x in 0..4 {
+                s += img.get(bx * 4 + x, by * 4 + y);
+            }
+        }
+        s / 16.0
+    };
+    let (mut d_ab, mut d_ref, mut n) = (0.0f64, 0.0f64, 0.0f64);
+    for by in 0..a.height / 4 {
+        for bx in 0..a.width / 4 {
+            if skip(bx, by) {
+                continue;
+            }
+            let (pa, pb, pr) = (block(a, bx, by), block(b, bx, by), block(r, bx, by));
+            let ab = pa - pb;
+            let m = 0.5 * (pa + pb) - pr;
+            d_ab += ab.dot(ab) as f64 / 3.0;
+            d_ref += m.dot(m) as f64 / 3.0;
+            n += 1.0;
+        }
+    }
+    let var_ours = d_ab / n / 2.0;
+    let var_ref = ref_noise * ref_noise / 16.0;
+    (d_ref / n, var_ours / 2.0 + var_ref)
+}
+
+/// Mean of the first channel over an image's pixels and its standard error (pixels are
+/// independent estimates of the same value when the camera sees one point).
+pub fn mean_and_se(r: &Rendered) -> (f64, f64) {
+    let v: Vec<f64> = r.image.pixels.iter().map(|p| p.x as f64).collect();
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
