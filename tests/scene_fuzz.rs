@@ -257,6 +257,8 @@ proptest! {
         }
         let tmp = std::env::temp_dir().join(format!("rtis-fuzz-{}", std::process::id()));
         std::fs::create_dir_all(&tmp).unwrap();
+        // Removed when the case ends, however it ends.
+        let _cleanup = RemoveOnDrop(tmp.clone());
         let shown = String::from_utf8_lossy(&bytes).into_owned();
         let result = catch_unwind(AssertUnwindSafe(|| load(name, &bytes, &tmp)));
         let result = match result {
@@ -289,5 +291,14 @@ proptest! {
             prop_assert!(e.message.chars().count() <= MAX_MESSAGE);
             prop_assert!(display.len() < 2000, "{display}");
         }
+    }
+}
+
+/// Removes a folder when dropped.
+struct RemoveOnDrop(std::path::PathBuf);
+
+impl Drop for RemoveOnDrop {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
     }
 }
