@@ -64,7 +64,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
             };
             let light = match (emitter, emitting) {
                 (Some(&emitter), Some(shape)) => {
-                    area_lights.push(AreaLight { shape, emitter });
+                    area_lights.push(AreaLight::new(shape, emitter));
                     (area_lights.len() - 1) as u32
                 }
                 _ => NO_LIGHT,

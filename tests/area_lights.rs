@@ -226,23 +226,23 @@ fn scenes_without_emitters_pay_nothing() {
 /// L = (1, 2, 3) (power pi 0.5 2 2 = 2 pi).
 #[test]
 fn lights_are_chosen_by_power() {
-    let sphere = AreaLight {
-        shape: Emitting::Sphere(Sphere {
+    let sphere = AreaLight::new(
+        Emitting::Sphere(Sphere {
             c: Vec3A::ZERO,
             r: 1.0,
         }),
-        emitter: Emitter {
+        Emitter {
             radiance: Vec3A::ONE,
             two_sided: false,
         },
-    };
-    let triangle = AreaLight {
-        shape: Emitting::Triangle(Triangle::new(Vec3A::ZERO, Vec3A::X, Vec3A::Y).unwrap()),
-        emitter: Emitter {
+    );
+    let triangle = AreaLight::new(
+        Emitting::Triangle(Triangle::new(Vec3A::ZERO, Vec3A::X, Vec3A::Y).unwrap()),
+        Emitter {
             radiance: Vec3A::new(1.0, 2.0, 3.0),
             two_sided: true,
         },
-    };
+    );
     let (ps, pt) = (4.0 * PI * PI, 2.0 * PI);
     assert!((sphere.power() as f64 - ps).abs() < 1e-4);
     assert!((triangle.power() as f64 - pt).abs() < 1e-5);
@@ -279,15 +279,17 @@ fn lights_are_chosen_by_power() {
 /// against its by-power density.
 #[test]
 fn a_wrong_light_pdf_is_rejected() {
-    let light = |r: f32| AreaLight {
-        shape: Emitting::Sphere(Sphere {
-            c: Vec3A::new(-2.0, 2.0, 1.5),
-            r,
-        }),
-        emitter: Emitter {
-            radiance: Vec3A::ONE,
-            two_sided: false,
-        },
+    let light = |r: f32| {
+        AreaLight::new(
+            Emitting::Sphere(Sphere {
+                c: Vec3A::new(-2.0, 2.0, 1.5),
+                r,
+            }),
+            Emitter {
+                radiance: Vec3A::ONE,
+                two_sided: false,
+            },
+        )
     };
     let claimed = Emitters::new(vec![light(1.1)]);
     let drawn = Emitters::new(vec![light(1.0)]);
@@ -349,14 +351,14 @@ proptest! {
             return Ok(());
         };
         let emitters = Emitters::new(vec![
-            AreaLight {
-                shape: Emitting::Sphere(Sphere { c, r }),
-                emitter: Emitter { radiance: Vec3A::ONE, two_sided: true },
-            },
-            AreaLight {
-                shape: Emitting::Triangle(triangle),
-                emitter: Emitter { radiance: Vec3A::splat(3.0), two_sided: true },
-            },
+            AreaLight::new(
+                Emitting::Sphere(Sphere { c, r }),
+                Emitter { radiance: Vec3A::ONE, two_sided: true },
+            ),
+            AreaLight::new(
+                Emitting::Triangle(triangle),
+                Emitter { radiance: Vec3A::splat(3.0), two_sided: true },
+            ),
         ]);
         let Some((light, pmf)) = emitters.choose(u.0) else { return Ok(()) };
         let Some(ls) = light.sample(p, u.1, u.2) else { return Ok(()) };
@@ -404,16 +406,7 @@ fn mitsuba_cornell_box_with_an_area_light() {
     let a = render_scene(&s);
     s.settings.seed = 4321;
     let b = render_scene(&s);
-    let reference = rtis::render::output::load(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/mitsuba_cornell_area_128_spp4096.exr"),
-    )
-    .unwrap()
-    .flipped_horizontally();
-    assert_eq!(
-        (a.image.width, a.image.height),
-        (reference.width, reference.height)
-    );
+    let reference = common::mitsuba_reference("mitsuba_cornell_area_128_spp4096.exr");
     let sees_light = |bx: u32, by: u32| {
         (0..16).any(|i| reference.get(bx * 4 + i % 4, by * 4 + i / 4).max_element() > 3.0)
     };

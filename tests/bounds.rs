@@ -7,9 +7,8 @@
 //! divided instead of multiplied, is caught even when it leaves the bound safe.
 
 use glam::{DVec3, Vec3A};
-use rtis::accel::{FLAT, Geometry, Prim};
+use rtis::accel::{Geometry, Prim};
 use rtis::geometry::Ray;
-use rtis::light::NO_LIGHT;
 use rtis::sampling::Sampler;
 use rtis::shape::{Plane, Shape, Sphere, Surface, Triangle};
 
@@ -37,15 +36,6 @@ fn log_uniform(s: &mut Sampler, lo: f32, hi: f32) -> f32 {
     (lo.ln() + s.next_f32() * (hi.ln() - lo.ln())).exp()
 }
 
-fn prim(shape: Shape) -> Prim {
-    Prim {
-        shape,
-        material: 0,
-        smooth: FLAT,
-        light: NO_LIGHT,
-    }
-}
-
 /// The far root of the ray against the sphere in double precision.
 fn far_root(o: Vec3A, d: Vec3A, c: Vec3A, r: f32) -> f64 {
     let f = o.as_dvec3() - c.as_dvec3();
@@ -59,12 +49,12 @@ fn far_root(o: Vec3A, d: Vec3A, c: Vec3A, r: f32) -> f64 {
 /// most 16 spheres), and the BVH (more): each returns the distance to `s` along `ray`.
 fn sphere_paths(s: Sphere, ray: &Ray) -> [Option<f32>; 3] {
     let scalar = Shape::Sphere(s).intersect(ray);
-    let packed = Geometry::build(vec![prim(Shape::Sphere(s))], Vec::new());
+    let packed = Geometry::build(vec![Prim::flat(Shape::Sphere(s))], Vec::new());
     // 17 spheres go to the BVH; the 16 others are tiny and far behind the ray's origin.
-    let mut many = vec![prim(Shape::Sphere(s))];
+    let mut many = vec![Prim::flat(Shape::Sphere(s))];
     for k in 0..16 {
         let far = s.c - ray.d * (1e3 * s.r + 10.0 * s.r * k as f32);
-        many.push(prim(Shape::Sphere(Sphere {
+        many.push(Prim::flat(Shape::Sphere(Sphere {
             c: far,
             r: s.r * 1e-3,
         })));
@@ -159,7 +149,7 @@ fn rays_starting_on_a_plane_do_not_meet_it() {
             None,
             "{plane:?} from {o}"
         );
-        let g = Geometry::build(vec![prim(Shape::Plane(plane))], Vec::new());
+        let g = Geometry::build(vec![Prim::flat(Shape::Plane(plane))], Vec::new());
         assert!(g.intersect(&ray).is_none(), "packet: {plane:?} from {o}");
     }
 }

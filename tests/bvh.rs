@@ -4,24 +4,12 @@
 //! hits with brute force) but a slower tree; the SAH cost sees it without timing anything.
 
 use glam::Vec3;
-use rtis::accel::{FLAT, Geometry, Prim};
+use rtis::accel::{Geometry, Prim};
 use rtis::mesh::displaced_sphere;
 use rtis::shape::{Shape, Triangle};
 
 fn mesh_prims(n: usize) -> Vec<Prim> {
-    let mesh = displaced_sphere(n, Vec3::ZERO, 1.0, 0.05);
-    mesh.faces
-        .iter()
-        .filter_map(|f| {
-            let [a, b, c] = f.map(|i| mesh.positions[i as usize].as_vec3a());
-            Triangle::new(a, b, c).map(|t| Prim {
-                shape: Shape::Triangle(t),
-                material: 0,
-                smooth: FLAT,
-                light: rtis::light::NO_LIGHT,
-            })
-        })
-        .collect()
+    Prim::flat_triangles(&displaced_sphere(n, Vec3::ZERO, 1.0, 0.05))
 }
 
 fn area(min: Vec3, max: Vec3) -> f32 {
@@ -118,12 +106,7 @@ fn bvh_holds_every_primitive_once_in_nested_boxes_and_beats_a_median_split() {
 #[test]
 fn leaves_stay_small_when_no_split_helps() {
     let t = Triangle::new(Vec3::ZERO.into(), Vec3::X.into(), Vec3::Y.into()).unwrap();
-    let prim = Prim {
-        shape: Shape::Triangle(t),
-        material: 0,
-        smooth: FLAT,
-        light: rtis::light::NO_LIGHT,
-    };
+    let prim = Prim::flat(Shape::Triangle(t));
     let g = Geometry::build(vec![prim; 100], Vec::new());
     let leaves: Vec<u32> = g
         .bvh
@@ -146,15 +129,9 @@ fn leaves_stay_small_when_no_split_helps() {
 fn small_sets_split_only_when_the_sah_says_so() {
     let tri = |o: Vec3, s: f32| {
         let a = o;
-        Prim {
-            shape: Shape::Triangle(
-                Triangle::new(a.into(), (a + Vec3::X * s).into(), (a + Vec3::Y * s).into())
-                    .unwrap(),
-            ),
-            material: 0,
-            smooth: FLAT,
-            light: rtis::light::NO_LIGHT,
-        }
+        Prim::flat(Shape::Triangle(
+            Triangle::new(a.into(), (a + Vec3::X * s).into(), (a + Vec3::Y * s).into()).unwrap(),
+        ))
     };
     let corners: Vec<Prim> = [
         Vec3::ZERO,

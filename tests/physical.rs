@@ -6,8 +6,8 @@ mod common;
 use common::{render_str, scene, scenes_dir};
 use glam::Vec3A;
 use proptest::prelude::*;
-use rtis::geometry::Frame;
-use rtis::material::{Phong, reflect};
+use rtis::converge::warptest;
+use rtis::material::Phong;
 use rtis::sampling::Sampling;
 use rtis::sampling::{Sampler, hemisphere};
 use rtis::shader::path;
@@ -177,12 +177,13 @@ fn chi2_quantile(k: f64, z: f64) -> f64 {
     k * (1.0 - a + z * a.sqrt()).powi(3)
 }
 
-/// Chi-squared test of each sampling routine against its pdf, as pbrt and Mitsuba do: histogram
-/// 500000 samples on a 20 x 40 (cos theta, phi) grid of the sphere, integrate the pdf over each
-/// cell (8 x 8 sub-cells), pool cells expecting fewer than 5, and reject at p = 1e-4 (z = 3.72).
+/// Chi-squared test of each sampling routine against its pdf, as pbrt and Mitsuba do, through
+/// `rtis warptest`'s machinery: histogram 500000 samples on its 20 x 40 (cos theta, phi) grid of
+/// the sphere, integrate the pdf over each cell, pool cells expecting fewer than 5, and reject
+/// at p = 1e-4 (z = 3.72).
 #[test]
 fn samplers_match_their_pdfs_chi_squared() {
-    let (nt, np, count) = (20usize, 40usize, 500_000usize);
+    let count = 500_000;
     let cases: Vec<(Phong, Vec3A, Sampling)> = vec![
         (
             Phong {
@@ -222,76 +223,14 @@ fn samplers_match_their_pdfs_chi_squared() {
         ),
     ];
     for (phong, wo, sampling) in cases {
-        let n = Vec3A::Z;
-        let cell = |w: Vec3A| {
-            let t = (((w.z + 1.0) * 0.5 * nt as f32) as usize).min(nt - 1);
-            let phi = w.y.atan2(w.x).rem_euclid(2.0 * PI);
-            let p = ((phi / (2.0 * PI) * np as f32) as usize).min(np - 1);
-            t * np + p
-        };
-        let mut observed = vec![0f64; nt * np];
-        let mut s = Sampler::new(42, 0, 0);
-        for _ in 0..count {
-            let (u1, u2) = s.next_2d();
-            let wi = match sampling {
-                Sampling::Uniform => hemisphere::uniform(u1, u2),
-                Sampling::Cosine => hemisphere::cosine(u1, u2),
-                Sampling::Brdf => {
-                    if s.next_f32() < path::diffuse_probability(&phong) {
-                        hemisphere::cosine(u1, u2)
-                    } else {
-                        Frame::from_normal(reflect(wo, n)).to_world(hemisphere::phong_lobe(
-                            u1,
-                            u2,
-                            phong.shininess,
-                        ))
-                    }
-                }
-            };
-            // Directions below the surface are rejected by the integrator: an "escaped" cell.
-            if wi.dot(n) > 0.0 {
-                observed[cell(wi)] += 1.0;
-            }
-        }
-        let mut expected = vec![0f64; nt * np];
-        let sub = 8;
-        for t in 0..nt {
-            for p in 0..np {
-                let mut acc = 0.0f64;
-                for a in 0..sub {
-                    for b in 0..sub {
-                        let z = -1.0 + 2.0 * (t as f32 + (a as f32 + 0.5) / sub as f32) / nt as f32;
-                        let phi = 2.0 * PI * (p as f32 + (b as f32 + 0.5) / sub as f32) / np as f32;
-                        let r = (1.0 - z * z).max(0.0).sqrt();
-                        let wi = Vec3A::new(r * phi.cos(), r * phi.sin(), z);
-                        acc += path::pdf(&phong, wo, n, wi, sampling) as f64;
-                    }
-                }
-                let area = (2.0 / nt as f64) * (2.0 * std::f64::consts::PI / np as f64);
-                expected[t * np + p] = acc / (sub * sub) as f64 * area * count as f64;
-            }
-        }
-        // Pool small cells, then chi^2.
-        let (mut chi2, mut dof, mut pool_o, mut pool_e) = (0.0, 0usize, 0.0, 0.0);
-        for (o, e) in observed.iter().zip(&expected) {
-            if *e < 5.0 {
-                pool_o += o;
-                pool_e += e;
-            } else {
-                chi2 += (o - e) * (o - e) / e;
-                dof += 1;
-            }
-        }
-        if pool_e >= 5.0 {
-            chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-            dof += 1;
-        }
-        let limit = chi2_quantile((dof - 1) as f64, 3.72);
+        let case = warptest::direction_case("", phong, wo, sampling);
+        let o = warptest::run(&case, count, 42);
+        let (chi2, dof) = (o.chi2, o.dof);
+        let limit = chi2_quantile(dof as f64, 3.72);
         assert!(
             chi2 < limit,
-            "{sampling:?} s {}: chi2 {chi2:.1} with {} dof, limit {limit:.1}",
-            phong.shininess,
-            dof - 1
+            "{sampling:?} s {}: chi2 {chi2:.1} with {dof} dof, limit {limit:.1}",
+            phong.shininess
         );
     }
 }
@@ -310,16 +249,7 @@ fn cornell_box_matches_mitsuba() {
     let a = common::render_scene(&s);
     s.settings.seed = 1234;
     let b = common::render_scene(&s);
-    let reference = rtis::render::output::load(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/cornell_rtis_diffuse_360x288_dinf_spp4096.exr"),
-    )
-    .unwrap()
-    .flipped_horizontally();
-    assert_eq!(
-        (a.image.width, a.image.height),
-        (reference.width, reference.height)
-    );
+    let reference = common::mitsuba_reference("cornell_rtis_diffuse_360x288_dinf_spp4096.exr");
     let (mse, noise) = common::block_mse(&a.image, &b.image, &reference, 0.0069, &|_, _| false);
     let allowed = 1.5 * noise;
     eprintln!("block MSE vs Mitsuba {mse:.3e}; noise explains {noise:.3e}; allowed {allowed:.3e}");

@@ -2,7 +2,7 @@
 
 use glam::Vec3A;
 use proptest::prelude::*;
-use rtis::accel::{FLAT, Geometry, Prim};
+use rtis::accel::{Geometry, Prim};
 use rtis::geometry::{Hit, Ray};
 use rtis::shape::{Plane, Shape, Sphere, Triangle};
 
@@ -207,7 +207,7 @@ proptest! {
             .chain([Shape::Plane(Plane::through(Vec3A::new(0.0, -2.0 * s, 0.0), Vec3A::Y))])
             .collect();
         let prims = |shapes: &[Shape]| -> Vec<Prim> {
-            shapes.iter().map(|&shape| Prim { shape, material: 0, smooth: FLAT, light: rtis::light::NO_LIGHT }).collect()
+            shapes.iter().map(|&shape| Prim::flat(shape)).collect()
         };
         let packed = Geometry::build(prims(&shapes), Vec::new());
         // Padding the scene to 17 spheres (far away) sends its spheres to the BVH.
@@ -250,22 +250,14 @@ fn unit_sphere_is_hit_at_four_in_every_path() {
     });
     let ray = Ray::new(Vec3A::new(0.0, 0.0, -5.0), Vec3A::Z);
     assert_eq!(sphere.intersect(&ray), Some(4.0));
-    let prim = Prim {
-        shape: sphere,
-        material: 0,
-        smooth: FLAT,
-        light: rtis::light::NO_LIGHT,
-    };
+    let prim = Prim::flat(sphere);
     let packed = Geometry::build(vec![prim], Vec::new());
     assert_eq!(packed.intersect(&ray).map(|h| h.t), Some(4.0));
-    let far = |i: usize| Prim {
-        shape: Shape::Sphere(Sphere {
+    let far = |i: usize| {
+        Prim::flat(Shape::Sphere(Sphere {
             c: Vec3A::new(100.0, i as f32, 0.0),
             r: 0.1,
-        }),
-        material: 0,
-        smooth: FLAT,
-        light: rtis::light::NO_LIGHT,
+        }))
     };
     let bvh = Geometry::build(
         std::iter::once(prim).chain((0..20).map(far)).collect(),

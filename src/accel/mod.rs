@@ -7,7 +7,7 @@ pub mod lanes;
 pub use bvh::{Bvh, Node};
 
 use crate::geometry::{Hit, Ray};
-use crate::shape::{Shape, ShapeKind};
+use crate::shape::{Shape, ShapeKind, Triangle};
 use lanes::{Lanes, PlaneLanes, RayLanes, SphereLanes};
 
 /// A shape with the index of its material.
@@ -22,6 +22,31 @@ pub struct Prim {
     /// Index of the primitive's area light in the render's `Emitters`, or
     /// [`crate::light::NO_LIGHT`].
     pub light: u32,
+}
+
+impl Prim {
+    /// A primitive of material 0, shaded with its geometric normal, emitting nothing: the form
+    /// benchmarks and tests build geometry in.
+    pub fn flat(shape: Shape) -> Self {
+        Prim {
+            shape,
+            material: 0,
+            smooth: FLAT,
+            light: crate::light::NO_LIGHT,
+        }
+    }
+
+    /// The non-degenerate triangles of `mesh` as [`Prim::flat`] primitives, in its own
+    /// coordinates (for benchmarks and tests; scenes go through extraction).
+    pub fn flat_triangles(mesh: &crate::mesh::MeshData) -> Vec<Prim> {
+        mesh.faces
+            .iter()
+            .filter_map(|f| {
+                let [a, b, c] = f.map(|i| mesh.positions[i as usize].as_vec3a());
+                Triangle::new(a, b, c).map(|t| Prim::flat(Shape::Triangle(t)))
+            })
+            .collect()
+    }
 }
 
 /// [`Prim::smooth`] of a primitive shaded with its geometric normal.

@@ -4,7 +4,7 @@ use super::CliError;
 use clap::Args;
 use glam::{Vec3, Vec3A};
 use rtis::RenderScene;
-use rtis::accel::{FLAT, Geometry, Node, Prim};
+use rtis::accel::{Geometry, Node, Prim};
 use rtis::converge::{reference_shader, with_settings};
 use rtis::geometry::Ray;
 use rtis::mesh::displaced_sphere;
@@ -12,7 +12,6 @@ use rtis::render::render;
 use rtis::sampling::{Sampler, hemisphere};
 use rtis::scene::load_default;
 use rtis::shader::{Global, Shader};
-use rtis::shape::{Shape, Triangle};
 use std::time::Instant;
 
 /// Arguments of `rtis bench`.
@@ -257,19 +256,7 @@ fn meshes_section(
     };
     for &n in sizes {
         let mesh = displaced_sphere(n as usize, Vec3::ZERO, 1.0, 0.05);
-        let prims: Vec<Prim> = mesh
-            .faces
-            .iter()
-            .filter_map(|f| {
-                let [a, b, c] = f.map(|i| mesh.positions[i as usize].as_vec3a());
-                Triangle::new(a, b, c).map(|t| Prim {
-                    shape: Shape::Triangle(t),
-                    material: 0,
-                    smooth: FLAT,
-                    light: rtis::light::NO_LIGHT,
-                })
-            })
-            .collect();
+        let prims = Prim::flat_triangles(&mesh);
         let count = prims.len();
         let start = Instant::now();
         let g = Geometry::build(prims, Vec::new());

@@ -123,7 +123,7 @@ fn integrate_bin(pdf: &impl Fn(Vec3A) -> f64, bin: usize, sub_z: usize, sub_phi:
 }
 
 /// A direction sampler with the pdf of `path::pdf` for `sampling` (normal +z).
-fn direction_case(name: &str, phong: Phong, wo: Vec3A, sampling: Sampling) -> Case {
+pub fn direction_case(name: &str, phong: Phong, wo: Vec3A, sampling: Sampling) -> Case {
     let n = Vec3A::Z;
     let expected = integrate_pdf(|wi| path::pdf(&phong, wo, n, wi, sampling) as f64);
     Case {
@@ -198,24 +198,24 @@ fn light_case(name: &str, lights: Vec<AreaLight>) -> Case {
 
 /// An emitting sphere, one-sided, of radiance `l`.
 fn sphere_light(c: Vec3A, r: f32, l: f32) -> AreaLight {
-    AreaLight {
-        shape: Emitting::Sphere(Sphere { c, r }),
-        emitter: Emitter {
+    AreaLight::new(
+        Emitting::Sphere(Sphere { c, r }),
+        Emitter {
             radiance: Vec3A::splat(l),
             two_sided: false,
         },
-    }
+    )
 }
 
 /// An emitting triangle, two-sided, of radiance `l`.
 fn triangle_light(v: [Vec3A; 3], l: f32) -> AreaLight {
-    AreaLight {
-        shape: Emitting::Triangle(Triangle::new(v[0], v[1], v[2]).expect("a triangle")),
-        emitter: Emitter {
+    AreaLight::new(
+        Emitting::Triangle(Triangle::new(v[0], v[1], v[2]).expect("a triangle")),
+        Emitter {
             radiance: Vec3A::splat(l),
             two_sided: true,
         },
-    }
+    )
 }
 
 /// The light samplers: a sphere's cone from near and far, a sphere from inside (by area), a

@@ -62,6 +62,8 @@ pub struct AreaLight {
     pub shape: Emitting,
     /// Its emission.
     pub emitter: Emitter,
+    /// Its surface area, computed once: every light sample and every MIS weight reads it.
+    area: f32,
 }
 
 /// A point sampled on an area light, seen from the shaded point.
@@ -78,12 +80,23 @@ pub struct LightSample {
 }
 
 impl AreaLight {
-    /// Surface area.
-    pub fn area(&self) -> f32 {
-        match self.shape {
+    /// The light of `shape` emitting as `emitter`.
+    pub fn new(shape: Emitting, emitter: Emitter) -> Self {
+        let area = match shape {
             Emitting::Sphere(s) => 4.0 * PI * s.r * s.r,
-            Emitting::Triangle(t) => triangle_area(&t),
+            Emitting::Triangle(t) => 0.5 * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).length(),
+        };
+        AreaLight {
+            shape,
+            emitter,
+            area,
         }
+    }
+
+    /// Surface area.
+    #[inline]
+    pub fn area(&self) -> f32 {
+        self.area
     }
 
     /// Emitted power of a Lambertian emitter, `pi A L` per side, averaged over the channels:
@@ -188,9 +201,4 @@ impl AreaLight {
 fn area_to_solid_angle(a: f32, d2: f32, cos_q: f32) -> Option<f32> {
     let pdf = d2 / (a * cos_q);
     (cos_q > 0.0 && pdf.is_finite() && pdf > 0.0).then_some(pdf)
-}
-
-/// Area of a triangle.
-fn triangle_area(t: &Triangle) -> f32 {
-    0.5 * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).length()
 }

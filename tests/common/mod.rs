@@ -95,3 +95,15 @@ pub fn mean_and_se(r: &Rendered) -> (f64, f64) {
     let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
     (mean, (var / n).sqrt())
 }
+
+/// A Mitsuba reference image from `tests/data/`, mirrored left-right into rtis's camera
+/// convention (Mitsuba's camera is right-handed).
+pub fn mitsuba_reference(file: &str) -> rtis::render::film::Image {
+    rtis::render::output::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(file),
+    )
+    .unwrap_or_else(|e| panic!("{file}: {e}"))
+    .flipped_horizontally()
+}
