@@ -1,13 +1,17 @@
 //! Ray queries over the prepared geometry: packets of four planes and (in small scenes) four
 //! spheres tested with SSE, and a BVH over the remaining finite primitives.
 
+pub mod block;
 mod bvh;
 pub mod lanes;
+pub mod wide;
 
 pub use bvh::{Bvh, Node};
+pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::{Hit, Ray};
 use crate::shape::{Shape, ShapeKind, Triangle};
+use block::{Block, BlockRay};
 use lanes::{Lanes, PlaneLanes, RayLanes, SphereLanes};
 
 /// A shape with the index of its material.
@@ -74,8 +78,10 @@ pub struct Geometry {
     pub prims: Vec<Prim>,
     /// How many of `prims` the BVH holds.
     pub in_bvh: usize,
-    /// BVH over `prims[..in_bvh]`.
-    pub bvh: Bvh,
+    /// Four-wide BVH over `prims[..in_bvh]`; a leaf's payload indexes `blocks`.
+    pub bvh: WideBvh,
+    /// The BVH's leaves, each with its triangles in lanes.
+    pub blocks: Vec<Block>,
     /// Spheres in packets of four (small scenes).
     pub spheres: Lanes<SphereLanes>,
     /// Infinite planes in packets of four.
@@ -116,7 +122,12 @@ impl Geometry {
         let has_triangles = for_bvh
             .iter()
             .any(|p| p.shape.kind() == ShapeKind::Triangle);
-        let (bvh, mut all) = Bvh::build(for_bvh);
+        let (binary, mut all) = Bvh::build(for_bvh);
+        let mut blocks = Vec::new();
+        let bvh = WideBvh::collapse(&binary.nodes, |first, count| {
+            blocks.push(Block::new(&all, first, count));
+            (blocks.len() - 1) as u32
+        });
         let in_bvh = all.len();
         let sphere_items = append(&mut all, spheres);
         let plane_items = append(&mut all, planes);
@@ -124,6 +135,7 @@ impl Geometry {
             prims: all,
             in_bvh,
             bvh,
+            blocks,
             spheres: lanes::pack(&sphere_items, SphereLanes::pack),
             planes: lanes::pack(&plane_items, PlaneLanes::pack),
             normals,
@@ -179,7 +191,9 @@ impl Geometry {
             .closest(&lanes, &mut t_max, &mut best, SphereLanes::hit);
         if !self.bvh.nodes.is_empty() {
             let r = ray.for_bvh(t_max, self.has_triangles);
-            if let Some((i, t)) = self.bvh.closest(&self.prims[..self.in_bvh], &r) {
+            let br = BlockRay::new(&r);
+            let leaf = |b: u32, r: &Ray| self.blocks[b as usize].closest(&self.prims, &br, r);
+            if let Some((i, t)) = self.bvh.closest(&r, leaf) {
                 t_max = t;
                 best = Some(i);
             }
@@ -204,10 +218,11 @@ impl Geometry {
         let lanes = RayLanes::new(ray);
         self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
             || self.planes.any(&lanes, ray.t_max, PlaneLanes::hit)
-            || (!self.bvh.nodes.is_empty()
-                && self.bvh.any(
-                    &self.prims[..self.in_bvh],
-                    &ray.for_bvh(ray.t_max, self.has_triangles),
-                ))
+            || (!self.bvh.nodes.is_empty() && {
+                let r = ray.for_bvh(ray.t_max, self.has_triangles);
+                let br = BlockRay::new(&r);
+                self.bvh
+                    .any(&r, |b, r| self.blocks[b as usize].any(&self.prims, &br, r))
+            })
     }
 }

@@ -4,7 +4,8 @@ use super::CliError;
 use clap::Args;
 use glam::{Vec3, Vec3A};
 use rtis::RenderScene;
-use rtis::accel::{Geometry, Node, Prim};
+use rtis::accel::block::Block;
+use rtis::accel::{Geometry, Prim, WideNode};
 use rtis::converge::{reference_shader, with_settings};
 use rtis::geometry::Ray;
 use rtis::mesh::displaced_sphere;
@@ -215,23 +216,53 @@ fn case(name: &str, scene: &RenderScene, runs: u32, json: bool) {
 }
 
 /// Mrays/s of `rays` run through `f` in parallel (chunks of 4096 rays).
-fn rate(rays: &[Ray], f: impl Fn(&Ray) -> bool + Sync) -> (f64, usize) {
+fn rate(rays: &[Ray], runs: u32, f: impl Fn(&Ray) -> bool + Sync) -> (f64, usize) {
     use rayon::prelude::*;
-    let start = Instant::now();
-    let hits: usize = rays
-        .par_chunks(4096)
-        .map(|c| c.iter().filter(|r| f(r)).count())
-        .sum();
-    (
-        rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6,
-        hits,
-    )
+    let once = || {
+        let start = Instant::now();
+        let hits: usize = rays
+            .par_chunks(4096)
+            .map(|c| c.iter().filter(|r| f(r)).count())
+            .sum();
+        (start.elapsed().as_secs_f64(), hits)
+    };
+    let (seconds, hits) = median_of(runs, once);
+    (rays.len() as f64 / seconds / 1e6, hits)
+}
+
+/// The median time of `runs` (at least 1) calls of `f`, which return a time and a result that
+/// every call must agree on.
+fn median_of<T: PartialEq + std::fmt::Debug>(
+    runs: u32,
+    mut f: impl FnMut() -> (f64, T),
+) -> (f64, T) {
+    let mut results: Vec<(f64, T)> = (0..runs.max(1)).map(|_| f()).collect();
+    results.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mid = results.swap_remove(results.len() / 2);
+    assert!(results.iter().all(|r| r.1 == mid.1), "runs disagree");
+    mid
+}
+
+/// A built geometry, compared by its node count (builds of the same primitives agree).
+struct BuiltOnce(Geometry);
+
+impl PartialEq for BuiltOnce {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.bvh.nodes.len() == other.0.bvh.nodes.len()
+    }
+}
+
+impl std::fmt::Debug for BuiltOnce {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "{} wide nodes", self.0.bvh.nodes.len())
+    }
 }
 
 /// BVH build time, memory per triangle and ray rates for procedural meshes of 10k, 100k and
 /// 1M triangles (a displaced sphere of radius 1 at the origin).
 fn meshes_section(
     json: bool,
+    runs: u32,
     sizes: &[u32],
     dump: Option<&std::path::Path>,
 ) -> Result<(), CliError> {
@@ -258,11 +289,17 @@ fn meshes_section(
         let mesh = displaced_sphere(n as usize, Vec3::ZERO, 1.0, 0.05);
         let prims = Prim::flat_triangles(&mesh);
         let count = prims.len();
-        let start = Instant::now();
-        let g = Geometry::build(prims, Vec::new());
-        let build = start.elapsed().as_secs_f64();
+        let (build, g) = median_of(runs, || {
+            let start = Instant::now();
+            let g = Geometry::build(prims.clone(), Vec::new());
+            (start.elapsed().as_secs_f64(), BuiltOnce(g))
+        });
+        let g = g.0;
         let nodes = g.bvh.nodes.len();
-        let bvh_bytes = (nodes * std::mem::size_of::<Node>()) as f64 / count as f64;
+        // The tree's nodes and its leaves' blocks of lanes.
+        let bvh_bytes = (nodes * std::mem::size_of::<WideNode>()
+            + g.blocks.len() * std::mem::size_of::<Block>()) as f64
+            / count as f64;
         // Camera rays: a pinhole at z = -3 through a 1000 x 1000 grid covering the sphere.
         let eye = Vec3A::new(0.0, 0.0, -3.0);
         let camera: Vec<Ray> = (0..1_000_000)
@@ -274,7 +311,7 @@ fn meshes_section(
                 Ray::new(eye, (Vec3A::new(1.2 * x, 1.2 * y, 3.0)).normalize())
             })
             .collect();
-        let (cam_rate, cam_hits) = rate(&camera, |r| g.intersect(r).is_some());
+        let (cam_rate, cam_hits) = rate(&camera, runs, |r| g.intersect(r).is_some());
         // Shadow rays from the visible surface towards a light at (2, 3, -3).
         let light = Vec3A::new(2.0, 3.0, -3.0);
         let shadow: Vec<Ray> = camera
@@ -286,7 +323,7 @@ fn meshes_section(
                 Ray::spawn(&h, w, to.length() * 0.9999)
             })
             .collect();
-        let (shadow_rate, _) = rate(&shadow, |r| g.occluded(r));
+        let (shadow_rate, _) = rate(&shadow, runs, |r| g.occluded(r));
         // Incoherent rays: random origins in the box [-2, 2]^3, random directions.
         let mut s = Sampler::new(1, 2, 3);
         let incoherent: Vec<Ray> = (0..1_000_000)
@@ -301,7 +338,7 @@ fn meshes_section(
                 Ray::new(o, d)
             })
             .collect();
-        let (inc_rate, inc_hits) = rate(&incoherent, |r| g.intersect(r).is_some());
+        let (inc_rate, inc_hits) = rate(&incoherent, runs, |r| g.intersect(r).is_some());
         let prim_bytes = std::mem::size_of::<Prim>();
         if let Some(dir) = dump {
             dump_work(dir, n, &mesh, &camera, &incoherent)?;
@@ -380,7 +417,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     });
     let wants = |s: Section| a.section == Section::All || a.section == s;
     if wants(Section::Meshes) {
-        meshes_section(a.json, &a.triangles, a.dump.as_deref())?;
+        meshes_section(a.json, a.runs, &a.triangles, a.dump.as_deref())?;
     }
     if wants(Section::Effects) {
         effects_section(&a.scenes, a.runs, a.shrink, a.json)?;

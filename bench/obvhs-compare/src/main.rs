@@ -4,7 +4,7 @@
 use glam::{Vec3, Vec3A};
 use obvhs::{BvhBuildParams, cwbvh::builder::build_cwbvh_from_tris, ray::RayHit};
 use rayon::prelude::*;
-use rtis::accel::{FLAT, Geometry, Node, Prim};
+use rtis::accel::{FLAT, Geometry, Prim, WideNode};
 use rtis::geometry::Ray;
 use rtis::mesh::displaced_sphere;
 use rtis::sampling::{Sampler, hemisphere};
@@ -55,7 +55,7 @@ fn main() {
         let t = Instant::now();
         let g = Geometry::build(prims, Vec::new());
         let build = t.elapsed().as_secs_f64();
-        let bytes = (g.bvh.nodes.len() * std::mem::size_of::<Node>()) as f64 / count as f64;
+        let bytes = (g.bvh.nodes.len() * std::mem::size_of::<WideNode>()) as f64 / count as f64;
         let (r, hits) = rate(&rays, |o, d| g.intersect(&Ray::new(o, d)).is_some());
         println!("{count:>9} {:<22} {build:>8.3} {bytes:>8.1} {r:>8.2} M/s {hits:>8}", "rtis (binned SAH, BVH2)");
         // obvhs.
