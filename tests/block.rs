@@ -29,12 +29,51 @@ fn scalar(prims: &[Prim], r: &Ray) -> Option<(u32, f32)> {
 /// Check one ray against the block of all of `prims` (at most four); returns whether it hit.
 fn agree(prims: &[Prim], ray: &Ray) -> bool {
     let r = ray.for_bvh(ray.t_max, true);
-    let block = Block::new(prims, 0, prims.len());
+    let (block, others) = block_of(prims);
     let br = BlockRay::new(&r);
     let expect = scalar(prims, &r);
-    assert_eq!(block.closest(prims, &br, &r), expect, "{r:?} {prims:?}");
-    assert_eq!(block.any(prims, &br, &r), expect.is_some(), "{r:?}");
+    assert_eq!(block.closest(&others, &br, &r), expect, "{r:?} {prims:?}");
+    assert_eq!(block.any(&others, &br, &r), expect.is_some(), "{r:?}");
     expect.is_some()
+}
+
+/// The block of `prims` and the array that holds its non-triangles.
+fn block_of(prims: &[Prim]) -> (Block, Vec<Prim>) {
+    let others = prims
+        .iter()
+        .filter(|p| !matches!(p.shape, Shape::Triangle(_)))
+        .copied()
+        .collect();
+    (Block::new(prims, 0), others)
+}
+
+/// A block gives back each triangle with the same vertices and normal, to the bit (the
+/// renderer keeps BVH triangles nowhere else), and no triangle for other lanes.
+#[test]
+fn blocks_give_back_their_triangles_exactly() {
+    let mesh = displaced_sphere(2_000, Vec3::ZERO, 1.0, 0.05);
+    let all = Prim::flat_triangles(&mesh);
+    for chunk in all.chunks(4) {
+        let (block, _) = block_of(chunk);
+        for (lane, p) in chunk.iter().enumerate() {
+            let Shape::Triangle(t) = p.shape else {
+                unreachable!()
+            };
+            let back = block.triangle(lane).expect("a triangle lane");
+            let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+            assert_eq!(t.v.map(bits), back.v.map(bits));
+            assert_eq!(bits(t.n), bits(back.n));
+        }
+        assert!(block.triangle(chunk.len()).is_none() || chunk.len() == 4);
+    }
+    let sphere = Prim::flat(Shape::Sphere(Sphere {
+        c: Vec3A::ZERO,
+        r: 1.0,
+    }));
+    let (block, others) = block_of(&[sphere, all[0], sphere]);
+    assert!(block.triangle(0).is_none() && block.triangle(1).is_some());
+    assert_eq!((block.other_index(0), block.other_index(2)), (0, 1));
+    assert_eq!(others.len(), 2);
 }
 
 fn tri(a: Vec3A, b: Vec3A, c: Vec3A) -> Prim {
@@ -156,7 +195,9 @@ fn blocks_mixing_spheres_and_triangles() {
     }
     // Coincident triangles: the later lane wins the tie, as in the loop.
     let r = Ray::new(Vec3A::new(0.1, 0.0, 5.0), -Vec3A::Z).for_bvh(f32::INFINITY, true);
-    let prims = &orders[3];
-    let block = Block::new(prims, 0, 3);
-    assert_eq!(block.closest(prims, &BlockRay::new(&r), &r), Some((1, 3.0)));
+    let (block, others) = block_of(&orders[3]);
+    assert_eq!(
+        block.closest(&others, &BlockRay::new(&r), &r),
+        Some((1, 3.0))
+    );
 }

@@ -199,56 +199,64 @@ fn collapse(bvh: &Bvh) -> (WideBvh, Vec<(usize, usize)>) {
     (wide, ranges)
 }
 
-/// The four-wide tree holds every primitive of the binary one once, in the same leaves, each
-/// child box is the binary subtree's box, and interior boxes contain their children's.
+/// The four-wide tree holds every primitive of the binary one once, in the same leaves; each
+/// decoded child box contains the binary subtree's exact box and is at most a grid step (1/255
+/// of the parent's extent) larger on each side.
 #[test]
-fn wide_tree_holds_the_binary_leaves_in_nested_boxes() {
+fn wide_tree_holds_the_binary_leaves_in_boxes_that_contain_them() {
     let g = build(mesh_prims(20_000));
     let (wide, ranges) = collapse(&g.bvh);
     let binary_leaves = g.bvh.nodes.iter().filter(|n| n.count > 0).count();
     let mut seen = vec![0u32; g.prims.len()];
     let mut leaves = 0;
+    // (wide node, the binary boxes of its children are checked through the leaves and the
+    // nesting of their contents).
     let mut stack = vec![0usize];
     while let Some(i) = stack.pop() {
         let n = &wide.nodes[i];
         for slot in 0..4 {
             let c = n.child[slot];
-            if c == wide::EMPTY {
-                assert!(n.lo[0][slot].is_nan(), "an empty slot with a box");
+            let Some((lo, hi)) = n.child_box(slot) else {
+                assert_eq!(c, wide::EMPTY);
                 continue;
+            };
+            let step = Vec3::from_array(n.step);
+            // Everything below this slot must lie in its decoded box.
+            let mut below = vec![c];
+            let (mut tight_lo, mut tight_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+            while let Some(d) = below.pop() {
+                if d & wide::LEAF != 0 {
+                    let (first, count) = ranges[(d & !wide::LEAF) as usize];
+                    for p in &g.prims[first..first + count] {
+                        let (a, b) = tri_box(p);
+                        tight_lo = tight_lo.min(a);
+                        tight_hi = tight_hi.max(b);
+                    }
+                } else {
+                    below.extend(
+                        wide.nodes[d as usize]
+                            .child
+                            .iter()
+                            .filter(|&&x| x != wide::EMPTY),
+                    );
+                }
             }
-            let (lo, hi) = (
-                Vec3::new(n.lo[0][slot], n.lo[1][slot], n.lo[2][slot]),
-                Vec3::new(n.hi[0][slot], n.hi[1][slot], n.hi[2][slot]),
+            assert!(
+                tight_lo.cmpge(lo).all() && tight_hi.cmple(hi).all(),
+                "contents {tight_lo}..{tight_hi} outside the decoded box {lo}..{hi}"
+            );
+            assert!(
+                (tight_lo - lo).cmple(step * 1.001).all()
+                    && (hi - tight_hi).cmple(step * 1.001).all(),
+                "decoded box {lo}..{hi} looser than a step {step} around {tight_lo}..{tight_hi}"
             );
             if c & wide::LEAF != 0 {
                 leaves += 1;
                 let (first, count) = ranges[(c & !wide::LEAF) as usize];
-                for (s, p) in seen[first..first + count]
-                    .iter_mut()
-                    .zip(&g.prims[first..first + count])
-                {
+                for s in &mut seen[first..first + count] {
                     *s += 1;
-                    let (a, b) = tri_box(p);
-                    assert!(
-                        a.cmpge(lo).all() && b.cmple(hi).all(),
-                        "triangle outside its leaf"
-                    );
                 }
             } else {
-                let m = &wide.nodes[c as usize];
-                for s in 0..4 {
-                    if m.child[s] != wide::EMPTY {
-                        let (a, b) = (
-                            Vec3::new(m.lo[0][s], m.lo[1][s], m.lo[2][s]),
-                            Vec3::new(m.hi[0][s], m.hi[1][s], m.hi[2][s]),
-                        );
-                        assert!(
-                            a.cmpge(lo).all() && b.cmple(hi).all(),
-                            "child outside parent"
-                        );
-                    }
-                }
                 stack.push(c as usize);
             }
         }
@@ -268,6 +276,60 @@ fn wide_tree_holds_the_binary_leaves_in_nested_boxes() {
         "{} wide nodes for {interior} binary interior nodes",
         wide.nodes.len()
     );
+    assert_eq!(
+        std::mem::size_of::<rtis::accel::WideNode>(),
+        64,
+        "one cache line"
+    );
+}
+
+/// Boxes far from the origin, tiny, huge and flat keep containing what they hold after
+/// quantisation: a wide tree over a mesh scaled by 1e-6 to 1e9 and moved up to 1e12 away
+/// (every triangle keeping a non-zero area in single precision).
+#[test]
+fn quantised_boxes_contain_their_triangles_at_every_scale() {
+    for (scale, offset) in [
+        (1e-6f32, 0.0f32),
+        (1e-6, 3e-4),
+        (1.0, 1e5),
+        (1e9, 0.0),
+        (1e9, -1e12),
+    ] {
+        let prims: Vec<Prim> = mesh_prims(2_000)
+            .iter()
+            .filter_map(|p| {
+                let Shape::Triangle(t) = p.shape else {
+                    unreachable!()
+                };
+                let v = t.v.map(|v| v * scale + Vec3A::splat(offset));
+                Triangle::new(v[0], v[1], v[2]).map(|t| Prim::flat(Shape::Triangle(t)))
+            })
+            .collect();
+        assert!(
+            prims.len() > 1_500,
+            "{scale} {offset}: {} triangles",
+            prims.len()
+        );
+        let g = build(prims);
+        let (wide, ranges) = collapse(&g.bvh);
+        for n in &wide.nodes {
+            for slot in 0..4 {
+                let (Some((lo, hi)), c) = (n.child_box(slot), n.child[slot]) else {
+                    continue;
+                };
+                if c & wide::LEAF != 0 {
+                    let (first, count) = ranges[(c & !wide::LEAF) as usize];
+                    for p in &g.prims[first..first + count] {
+                        let (a, b) = tri_box(p);
+                        assert!(
+                            a.cmpge(lo).all() && b.cmple(hi).all(),
+                            "scale {scale}: {a}..{b} outside {lo}..{hi}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The nearest hit among `prims[first..first + count]` by the scalar loop (a later primitive

@@ -12,8 +12,8 @@
 
 use super::Prim;
 use crate::geometry::{Ray, gamma};
-use crate::shape::Shape;
-use glam::Vec4;
+use crate::shape::{Shape, Triangle};
+use glam::{Vec3A, Vec4};
 
 /// Up to four consecutive primitives of a leaf; triangles' vertices in lanes.
 #[derive(Clone, Copy, Debug)]
@@ -22,31 +22,33 @@ pub struct Block {
     /// `v[j][axis]`: coordinate `axis` of vertex `j` of each lane's triangle (NaN in lanes
     /// that hold no triangle, which every comparison rejects).
     pub v: [[Vec4; 3]; 3],
-    /// The triangles' unit normals, `n[axis]`.
-    pub n: [Vec4; 3],
-    /// Index of the first primitive; lane `i` is primitive `first + i`.
-    pub first: u32,
+    /// Where the lanes that hold no triangle (spheres, in order) keep their primitives, from
+    /// this index on, in the array passed to the queries.
+    pub other: u32,
     /// Number of primitives, 1 to 4.
     pub count: u32,
-    /// Lanes (bits) that always go to the scalar test: the non-triangles.
+    /// Lanes (bits) that hold no triangle and go to the scalar test.
     pub scalar: u32,
     _pad: u32,
 }
 
 impl Block {
-    /// The block of `prims[first..first + count]` (`count` from 1 to 4).
-    pub fn new(prims: &[Prim], first: usize, count: usize) -> Block {
+    /// The block of the primitives `leaf` (1 to 4), whose non-triangles the caller stores, in
+    /// order, from index `other` on.
+    pub fn new(leaf: &[Prim], other: usize) -> Block {
+        assert!(
+            (1..=4).contains(&leaf.len()),
+            "a block holds 1 to 4 primitives"
+        );
         let mut v = [[[f32::NAN; 4]; 3]; 3];
-        let mut n = [[f32::NAN; 4]; 3];
         let mut scalar = 0;
-        for (i, p) in prims[first..first + count].iter().enumerate() {
+        for (i, p) in leaf.iter().enumerate() {
             match p.shape {
                 Shape::Triangle(t) => {
                     for axis in 0..3 {
                         for (j, vertex) in t.v.iter().enumerate() {
                             v[j][axis][i] = vertex[axis];
                         }
-                        n[axis][i] = t.n[axis];
                     }
                 }
                 _ => scalar |= 1 << i,
@@ -54,12 +56,27 @@ impl Block {
         }
         Block {
             v: v.map(|a| a.map(Vec4::from_array)),
-            n: n.map(Vec4::from_array),
-            first: first as u32,
-            count: count as u32,
+            other: other as u32,
+            count: leaf.len() as u32,
             scalar,
             _pad: 0,
         }
+    }
+
+    /// The triangle in lane `lane`, or `None` if the lane holds another shape or nothing.
+    pub fn triangle(&self, lane: usize) -> Option<Triangle> {
+        if lane >= self.count as usize || self.scalar & (1 << lane) != 0 {
+            return None;
+        }
+        let vertex =
+            |j: usize| Vec3A::new(self.v[j][0][lane], self.v[j][1][lane], self.v[j][2][lane]);
+        Triangle::new(vertex(0), vertex(1), vertex(2))
+    }
+
+    /// Index, in the array of other primitives, of the shape in scalar lane `lane`.
+    #[inline]
+    pub fn other_index(&self, lane: u32) -> usize {
+        (self.other + (self.scalar & ((1 << lane) - 1)).count_ones()) as usize
     }
 
     /// The lanes' distances, the lanes (bits) that certainly hit at those distances within
@@ -87,28 +104,38 @@ impl Block {
         let t_scaled = u * (sz * az) + v * (sz * bz) + w * (sz * cz);
         let t = t_scaled / det;
         let in_range = t.cmpgt(zero) & t.cmple(Vec4::splat(t_max)) & det.cmpne(zero);
+        let lanes = (1 << self.count) - 1;
+        let scalar = (on_edge.bitmask() | self.scalar) & lanes;
+        let hits = (!on_edge & !outside & in_range).bitmask() & lanes & !self.scalar;
+        if hits == 0 {
+            return (t, 0, scalar);
+        }
         // A ray starting on the triangle's plane (within the error band of the origin's signed
-        // distance) does not meet it at its start.
-        let an = self.n.map(Vec4::abs);
-        let reach = [
-            self.v[0][0].abs() + r.o_abs[0],
-            self.v[0][1].abs() + r.o_abs[1],
-            self.v[0][2].abs() + r.o_abs[2],
+        // distance) does not meet it at its start. Few tests get here, so the normal is
+        // computed now rather than stored: `Triangle::new`'s operations, lane by lane.
+        let e1 = [0, 1, 2].map(|axis| self.v[1][axis] - self.v[0][axis]);
+        let e2 = [0, 1, 2].map(|axis| self.v[2][axis] - self.v[0][axis]);
+        let c = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
         ];
+        let len = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        let n = c.map(|c| c / len);
+        let an = n.map(Vec4::abs);
+        let reach = [0, 1, 2].map(|axis| self.v[0][axis].abs() + r.o_abs[axis]);
         let band = Vec4::splat(gamma(5)) * (an[0] * reach[0] + an[1] * reach[1] + an[2] * reach[2])
             + (an[0] + an[1] + an[2]) * r.o_err;
-        let along = (self.n[0] * r.d[0] + self.n[1] * r.d[1] + self.n[2] * r.d[2]).abs();
-        let off_start = (t * along).cmpgt(band);
-        let lanes = (1 << self.count) - 1;
-        let exact = (!on_edge & !outside & in_range & off_start).bitmask() & !self.scalar;
-        let scalar = (on_edge.bitmask() | self.scalar) & lanes;
-        (t, exact & lanes, scalar)
+        let along = (n[0] * r.d[0] + n[1] * r.d[1] + n[2] * r.d[2]).abs();
+        let off_start = (t * along).cmpgt(band).bitmask();
+        (t, hits & off_start, scalar)
     }
 
-    /// Nearest hit among the block's primitives within `(0, ray.t_max]`, with the scalar
-    /// loop's tie rule (a later primitive at equal distance wins).
+    /// Nearest hit among the block's primitives within `(0, ray.t_max]`: its lane and
+    /// distance, with the scalar loop's tie rule (a later lane at equal distance wins).
+    /// `others` holds the shapes of the scalar lanes from [`Block::other`] on.
     #[inline(always)]
-    pub fn closest(&self, prims: &[Prim], br: &BlockRay, ray: &Ray) -> Option<(u32, f32)> {
+    pub fn closest(&self, others: &[Prim], br: &BlockRay, ray: &Ray) -> Option<(u32, f32)> {
         let (t, exact, mut scalar) = self.test(br, ray.t_max);
         let t = t.to_array();
         let mut best: Option<(u32, f32)> = None;
@@ -119,15 +146,13 @@ impl Block {
             mask &= mask - 1;
             let hit = if scalar & (1 << i) != 0 {
                 scalar &= !(1 << i);
-                prims[(self.first + i) as usize]
-                    .shape
-                    .intersect(&Ray { t_max, ..*ray })
+                self.scalar_hit(others, i, &Ray { t_max, ..*ray })
             } else {
                 Some(t[i as usize]).filter(|&t| t <= t_max)
             };
             if let Some(t) = hit {
                 t_max = t;
-                best = Some((self.first + i, t));
+                best = Some((i, t));
             }
         }
         best
@@ -135,7 +160,7 @@ impl Block {
 
     /// True if any of the block's primitives is hit within `(0, ray.t_max]`.
     #[inline(always)]
-    pub fn any(&self, prims: &[Prim], br: &BlockRay, ray: &Ray) -> bool {
+    pub fn any(&self, others: &[Prim], br: &BlockRay, ray: &Ray) -> bool {
         let (_, exact, mut scalar) = self.test(br, ray.t_max);
         if exact != 0 {
             return true;
@@ -143,15 +168,20 @@ impl Block {
         while scalar != 0 {
             let i = scalar.trailing_zeros();
             scalar &= scalar - 1;
-            if prims[(self.first + i) as usize]
-                .shape
-                .intersect(ray)
-                .is_some()
-            {
+            if self.scalar_hit(others, i, ray).is_some() {
                 return true;
             }
         }
         false
+    }
+
+    /// The scalar test of lane `lane`: its triangle's, or its other shape's.
+    #[inline(never)]
+    fn scalar_hit(&self, others: &[Prim], lane: u32, ray: &Ray) -> Option<f32> {
+        match self.triangle(lane as usize) {
+            Some(t) => t.intersect(ray),
+            None => others[self.other_index(lane)].shape.intersect(ray),
+        }
     }
 }
 

@@ -59,34 +59,63 @@ pub const FLAT: u32 = u32::MAX;
 /// Scenes with at most this many spheres test them in packets instead of a BVH.
 pub const PACKED_SPHERES: usize = 16;
 
-/// Append packed primitives to `all`; returns each shape with its index there.
-fn append<T>(all: &mut Vec<Prim>, packed: Vec<(Prim, T)>) -> Vec<(u32, T)> {
+/// Append packed primitives to `others`; returns each shape with its index among all
+/// primitives (after the `slots` of the BVH's blocks).
+fn append<T>(others: &mut Vec<Prim>, slots: usize, packed: Vec<(Prim, T)>) -> Vec<(u32, T)> {
     packed
         .into_iter()
         .map(|(p, shape)| {
-            all.push(p);
-            ((all.len() - 1) as u32, shape)
+            others.push(p);
+            ((slots + others.len() - 1) as u32, shape)
         })
         .collect()
 }
 
+/// What shading needs of a BVH triangle besides its vertices (which its block holds):
+/// [`Prim`]'s other fields in 8 bytes. A smooth triangle's vertex normals are
+/// [`Geometry::normals`]' entry at its lane's index.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attrs {
+    /// Index into the prepared material array, with [`SMOOTH`] set for a smooth triangle.
+    pub material: u32,
+    /// Area light, or [`crate::light::NO_LIGHT`].
+    pub light: u32,
+}
+
+/// Set in [`Attrs::material`] for a triangle with vertex normals.
+pub const SMOOTH: u32 = 1 << 31;
+
+impl Attrs {
+    /// The attributes of a padding lane, which no ray hits.
+    const NONE: Attrs = Attrs {
+        material: !SMOOTH,
+        light: crate::light::NO_LIGHT,
+    };
+}
+
 /// All of a scene's primitives, ready for ray queries.
+///
+/// A primitive's index (what [`Hit::prim`] holds) below `4 * blocks.len()` is a lane of a BVH
+/// block (`4 * block + lane`); a BVH triangle is stored only there, its vertices in the block
+/// and the rest in `attrs`. Indices from `4 * blocks.len()` on are `others`' entries in order.
 #[derive(Clone, Debug, Default)]
 pub struct Geometry {
-    /// Every primitive; hits refer to indices here. The first `in_bvh` are the BVH's, in leaf
-    /// order; the packed spheres and the planes follow.
-    pub prims: Vec<Prim>,
-    /// How many of `prims` the BVH holds.
+    /// The primitives that are not BVH triangles: the BVH's other shapes (spheres of large
+    /// scenes, which blocks send to the scalar test), then the packed spheres and the planes.
+    pub others: Vec<Prim>,
+    /// How many primitives the BVH holds.
     pub in_bvh: usize,
-    /// Four-wide BVH over `prims[..in_bvh]`; a leaf's payload indexes `blocks`.
+    /// Four-wide BVH; a leaf's payload indexes `blocks`.
     pub bvh: WideBvh,
     /// The BVH's leaves, each with its triangles in lanes.
     pub blocks: Vec<Block>,
+    /// Material, smoothness and light of each block lane (`4 * block + lane`).
+    pub attrs: Vec<Attrs>,
     /// Spheres in packets of four (small scenes).
     pub spheres: Lanes<SphereLanes>,
     /// Infinite planes in packets of four.
     pub planes: Lanes<PlaneLanes>,
-    /// Vertex normals of smooth triangles.
+    /// Vertex normals of smooth triangles, at their lane's index (empty if none is smooth).
     pub normals: Vec<[glam::Vec3A; 3]>,
     /// True if the BVH holds triangles: its rays then need the watertight test's shear
     /// constants.
@@ -122,23 +151,52 @@ impl Geometry {
         let has_triangles = for_bvh
             .iter()
             .any(|p| p.shape.kind() == ShapeKind::Triangle);
-        let (binary, mut all) = Bvh::build(for_bvh);
-        let mut blocks = Vec::new();
+        let (binary, sorted) = Bvh::build(for_bvh);
+        let (mut blocks, mut attrs, mut others) = (Vec::new(), Vec::new(), Vec::new());
+        let any_smooth = sorted.iter().any(|p| p.smooth != FLAT);
+        let mut lane_normals = Vec::new();
         let bvh = WideBvh::collapse(&binary.nodes, |first, count| {
-            blocks.push(Block::new(&all, first, count));
+            let leaf = &sorted[first..first + count];
+            blocks.push(Block::new(leaf, others.len()));
+            for lane in 0..4 {
+                let smooth = leaf.get(lane).map_or(FLAT, |p| p.smooth);
+                if any_smooth {
+                    lane_normals.push(match smooth {
+                        FLAT => [glam::Vec3A::ZERO; 3],
+                        i => normals[i as usize],
+                    });
+                }
+                attrs.push(match leaf.get(lane) {
+                    Some(p) if p.shape.kind() == ShapeKind::Triangle => {
+                        assert!(p.material < SMOOTH, "at most 2^31 materials");
+                        Attrs {
+                            material: p.material | if smooth == FLAT { 0 } else { SMOOTH },
+                            light: p.light,
+                        }
+                    }
+                    Some(p) => {
+                        others.push(*p);
+                        Attrs::NONE
+                    }
+                    None => Attrs::NONE,
+                });
+            }
             (blocks.len() - 1) as u32
         });
-        let in_bvh = all.len();
-        let sphere_items = append(&mut all, spheres);
-        let plane_items = append(&mut all, planes);
+        let in_bvh = sorted.len();
+        drop(sorted);
+        let slots = attrs.len();
+        let sphere_items = append(&mut others, slots, spheres);
+        let plane_items = append(&mut others, slots, planes);
         Geometry {
-            prims: all,
+            others,
             in_bvh,
             bvh,
             blocks,
+            attrs,
             spheres: lanes::pack(&sphere_items, SphereLanes::pack),
             planes: lanes::pack(&plane_items, PlaneLanes::pack),
-            normals,
+            normals: lane_normals,
             has_triangles,
         }
     }
@@ -165,20 +223,62 @@ impl Geometry {
         }
     }
 
-    /// The primitive a hit refers to.
+    /// The primitive with index `index` (what a hit refers to).
     #[inline]
-    pub fn prim(&self, index: u32) -> &Prim {
-        &self.prims[index as usize]
+    pub fn prim(&self, index: u32) -> Prim {
+        let i = index as usize;
+        if i >= self.attrs.len() {
+            return self.others[i - self.attrs.len()];
+        }
+        let (block, lane) = (&self.blocks[i / 4], i % 4);
+        match block.triangle(lane) {
+            Some(t) => {
+                let a = self.attrs[i];
+                Prim {
+                    shape: Shape::Triangle(t),
+                    material: a.material & !SMOOTH,
+                    smooth: if a.material & SMOOTH != 0 {
+                        index
+                    } else {
+                        FLAT
+                    },
+                    light: a.light,
+                }
+            }
+            None => self.others[block.other_index(lane as u32)],
+        }
+    }
+
+    /// Every primitive's index: the occupied block lanes, then the primitives outside the BVH.
+    pub fn indices(&self) -> impl Iterator<Item = u32> + '_ {
+        let lanes = self
+            .blocks
+            .iter()
+            .enumerate()
+            .flat_map(|(b, block)| (0..block.count).map(move |lane| (4 * b) as u32 + lane));
+        // The BVH's other shapes come first in `others`; its lanes already name them.
+        let in_blocks: usize = self
+            .blocks
+            .iter()
+            .map(|b| b.scalar.count_ones() as usize)
+            .sum();
+        let rest = (in_blocks..self.others.len()).map(|k| (self.attrs.len() + k) as u32);
+        lanes.chain(rest)
+    }
+
+    /// Every primitive, in the order of [`Geometry::indices`].
+    pub fn prims(&self) -> impl Iterator<Item = Prim> + '_ {
+        self.indices().map(|i| self.prim(i))
     }
 
     /// True if the scene has no primitive at all.
     pub fn is_empty(&self) -> bool {
-        self.prims.is_empty()
+        self.others.is_empty() && self.blocks.is_empty()
     }
 
     /// Number of primitives of each kind.
     pub fn count(&self, kind: ShapeKind) -> usize {
-        self.prims.iter().filter(|p| p.shape.kind() == kind).count()
+        self.prims().filter(|p| p.shape.kind() == kind).count()
     }
 
     /// The nearest hit along `ray` within `(0, ray.t_max]`.
@@ -192,7 +292,10 @@ impl Geometry {
         if !self.bvh.nodes.is_empty() {
             let r = ray.for_bvh(t_max, self.has_triangles);
             let br = BlockRay::new(&r);
-            let leaf = |b: u32, r: &Ray| self.blocks[b as usize].closest(&self.prims, &br, r);
+            let leaf = |b: u32, r: &Ray| {
+                let hit = self.blocks[b as usize].closest(&self.others, &br, r);
+                hit.map(|(lane, t)| (4 * b + lane, t))
+            };
             if let Some((i, t)) = self.bvh.closest(&r, leaf) {
                 t_max = t;
                 best = Some(i);
@@ -222,7 +325,7 @@ impl Geometry {
                 let r = ray.for_bvh(ray.t_max, self.has_triangles);
                 let br = BlockRay::new(&r);
                 self.bvh
-                    .any(&r, |b, r| self.blocks[b as usize].any(&self.prims, &br, r))
+                    .any(&r, |b, r| self.blocks[b as usize].any(&self.others, &br, r))
             })
     }
 }

@@ -1,11 +1,14 @@
 //! A four-wide BVH: the binary SAH tree ([`super::bvh`]) collapsed so that each node holds the
 //! boxes of up to four children in structure-of-arrays lanes, tested against a ray in one SSE
-//! pass (`glam::Vec4`), as Embree's BVH4 does. A ray then visits about half as many nodes, and
-//! each visit is one 112-byte node (two cache lines) instead of two 32-byte nodes in different
-//! places.
+//! pass (`glam::Vec4`), as Embree's BVH4 does. A ray then visits about half as many nodes.
 //!
-//! The box test is [`Aabb::hit`](crate::geometry::Aabb::hit) lane by lane with the same
-//! operations in the same order, so the wide tree culls exactly what the binary one would.
+//! Child boxes are quantised to 8 bits per coordinate on a grid spanning the node's box
+//! (Embree's compressed nodes, Ylitie et al. 2017), so a node is 64 bytes, one cache line, half
+//! of what full-precision boxes take. The grid rounds every box outwards, with each coordinate
+//! checked after rounding against the decoding the traversal does (`origin + q * step`, the
+//! same two operations), so a decoded box always contains the exact one: a ray can visit a few
+//! more nodes, never miss one. The slab test on the decoded boxes is
+//! [`Aabb::hit`](crate::geometry::Aabb::hit) lane by lane, with its operations in its order.
 
 use super::bvh::Node;
 use crate::geometry::Ray;
@@ -17,19 +20,80 @@ use std::mem::MaybeUninit;
 pub type ChildRef = u32;
 /// Set in a [`ChildRef`] that is a leaf.
 pub const LEAF: u32 = 1 << 31;
-/// An unused child slot. Its box is all NaN, which fails the slab test for every ray.
+/// An unused child slot, which no ray enters.
 pub const EMPTY: ChildRef = u32::MAX;
 
-/// Four child boxes, one per lane, and their references.
+/// Four child boxes, one per lane, on the node's 8-bit grid, and their references.
 #[derive(Clone, Copy, Debug)]
-#[repr(C)]
+#[repr(C, align(64))]
 pub struct WideNode {
-    /// Smallest corner of each child's box: x, y and z lanes.
-    pub lo: [Vec4; 3],
-    /// Largest corner of each child's box.
-    pub hi: [Vec4; 3],
+    /// The grid's origin: the smallest corner of the node's box.
+    pub origin: [f32; 3],
+    /// The grid's step per axis (0 on an axis where the node's box is flat).
+    pub step: [f32; 3],
+    /// `lo[axis][slot]`: smallest corner of each child's box, in steps from the origin.
+    pub lo: [[u8; 4]; 3],
+    /// Largest corner of each child's box, in steps from the origin.
+    pub hi: [[u8; 4]; 3],
     /// The children; unused slots are [`EMPTY`].
     pub child: [ChildRef; 4],
+}
+
+/// Four grid coordinates as floats: two unpacks and a conversion with SSE2 (part of every
+/// x86-64 CPU), four conversions elsewhere.
+#[inline(always)]
+fn widen(q: [u8; 4]) -> Vec4 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{
+            _mm_cvtepi32_ps, _mm_cvtsi32_si128, _mm_setzero_si128, _mm_unpacklo_epi8,
+            _mm_unpacklo_epi16,
+        };
+        // SAFETY: SSE2 is in the x86-64 baseline; these intrinsics only move and convert
+        // register values.
+        unsafe {
+            let zero = _mm_setzero_si128();
+            let bytes = _mm_cvtsi32_si128(i32::from_le_bytes(q));
+            let words = _mm_unpacklo_epi8(bytes, zero);
+            Vec4::from(_mm_cvtepi32_ps(_mm_unpacklo_epi16(words, zero)))
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        Vec4::new(q[0] as f32, q[1] as f32, q[2] as f32, q[3] as f32)
+    }
+}
+
+/// The grid coordinates of `[lo, hi]` on the grid `origin + q * step`, rounded outwards: the
+/// decoded interval contains `[lo, hi]`, which lies within `[origin, origin + 255 step]`.
+fn quantize(lo: f32, hi: f32, origin: f32, step: f32) -> (u8, u8) {
+    let decode = |q: u8| origin + q as f32 * step;
+    if step == 0.0 {
+        return (0, 0);
+    }
+    let mut ql = ((lo - origin) / step).floor().clamp(0.0, 255.0) as u8;
+    while ql > 0 && decode(ql) > lo {
+        ql -= 1;
+    }
+    let mut qh = ((hi - origin) / step).ceil().clamp(0.0, 255.0) as u8;
+    while qh < 255 && decode(qh) < hi {
+        qh += 1;
+    }
+    debug_assert!(decode(ql) <= lo && decode(qh) >= hi, "box outside its grid");
+    (ql, qh)
+}
+
+/// The step of a 255-step grid from `lo` that reaches `hi`.
+fn grid_step(lo: f32, hi: f32) -> f32 {
+    if hi <= lo {
+        return 0.0;
+    }
+    // Divided first so that huge extents do not overflow, then raised until the grid reaches.
+    let mut step = hi / 255.0 - lo / 255.0;
+    while lo + 255.0 * step < hi {
+        step = step.next_up();
+    }
+    step
 }
 
 /// The wide hierarchy; `nodes[0]` is the root (empty when the scene has no finite primitive).
@@ -69,16 +133,11 @@ impl WideNode {
     /// `(0, t_max]`: [`Aabb::hit`](crate::geometry::Aabb::hit), four at a time.
     #[inline(always)]
     fn hit(&self, r: &RayBox, t_max: f32) -> (Vec4, u32) {
-        let t0 = [
-            (self.lo[0] - r.o[0]) * r.inv_d[0],
-            (self.lo[1] - r.o[1]) * r.inv_d[1],
-            (self.lo[2] - r.o[2]) * r.inv_d[2],
-        ];
-        let t1 = [
-            (self.hi[0] - r.o[0]) * r.inv_d[0],
-            (self.hi[1] - r.o[1]) * r.inv_d[1],
-            (self.hi[2] - r.o[2]) * r.inv_d[2],
-        ];
+        let decode = |q: [u8; 4], axis: usize| {
+            Vec4::splat(self.origin[axis]) + widen(q) * Vec4::splat(self.step[axis])
+        };
+        let t0 = [0, 1, 2].map(|axis| (decode(self.lo[axis], axis) - r.o[axis]) * r.inv_d[axis]);
+        let t1 = [0, 1, 2].map(|axis| (decode(self.hi[axis], axis) - r.o[axis]) * r.inv_d[axis]);
         let near = [t0[0].min(t1[0]), t0[1].min(t1[1]), t0[2].min(t1[2])];
         let far = [t0[0].max(t1[0]), t0[1].max(t1[1]), t0[2].max(t1[2])];
         // The scalar test's horizontal max and min, operand for operand (they differ only when
@@ -90,7 +149,9 @@ impl WideNode {
         let far =
             far[0].min(far[2]).min(far[1].min(far[2])) * Vec4::splat(1.0 + 4.0 * f32::EPSILON);
         let ok = near.cmple(far) & near.cmple(Vec4::splat(t_max));
-        (near, ok.bitmask())
+        let used = self.child.map(|c| (c != EMPTY) as u32);
+        let used = used[0] | used[1] << 1 | used[2] << 2 | used[3] << 3;
+        (near, ok.bitmask() & used)
     }
 }
 
@@ -231,22 +292,51 @@ impl WideBvh {
 impl WideNode {
     /// The node over binary nodes `kids` with references `refs`.
     fn from_children(binary: &[Node], kids: &[usize], refs: &[ChildRef]) -> WideNode {
-        let nan = f32::NAN;
-        let mut lo = [[nan; 4]; 3];
-        let mut hi = [[nan; 4]; 3];
-        let mut child = [EMPTY; 4];
+        let (mut lo_all, mut hi_all) = (glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY);
+        for &k in kids {
+            lo_all = lo_all.min(binary[k].min);
+            hi_all = hi_all.max(binary[k].max);
+        }
+        let mut node = WideNode {
+            origin: [0.0; 3],
+            step: [0.0; 3],
+            lo: [[0; 4]; 3],
+            hi: [[0; 4]; 3],
+            child: [EMPTY; 4],
+        };
+        if kids.is_empty() {
+            return node;
+        }
+        for axis in 0..3 {
+            node.origin[axis] = lo_all[axis];
+            node.step[axis] = grid_step(lo_all[axis], hi_all[axis]);
+        }
         for (slot, (&k, &c)) in kids.iter().zip(refs).enumerate() {
             for axis in 0..3 {
-                lo[axis][slot] = binary[k].min[axis];
-                hi[axis][slot] = binary[k].max[axis];
+                let (ql, qh) = quantize(
+                    binary[k].min[axis],
+                    binary[k].max[axis],
+                    node.origin[axis],
+                    node.step[axis],
+                );
+                node.lo[axis][slot] = ql;
+                node.hi[axis][slot] = qh;
             }
-            child[slot] = c;
+            node.child[slot] = c;
         }
-        WideNode {
-            lo: lo.map(Vec4::from_array),
-            hi: hi.map(Vec4::from_array),
-            child,
-        }
+        node
+    }
+
+    /// The decoded box of child `slot` (what the traversal tests), or `None` if unused.
+    pub fn child_box(&self, slot: usize) -> Option<(glam::Vec3, glam::Vec3)> {
+        (self.child[slot] != EMPTY).then(|| {
+            let decode = |q: [[u8; 4]; 3]| {
+                glam::Vec3::from_array(
+                    [0, 1, 2].map(|a| self.origin[a] + q[a][slot] as f32 * self.step[a]),
+                )
+            };
+            (decode(self.lo), decode(self.hi))
+        })
     }
 }
 

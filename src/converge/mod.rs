@@ -185,7 +185,7 @@ pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
     let text = format!(
         "reference v3 (two independent halves)|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
         scene.camera,
-        scene.geometry.prims,
+        scene.geometry.prims().collect::<Vec<_>>(),
         scene.materials,
         scene.lights,
         scene.background,

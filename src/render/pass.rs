@@ -32,7 +32,7 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
     let text = format!(
         "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}",
         scene.camera,
-        scene.geometry.prims,
+        scene.geometry.prims().collect::<Vec<_>>(),
         scene.materials,
         scene.lights,
         scene.background,

@@ -39,7 +39,7 @@ impl Interaction {
         let prim = tr.geometry.prim(hit.prim);
         let ng = if hit.n.dot(wo) < 0.0 { -hit.n } else { hit.n };
         // The shading normal stays on the viewer's side of the surface.
-        let ns = tr.geometry.shading_normal(prim, hit.p, ng);
+        let ns = tr.geometry.shading_normal(&prim, hit.p, ng);
         let n = if ns.dot(ng) < 0.0 { -ns } else { ns };
         Interaction {
             hit,

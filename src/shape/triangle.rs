@@ -17,8 +17,15 @@ pub struct Triangle {
 impl Triangle {
     /// The triangle with these vertices, or `None` if it has zero area (it would never be hit).
     pub fn new(v0: Vec3A, v1: Vec3A, v2: Vec3A) -> Option<Self> {
-        let c = (v1 - v0).cross(v2 - v0);
-        let len = c.length();
+        let (e1, e2) = (v1 - v0, v2 - v0);
+        // The cross product and its length written out: the leaf blocks of the BVH compute
+        // the same normal in lanes with these operations, in this order, to the same bits.
+        let c = Vec3A::new(
+            e1.y * e2.z - e1.z * e2.y,
+            e1.z * e2.x - e1.x * e2.z,
+            e1.x * e2.y - e1.y * e2.x,
+        );
+        let len = (c.x * c.x + c.y * c.y + c.z * c.z).sqrt();
         (len > 0.0 && len.is_finite()).then(|| Triangle {
             v: [v0, v1, v2],
             n: c / len,
