@@ -29,8 +29,9 @@ How each engine is measured:
   binding copies the arrays into Embree's buffers element by element (numpy's generic indexing)
   before that; this copy is not Embree's work and is reported apart as `mesh_copy_s`. embreex commits lazily on the
   first query, so the commit is forced (and timed) with one ray before the timed queries.
-- bytes_per_triangle. rtis: BVH nodes plus its primitives (which hold the triangles), counted
-  from the sizes of its structures. Embree: the growth of the process's resident memory
+- bytes_per_triangle. rtis: its wide BVH's nodes, its leaf blocks (which hold the only copy of
+  the triangles' vertices) and the 8 bytes of material and light per block lane, counted from
+  the sizes of its structures. Embree: the growth of the process's resident memory
   (/proc/self/statm) across the mesh copy and the build, divided by the triangle count. It
   counts Embree's BVH (its leaves hold their own copy of the vertices) plus its copy of the
   mesh (16-byte vertices, 12-byte index triples: about 20 bytes per triangle, reported apart as

@@ -74,8 +74,23 @@ impl Item {
 impl Bvh {
     /// Build over `prims` (all bounded); returns the BVH and the primitives reordered to match.
     pub fn build(prims: Vec<Prim>) -> (Bvh, Vec<Prim>) {
+        let (sparse, order) = Bvh::build_sparse(&prims);
+        let nodes = if sparse.is_empty() {
+            Vec::new()
+        } else {
+            compact(&sparse)
+        };
+        let sorted = order.par_iter().map(|&i| prims[i as usize]).collect();
+        (Bvh { nodes }, sorted)
+    }
+
+    /// Build over `prims` (all bounded) without moving them: the nodes in the layout of
+    /// [`Bvh::nodes`] but with unused slots between them (the root first, an interior node's
+    /// first child after it, its second at `index`), and the order of the primitives that
+    /// leaves' `index..index + count` ranges refer to.
+    pub fn build_sparse(prims: &[Prim]) -> (Vec<Node>, Vec<u32>) {
         if prims.is_empty() {
-            return (Bvh::default(), prims);
+            return (Vec::new(), Vec::new());
         }
         let mut items: Vec<Item> = prims
             .par_iter()
@@ -93,18 +108,13 @@ impl Bvh {
                 }
             })
             .collect();
-        let empty = Node {
-            min: Vec3::ZERO,
-            index: 0,
-            max: Vec3::ZERO,
-            count: 0,
-        };
-        let mut sparse = vec![empty; 2 * prims.len() - 1];
-        let bounds = fold_bounds(&items);
+        let mut sparse = zeroed_nodes(2 * prims.len() - 1);
+        let bounds = items.par_chunks(PARALLEL_MIN).map(fold_bounds).reduce(
+            || (Aabb::EMPTY, Aabb::EMPTY),
+            |a, b| (a.0.union(b.0), a.1.union(b.1)),
+        );
         build_node(&mut items, 0, 0, &mut sparse, 0, bounds);
-        let nodes = compact(&sparse);
-        let sorted = items.par_iter().map(|it| prims[it.prim as usize]).collect();
-        (Bvh { nodes }, sorted)
+        (sparse, items.par_iter().map(|it| it.prim).collect())
     }
 
     /// Nearest primitive hit: its index in `prims` and distance.
@@ -215,6 +225,23 @@ impl Bvh {
             max: n.max.into(),
         }
         .hit(ray.o, ray.inv_d, t_max)
+    }
+}
+
+/// `n` nodes of zeros (an empty leaf at the origin), from zeroed memory: the system hands out
+/// fresh pages already zero, so the slots the build never writes cost nothing, and the others
+/// are touched first by the threads that write them.
+fn zeroed_nodes(n: usize) -> Vec<Node> {
+    let layout = std::alloc::Layout::array::<Node>(n).expect("node array size");
+    // SAFETY: `Node` is `repr(C)` of `f32` and `u32` fields, for which all-zero bits are a
+    // valid value; the memory comes from the global allocator with `Vec<Node>`'s layout for
+    // capacity `n`, and all `n` elements are initialised (to zero).
+    unsafe {
+        let p = std::alloc::alloc_zeroed(layout) as *mut Node;
+        if p.is_null() {
+            std::alloc::handle_alloc_error(layout);
+        }
+        Vec::from_raw_parts(p, n, n)
     }
 }
 

@@ -13,6 +13,7 @@ use crate::geometry::{Hit, Ray};
 use crate::shape::{Shape, ShapeKind, Triangle};
 use block::{Block, BlockRay};
 use lanes::{Lanes, PlaneLanes, RayLanes, SphereLanes};
+use rayon::prelude::*;
 
 /// A shape with the index of its material.
 #[derive(Clone, Copy, Debug)]
@@ -134,57 +135,95 @@ impl Geometry {
         // One pass: planes to their packets, spheres to theirs in small scenes, the rest to
         // the BVH. The packets keep each shape with its primitive, so no kind is lost.
         let (mut planes, mut spheres) = (Vec::new(), Vec::new());
-        let for_bvh: Vec<Prim> = prims
-            .into_iter()
-            .filter(|p| match p.shape {
-                Shape::Plane(pl) => {
-                    planes.push((*p, pl));
-                    false
-                }
-                Shape::Sphere(s) if pack_spheres => {
-                    spheres.push((*p, s));
-                    false
-                }
-                _ => true,
-            })
-            .collect();
+        let mut for_bvh = prims;
+        for_bvh.retain(|p| match p.shape {
+            Shape::Plane(pl) => {
+                planes.push((*p, pl));
+                false
+            }
+            Shape::Sphere(s) if pack_spheres => {
+                spheres.push((*p, s));
+                false
+            }
+            _ => true,
+        });
         let has_triangles = for_bvh
             .iter()
             .any(|p| p.shape.kind() == ShapeKind::Triangle);
-        let (binary, sorted) = Bvh::build(for_bvh);
-        let (mut blocks, mut attrs, mut others) = (Vec::new(), Vec::new(), Vec::new());
-        let any_smooth = sorted.iter().any(|p| p.smooth != FLAT);
-        let mut lane_normals = Vec::new();
-        let bvh = WideBvh::collapse(&binary.nodes, |first, count| {
-            let leaf = &sorted[first..first + count];
-            blocks.push(Block::new(leaf, others.len()));
-            for lane in 0..4 {
-                let smooth = leaf.get(lane).map_or(FLAT, |p| p.smooth);
-                if any_smooth {
-                    lane_normals.push(match smooth {
-                        FLAT => [glam::Vec3A::ZERO; 3],
-                        i => normals[i as usize],
-                    });
-                }
-                attrs.push(match leaf.get(lane) {
-                    Some(p) if p.shape.kind() == ShapeKind::Triangle => {
-                        assert!(p.material < SMOOTH, "at most 2^31 materials");
-                        Attrs {
-                            material: p.material | if smooth == FLAT { 0 } else { SMOOTH },
-                            light: p.light,
-                        }
-                    }
-                    Some(p) => {
-                        others.push(*p);
-                        Attrs::NONE
-                    }
-                    None => Attrs::NONE,
-                });
-            }
-            (blocks.len() - 1) as u32
+        let (binary, order) = Bvh::build_sparse(&for_bvh);
+        // The wide tree first, each leaf named by its rank; then the leaves' blocks and
+        // attributes in parallel, in that order (the reads of the primitives, in leaf order,
+        // are most of the work).
+        let mut ranges = Vec::new();
+        let bvh = WideBvh::collapse(&binary, |first, count| {
+            ranges.push((first, count));
+            (ranges.len() - 1) as u32
         });
-        let in_bvh = sorted.len();
-        drop(sorted);
+        drop(binary);
+        let leaf = |(first, count): (usize, usize)| {
+            let mut leaf = [for_bvh[order[first] as usize]; 4];
+            for (k, p) in leaf.iter_mut().enumerate().take(count) {
+                *p = for_bvh[order[first + k] as usize];
+            }
+            (leaf, count)
+        };
+        // Where each leaf's non-triangles start among `others` (all at 0 when the BVH holds
+        // triangles only).
+        let mut other_at = vec![0; ranges.len()];
+        let mut others = Vec::new();
+        let is_other = |p: &Prim| p.shape.kind() != ShapeKind::Triangle;
+        if for_bvh.par_iter().any(is_other) {
+            for (&(first, count), at) in ranges.iter().zip(&mut other_at) {
+                *at = others.len();
+                let leaf = order[first..first + count]
+                    .iter()
+                    .map(|&i| &for_bvh[i as usize]);
+                others.extend(leaf.filter(|p| is_other(p)));
+            }
+        }
+        let blocks: Vec<Block> = ranges
+            .par_iter()
+            .zip(&other_at)
+            .map(|(&range, &at)| {
+                let (leaf, count) = leaf(range);
+                Block::new(&leaf[..count], at)
+            })
+            .collect();
+        let lane = |p: Option<&Prim>| match p {
+            Some(p) if p.shape.kind() == ShapeKind::Triangle => {
+                assert!(p.material < SMOOTH, "at most 2^31 materials");
+                let smooth = if p.smooth == FLAT { 0 } else { SMOOTH };
+                Attrs {
+                    material: p.material | smooth,
+                    light: p.light,
+                }
+            }
+            _ => Attrs::NONE,
+        };
+        let attrs: Vec<Attrs> = ranges
+            .par_iter()
+            .flat_map_iter(|&range| {
+                let (leaf, count) = leaf(range);
+                (0..4).map(move |k| lane(leaf[..count].get(k)))
+            })
+            .collect();
+        let normals = &normals;
+        let lane_normals: Vec<[glam::Vec3A; 3]> = if for_bvh.par_iter().any(|p| p.smooth != FLAT) {
+            ranges
+                .par_iter()
+                .flat_map_iter(|&range| {
+                    let (leaf, count) = leaf(range);
+                    (0..4).map(move |k| match leaf[..count].get(k).map(|p| p.smooth) {
+                        Some(i) if i != FLAT => normals[i as usize],
+                        _ => [glam::Vec3A::ZERO; 3],
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let in_bvh = for_bvh.len();
+        drop(for_bvh);
         let slots = attrs.len();
         let sphere_items = append(&mut others, slots, spheres);
         let plane_items = append(&mut others, slots, planes);

@@ -352,31 +352,32 @@ fn collapse_node(
         let d = binary[k].max - binary[k].min;
         d.x * d.y + d.y * d.z + d.z * d.x
     };
-    let mut kids = vec![i + 1, binary[i].index as usize];
-    while kids.len() < 4 {
+    let (mut kids, mut n) = ([i + 1, binary[i].index as usize, 0, 0], 2);
+    while n < 4 {
         // Open the interior child with the largest box, keeping children in tree order.
-        let open = (0..kids.len())
+        let open = (0..n)
             .filter(|&k| binary[kids[k]].count == 0)
             .max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
         let Some(k) = open else { break };
         let j = kids[k];
-        kids.splice(k..=k, [j + 1, binary[j].index as usize]);
+        kids.copy_within(k + 1..n, k + 2);
+        kids[k] = j + 1;
+        kids[k + 1] = binary[j].index as usize;
+        n += 1;
     }
     let me = out.len();
     out.push(WideNode::from_children(binary, &[], &[]));
-    let refs: Vec<ChildRef> = kids
-        .iter()
-        .map(|&k| {
-            let n = binary[k];
-            if n.count > 0 {
-                let payload = leaf(n.index as usize, n.count as usize);
-                debug_assert!(payload < LEAF, "a leaf payload needs the top bit free");
-                LEAF | payload
-            } else {
-                collapse_node(binary, k, out, leaf)
-            }
-        })
-        .collect();
-    out[me] = WideNode::from_children(binary, &kids, &refs);
+    let mut refs = [EMPTY; 4];
+    for (r, &k) in refs.iter_mut().zip(&kids[..n]) {
+        let node = binary[k];
+        *r = if node.count > 0 {
+            let payload = leaf(node.index as usize, node.count as usize);
+            debug_assert!(payload < LEAF, "a leaf payload needs the top bit free");
+            LEAF | payload
+        } else {
+            collapse_node(binary, k, out, leaf)
+        };
+    }
+    out[me] = WideNode::from_children(binary, &kids[..n], &refs[..n]);
     me as u32
 }
