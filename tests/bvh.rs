@@ -389,3 +389,43 @@ fn small_wide_trees() {
     assert!(empty.closest(&down, |_, _| Some((0, 1.0))).is_none());
     assert!(!empty.any(&down, |_, _| true));
 }
+
+/// Rays parallel to two axes whose origins lie exactly on the sides of boxes (`0 * inf` is NaN
+/// in the slab test) find what testing every triangle finds, in both trees: a 16 x 16 grid of
+/// unit squares at z = 0 (two triangles each), rays along +z and -z from every grid point and
+/// cell centre. (The binary tree's slab test once took a NaN for an exit at infinity and missed
+/// the grid's corner.)
+#[test]
+fn axis_parallel_rays_on_box_sides_agree() {
+    let mut prims = Vec::new();
+    for i in 0..16 {
+        for j in 0..16 {
+            let p = |x: i32, y: i32| Vec3A::new((i + x) as f32, (j + y) as f32, 0.0);
+            for [a, b, c] in [[p(0, 0), p(1, 0), p(1, 1)], [p(0, 0), p(1, 1), p(0, 1)]] {
+                prims.push(Prim::flat(Shape::Triangle(Triangle::new(a, b, c).unwrap())));
+            }
+        }
+    }
+    let g = build(prims);
+    let (wide, ranges) = collapse(&g.bvh);
+    let leaf = |b: u32, r: &Ray| {
+        let (first, count) = ranges[b as usize];
+        scalar_leaf(&g.prims, first, count, r)
+    };
+    let mut hits = 0;
+    for x in 0..=32 {
+        for y in 0..=32 {
+            for dz in [1.0f32, -1.0] {
+                let o = Vec3A::new(x as f32 * 0.5, y as f32 * 0.5, -dz);
+                let r = Ray::new(o, Vec3A::new(0.0, 0.0, dz));
+                let expect = scalar_leaf(&g.prims, 0, g.prims.len(), &r);
+                assert_eq!(g.bvh.closest(&g.prims, &r), expect, "{r:?}");
+                assert_eq!(wide.closest(&r, leaf), expect, "{r:?}");
+                assert_eq!(wide.any(&r, |b, r| leaf(b, r).is_some()), expect.is_some());
+                hits += expect.is_some() as usize;
+            }
+        }
+    }
+    // Every point of the grid's interior and its lower and left border belongs to a square.
+    assert!(hits >= 2 * 32 * 32, "{hits} hits");
+}

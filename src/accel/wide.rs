@@ -108,6 +108,9 @@ pub struct WideBvh {
 struct RayBox {
     o: [Vec4; 3],
     inv_d: [Vec4; 3],
+    /// Per axis, true if the ray runs towards smaller coordinates: it then enters a slab by
+    /// its largest side.
+    back: [bool; 3],
 }
 
 impl RayBox {
@@ -120,6 +123,7 @@ impl RayBox {
                 Vec4::splat(inv_d.y),
                 Vec4::splat(inv_d.z),
             ],
+            back: inv_d.to_array().map(f32::is_sign_negative),
         }
     }
 }
@@ -130,28 +134,51 @@ const STACK: usize = 3 * 80;
 
 impl WideNode {
     /// Entry distances of the four children and the lanes whose box the ray enters within
-    /// `(0, t_max]`: [`Aabb::hit`](crate::geometry::Aabb::hit), four at a time.
+    /// `(0, t_max]`.
+    ///
+    /// The slab test of [`Aabb::hit`](crate::geometry::Aabb::hit) with each slab's entry and
+    /// exit sides chosen by the sign of the direction (as Embree does) instead of a min and max
+    /// of both. A NaN, from an origin exactly on a slab's side with the direction parallel to
+    /// it (`0 * inf`), drops out of the max and min (SSE's `max(a, b)` is `b` when either is
+    /// NaN, and the NaN is always `a` here), so such a ray stays in the slab, as in the scalar
+    /// test.
     #[inline(always)]
     fn hit(&self, r: &RayBox, t_max: f32) -> (Vec4, u32) {
-        let decode = |q: [u8; 4], axis: usize| {
-            Vec4::splat(self.origin[axis]) + widen(q) * Vec4::splat(self.step[axis])
+        let side = |axis: usize, hi: bool| {
+            let q = if hi { self.hi[axis] } else { self.lo[axis] };
+            let plane = Vec4::splat(self.origin[axis]) + widen(q) * Vec4::splat(self.step[axis]);
+            (plane - r.o[axis]) * r.inv_d[axis]
         };
-        let t0 = [0, 1, 2].map(|axis| (decode(self.lo[axis], axis) - r.o[axis]) * r.inv_d[axis]);
-        let t1 = [0, 1, 2].map(|axis| (decode(self.hi[axis], axis) - r.o[axis]) * r.inv_d[axis]);
-        let near = [t0[0].min(t1[0]), t0[1].min(t1[1]), t0[2].min(t1[2])];
-        let far = [t0[0].max(t1[0]), t0[1].max(t1[1]), t0[2].max(t1[2])];
-        // The scalar test's horizontal max and min, operand for operand (they differ only when
-        // a NaN is involved, and then this order is what `Vec3A::max_element` does).
-        let near = near[0]
-            .max(near[2])
-            .max(near[1].max(near[2]))
-            .max(Vec4::ZERO);
-        let far =
-            far[0].min(far[2]).min(far[1].min(far[2])) * Vec4::splat(1.0 + 4.0 * f32::EPSILON);
+        let enter = [0, 1, 2].map(|axis| side(axis, r.back[axis]));
+        let exit = [0, 1, 2].map(|axis| side(axis, !r.back[axis]));
+        let near = enter[0].max(enter[1].max(enter[2].max(Vec4::ZERO)));
+        let far = exit[0].min(exit[1].min(exit[2].min(Vec4::INFINITY)))
+            * Vec4::splat(1.0 + 4.0 * f32::EPSILON);
         let ok = near.cmple(far) & near.cmple(Vec4::splat(t_max));
-        let used = self.child.map(|c| (c != EMPTY) as u32);
-        let used = used[0] | used[1] << 1 | used[2] << 2 | used[3] << 3;
-        (near, ok.bitmask() & used)
+        (near, ok.bitmask() & self.used())
+    }
+
+    /// The slots (bits) that hold a child.
+    #[inline(always)]
+    fn used(&self) -> u32 {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{
+                __m128i, _mm_castsi128_ps, _mm_cmpeq_epi32, _mm_loadu_si128, _mm_movemask_ps,
+                _mm_set1_epi32,
+            };
+            // SAFETY: SSE2 is in the x86-64 baseline; the load reads the 16 bytes of `child`.
+            unsafe {
+                let child = _mm_loadu_si128(self.child.as_ptr() as *const __m128i);
+                let empty = _mm_cmpeq_epi32(child, _mm_set1_epi32(EMPTY as i32));
+                !(_mm_movemask_ps(_mm_castsi128_ps(empty)) as u32) & 0b1111
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let used = self.child.map(|c| (c != EMPTY) as u32);
+            used[0] | used[1] << 1 | used[2] << 2 | used[3] << 3
+        }
     }
 }
 
@@ -216,15 +243,19 @@ impl WideBvh {
                         best = Some((p, t));
                     }
                 } else {
-                    next[k] = (c, near[i]);
+                    // Kept farthest first (insertion into at most three).
+                    let mut j = k;
+                    while j > 0 && next[j - 1].1 < near[i] {
+                        next[j] = next[j - 1];
+                        j -= 1;
+                    }
+                    next[j] = (c, near[i]);
                     k += 1;
                 }
             }
             // Nearest child next; the others on the stack, farthest deepest.
-            let next = &mut next[..k];
-            next.sort_unstable_by(|a, b| b.1.total_cmp(&a.1));
             let mut nearest = None;
-            for &(c, t) in next.iter() {
+            for &(c, t) in &next[..k] {
                 if t <= r.t_max
                     && let Some(farther) = nearest.replace((c, t))
                 {

@@ -51,14 +51,23 @@ impl Aabb {
 
     /// Entry distance of a ray into the box if it enters within `(0, t_max]`, else `None`.
     ///
-    /// The slab test with NaN-safe min/max: a ray parallel to a slab and inside it stays in.
+    /// The slab test with each slab's entry and exit sides chosen by the sign of the direction.
+    /// A ray parallel to a slab and inside it stays in, also when its origin lies exactly on one
+    /// of the slab's sides: the `0 * inf` there is NaN, which `f32::max` and `f32::min` drop.
     #[inline]
     pub fn hit(&self, o: Vec3A, inv_d: Vec3A, t_max: f32) -> Option<f32> {
-        let t0 = (self.min - o) * inv_d;
-        let t1 = (self.max - o) * inv_d;
-        // Robust near/far (Ize 2013): widen the far distance by 2 ulps-ish.
-        let near = t0.min(t1).max_element().max(0.0);
-        let far = t0.max(t1).min_element() * (1.0 + 4.0 * f32::EPSILON);
+        let (mut near, mut far) = (0.0f32, f32::INFINITY);
+        for axis in 0..3 {
+            let (enter, exit) = if inv_d[axis].is_sign_negative() {
+                (self.max[axis], self.min[axis])
+            } else {
+                (self.min[axis], self.max[axis])
+            };
+            near = near.max((enter - o[axis]) * inv_d[axis]);
+            far = far.min((exit - o[axis]) * inv_d[axis]);
+        }
+        // Robust far distance (Ize 2013): widened by a few ulps for the rounding of both.
+        let far = far * (1.0 + 4.0 * f32::EPSILON);
         (near <= far && near <= t_max).then_some(near)
     }
 }
