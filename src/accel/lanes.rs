@@ -91,6 +91,12 @@ impl SphereLanes {
         let b = -dot(f, r.d);
         let l = [f[0] + b * r.d[0], f[1] + b * r.d[1], f[2] + b * r.d[2]];
         let disc = self.r2 - dot(l, l);
+        // Most rays miss every sphere of a packet (a shadow ray in a room of a few spheres):
+        // they skip the square root and division below, whose latency dominates the test.
+        let real = disc.cmpge(Vec4::ZERO);
+        if !real.any() {
+            return (Vec4::ZERO, real);
+        }
         let f2 = dot(f, f);
         let c = f2 - self.r2;
         let q = b + disc.sqrt().copysign(b);
@@ -116,7 +122,7 @@ impl SphereLanes {
             t = Vec4::select(on, other, t);
             ok = (on & ok_on) | (!on & ok);
         }
-        (t, disc.cmpge(zero) & q.cmpne(zero) & ok)
+        (t, real & q.cmpne(zero) & ok)
     }
 }
 
