@@ -154,11 +154,7 @@ impl Geometry {
         // The wide tree first, each leaf named by its rank; then the leaves' blocks and
         // attributes in parallel, in that order (the reads of the primitives, in leaf order,
         // are most of the work).
-        let mut ranges = Vec::new();
-        let bvh = WideBvh::collapse(&binary, |first, count| {
-            ranges.push((first, count));
-            (ranges.len() - 1) as u32
-        });
+        let (bvh, ranges) = WideBvh::collapse(&binary);
         drop(binary);
         let leaf = |(first, count): (usize, usize)| {
             let mut leaf = [for_bvh[order[first] as usize]; 4];
@@ -181,14 +177,6 @@ impl Geometry {
                 others.extend(leaf.filter(|p| is_other(p)));
             }
         }
-        let blocks: Vec<Block> = ranges
-            .par_iter()
-            .zip(&other_at)
-            .map(|(&range, &at)| {
-                let (leaf, count) = leaf(range);
-                Block::new(&leaf[..count], at)
-            })
-            .collect();
         let lane = |p: Option<&Prim>| match p {
             Some(p) if p.shape.kind() == ShapeKind::Triangle => {
                 assert!(p.material < SMOOTH, "at most 2^31 materials");
@@ -200,13 +188,20 @@ impl Geometry {
             }
             _ => Attrs::NONE,
         };
-        let attrs: Vec<Attrs> = ranges
+        // Each leaf's block and lane attributes from one read of its primitives.
+        let (blocks, lanes): (Vec<Block>, Vec<[Attrs; 4]>) = ranges
             .par_iter()
-            .flat_map_iter(|&range| {
+            .zip(&other_at)
+            .map(|(&range, &at)| {
                 let (leaf, count) = leaf(range);
-                (0..4).map(move |k| lane(leaf[..count].get(k)))
+                let leaf = &leaf[..count];
+                (
+                    Block::new(leaf, at),
+                    [0, 1, 2, 3].map(|k| lane(leaf.get(k))),
+                )
             })
-            .collect();
+            .unzip();
+        let attrs: Vec<Attrs> = lanes.into_iter().flatten().collect();
         let normals = &normals;
         let lane_normals: Vec<[glam::Vec3A; 3]> = if for_bvh.par_iter().any(|p| p.smooth != FLAT) {
             ranges

@@ -13,6 +13,7 @@
 use super::bvh::Node;
 use crate::geometry::Ray;
 use glam::{Vec3A, Vec4};
+use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
 /// A child reference: an interior node's index, or, when [`LEAF`] is set, a leaf's payload in
@@ -188,22 +189,23 @@ impl WideBvh {
     /// binary node's children and keeps opening the largest interior one among them until it
     /// has four, so the levels it skips are those a ray would most often visit.
     ///
-    /// `leaf(first, count)` stores a binary leaf's primitives (`count` of them, from `first`)
-    /// and returns its payload, below [`LEAF`]; leaves are stored in depth-first order.
-    pub fn collapse(binary: &[Node], mut leaf: impl FnMut(usize, usize) -> u32) -> WideBvh {
+    /// Returns the tree and its leaves, each a binary leaf's `(first, count)`: a leaf child's
+    /// payload is its index there. Leaves and nodes come in depth-first order; the top levels'
+    /// subtrees are collapsed in parallel and joined in that order, so the result does not
+    /// depend on the thread count.
+    pub fn collapse(binary: &[Node]) -> (WideBvh, Vec<(usize, usize)>) {
         if binary.is_empty() {
-            return WideBvh::default();
+            return (WideBvh::default(), Vec::new());
         }
-        let mut nodes = Vec::with_capacity(binary.len() / 3 + 1);
         let root = binary[0];
         if root.count > 0 {
             // A single leaf: a root with one child.
-            let only = LEAF | leaf(root.index as usize, root.count as usize);
-            nodes.push(WideNode::from_children(binary, &[0], &[only]));
-        } else {
-            collapse_node(binary, 0, &mut nodes, &mut leaf);
+            let node = WideNode::from_children(binary, &[0], &[LEAF]);
+            let leaves = vec![(root.index as usize, root.count as usize)];
+            return (WideBvh { nodes: vec![node] }, leaves);
         }
-        WideBvh { nodes }
+        let part = collapse_part(binary, 0, PARALLEL_LEVELS);
+        (WideBvh { nodes: part.nodes }, part.leaves)
     }
 
     /// Nearest primitive hit: its index and distance. `test(leaf, ray)` is the nearest hit in
@@ -371,21 +373,25 @@ impl WideNode {
     }
 }
 
-/// Append the wide node for binary interior node `i` (and, after it, its subtrees); returns
-/// its index.
-fn collapse_node(
-    binary: &[Node],
-    i: usize,
-    out: &mut Vec<WideNode>,
-    leaf: &mut impl FnMut(usize, usize) -> u32,
-) -> u32 {
+/// Wide levels whose subtrees are collapsed in parallel (up to 4^3 = 64 tasks).
+const PARALLEL_LEVELS: u32 = 3;
+
+/// A collapsed subtree, its root first, with node indices and leaf payloads counted from 0.
+struct Part {
+    nodes: Vec<WideNode>,
+    leaves: Vec<(usize, usize)>,
+}
+
+/// The up to four binary nodes a wide node over binary interior node `i` takes as children:
+/// `i`'s two, then the largest interior one among them opened until there are four, kept in
+/// tree order.
+fn children(binary: &[Node], i: usize) -> ([usize; 4], usize) {
     let area = |k: usize| {
         let d = binary[k].max - binary[k].min;
         d.x * d.y + d.y * d.z + d.z * d.x
     };
     let (mut kids, mut n) = ([i + 1, binary[i].index as usize, 0, 0], 2);
     while n < 4 {
-        // Open the interior child with the largest box, keeping children in tree order.
         let open = (0..n)
             .filter(|&k| binary[kids[k]].count == 0)
             .max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
@@ -396,17 +402,73 @@ fn collapse_node(
         kids[k + 1] = binary[j].index as usize;
         n += 1;
     }
+    (kids, n)
+}
+
+/// The subtree under binary interior node `i`, its interior children's subtrees collapsed in
+/// parallel for `levels` more levels, then joined in order (each child's indices shifted by
+/// what precedes it), which is what the sequential [`collapse_node`] would have written.
+fn collapse_part(binary: &[Node], i: usize, levels: u32) -> Part {
+    let mut part = Part {
+        nodes: Vec::new(),
+        leaves: Vec::new(),
+    };
+    if levels == 0 {
+        collapse_node(binary, i, &mut part.nodes, &mut part.leaves);
+        return part;
+    }
+    let (kids, n) = children(binary, i);
+    let subs: Vec<Option<Part>> = kids[..n]
+        .par_iter()
+        .map(|&k| (binary[k].count == 0).then(|| collapse_part(binary, k, levels - 1)))
+        .collect();
+    part.nodes.push(WideNode::from_children(binary, &[], &[]));
+    let mut refs = [EMPTY; 4];
+    for ((r, &k), sub) in refs.iter_mut().zip(&kids[..n]).zip(subs) {
+        *r = match sub {
+            None => {
+                part.leaves
+                    .push((binary[k].index as usize, binary[k].count as usize));
+                LEAF | (part.leaves.len() - 1) as u32
+            }
+            Some(sub) => {
+                let (node_at, leaf_at) = (part.nodes.len() as u32, part.leaves.len() as u32);
+                part.nodes.extend(sub.nodes.into_iter().map(|mut node| {
+                    for c in node.child.iter_mut().filter(|c| **c != EMPTY) {
+                        *c += if *c & LEAF != 0 { leaf_at } else { node_at };
+                    }
+                    node
+                }));
+                part.leaves.extend(sub.leaves);
+                node_at
+            }
+        };
+    }
+    part.nodes[0] = WideNode::from_children(binary, &kids[..n], &refs[..n]);
+    part
+}
+
+/// Append the wide node for binary interior node `i` (and, after it, its subtrees) to `out`,
+/// its leaves to `leaves`; returns its index.
+fn collapse_node(
+    binary: &[Node],
+    i: usize,
+    out: &mut Vec<WideNode>,
+    leaves: &mut Vec<(usize, usize)>,
+) -> u32 {
+    let (kids, n) = children(binary, i);
     let me = out.len();
     out.push(WideNode::from_children(binary, &[], &[]));
     let mut refs = [EMPTY; 4];
     for (r, &k) in refs.iter_mut().zip(&kids[..n]) {
         let node = binary[k];
         *r = if node.count > 0 {
-            let payload = leaf(node.index as usize, node.count as usize);
-            debug_assert!(payload < LEAF, "a leaf payload needs the top bit free");
+            leaves.push((node.index as usize, node.count as usize));
+            let payload = (leaves.len() - 1) as u32;
+            assert!(payload < LEAF, "at most 2^31 leaves");
             LEAF | payload
         } else {
-            collapse_node(binary, k, out, leaf)
+            collapse_node(binary, k, out, leaves)
         };
     }
     out[me] = WideNode::from_children(binary, &kids[..n], &refs[..n]);
