@@ -5,7 +5,7 @@
 
 use glam::{Vec3, Vec3A};
 use rtis::accel::Prim;
-use rtis::accel::block::{Block, BlockRay};
+use rtis::accel::block::{Block, BlockRay, lane_triangle};
 use rtis::geometry::{Hit, Ray};
 use rtis::mesh::displaced_sphere;
 use rtis::sampling::Sampler;
@@ -37,11 +37,11 @@ fn agree(prims: &[Prim], ray: &Ray) -> bool {
     expect.is_some()
 }
 
-/// The block of `prims` and the array that holds its non-triangles.
+/// The block of `prims` and the array that holds its lanes' whole primitives.
 fn block_of(prims: &[Prim]) -> (Block, Vec<Prim>) {
     let others = prims
         .iter()
-        .filter(|p| !matches!(p.shape, Shape::Triangle(_)))
+        .filter(|p| lane_triangle(p).is_none())
         .copied()
         .collect();
     (Block::new(prims, 0), others)
@@ -63,6 +63,9 @@ fn blocks_give_back_their_triangles_exactly() {
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
             assert_eq!(t.v.map(bits), back.v.map(bits));
             assert_eq!(bits(t.n), bits(back.n));
+            // The normal the lanes compute for the band test.
+            let n = block.normals().map(|a| a.to_array()[lane]);
+            assert_eq!(bits(t.n), bits(Vec3A::from_array(n)), "lane normal");
         }
         assert!(block.triangle(chunk.len()).is_none() || chunk.len() == 4);
     }
@@ -74,6 +77,23 @@ fn blocks_give_back_their_triangles_exactly() {
     assert!(block.triangle(0).is_none() && block.triangle(1).is_some());
     assert_eq!((block.other_index(0), block.other_index(2)), (0, 1));
     assert_eq!(others.len(), 2);
+    // A triangle built through its fields with another normal than `Triangle::new` gives is
+    // kept whole, for the scalar test, as is one of zero area.
+    let Shape::Triangle(mut odd) = all[0].shape else {
+        unreachable!()
+    };
+    odd.n = -odd.n;
+    let flat = Triangle {
+        v: [Vec3A::ZERO, Vec3A::X, Vec3A::X],
+        n: Vec3A::Z,
+    };
+    for t in [odd, flat] {
+        let p = Prim::flat(Shape::Triangle(t));
+        assert!(lane_triangle(&p).is_none());
+        let (block, others) = block_of(&[all[1], p]);
+        assert!(block.triangle(1).is_none() && block.scalar == 0b10);
+        assert_eq!(others.len(), 1);
+    }
 }
 
 fn tri(a: Vec3A, b: Vec3A, c: Vec3A) -> Prim {
@@ -155,8 +175,14 @@ fn shared_edges_and_vertices_go_to_exactly_one_lane() {
                 let ray = Ray::new(p - 2.0 * dir, dir);
                 let inside = (1..4).contains(&x) && (1..4).contains(&y);
                 let hit = agree(&quad, &ray);
-                if inside && dir == Vec3A::Z {
-                    assert!(hit, "a ray through {p} fell through");
+                // Each triangle in a block of its own: inside the square, exactly one owns
+                // the point, whether on the shared diagonal or not.
+                let owners = quad
+                    .iter()
+                    .filter(|t| agree(std::slice::from_ref(t), &ray))
+                    .count();
+                if inside {
+                    assert!(hit && owners == 1, "{owners} owners of {p} along {dir}");
                 }
             }
         }

@@ -452,3 +452,76 @@ fn wide_tree_does_not_depend_on_the_thread_count() {
         "the thread count changed the tree"
     );
 }
+
+/// A scene with more spheres than the packets take puts spheres and triangles in the same
+/// leaves: every hit names the primitive a test of every primitive finds, at the same
+/// distance, and the geometry counts and lists each primitive once. Smooth triangles keep
+/// their vertex normals through the move to lanes, also one whose stored normal differs from
+/// what its vertices give (kept whole).
+#[test]
+fn mixed_leaves_of_spheres_and_triangles() {
+    use rtis::geometry::Hit;
+    use rtis::shape::{ShapeKind, Sphere};
+    let mut s = Sampler::new(5, 0, 0);
+    let mut prims = mesh_prims(2_000);
+    let triangles = prims.len();
+    for _ in 0..40 {
+        let c = Vec3A::new(s.next_f32(), s.next_f32(), s.next_f32()) * 3.0 - Vec3A::splat(1.5);
+        prims.push(Prim::flat(Shape::Sphere(Sphere { c, r: 0.1 })));
+    }
+    // Vertex normals for every tenth triangle, one of them with a flipped stored normal.
+    let mut normals = Vec::new();
+    for (k, p) in prims.iter_mut().enumerate().take(triangles).step_by(10) {
+        let Shape::Triangle(t) = &mut p.shape else {
+            unreachable!()
+        };
+        if k == 50 {
+            t.n = -t.n;
+        }
+        p.smooth = normals.len() as u32;
+        normals.push([Vec3A::X, Vec3A::Y, Vec3A::Z * (k as f32 + 1.0)]);
+    }
+    let g = rtis::accel::Geometry::build(prims.clone(), normals.clone());
+    assert_eq!(g.count(ShapeKind::Sphere), 40);
+    assert_eq!(g.count(ShapeKind::Triangle), triangles);
+    assert_eq!(g.indices().count(), prims.len());
+    // Each smooth triangle finds its own normals: the third one's z names it.
+    for i in g.indices() {
+        let p = g.prim(i);
+        if p.smooth != rtis::accel::FLAT {
+            let z = g.normals[p.smooth as usize][2].z;
+            let original = &prims[z as usize - 1];
+            let (Shape::Triangle(a), Shape::Triangle(b)) = (original.shape, p.shape) else {
+                panic!("a smooth primitive that is not a triangle")
+            };
+            assert_eq!(
+                (a.v, a.n),
+                (b.v, b.n),
+                "normals moved with another triangle"
+            );
+        }
+    }
+    let mut hits = 0;
+    for r in rays(5_000, 9) {
+        let brute = prims
+            .iter()
+            .filter_map(|p| {
+                p.shape
+                    .intersect(&r.for_bvh(r.t_max, true))
+                    .map(|t| (t, p.shape))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let got: Option<Hit> = g.intersect(&r);
+        match (brute, got) {
+            (None, None) => {}
+            (Some((t, shape)), Some(h)) => {
+                assert_eq!(h.t, t, "{r:?}");
+                assert_eq!(format!("{:?}", g.prim(h.prim).shape), format!("{shape:?}"));
+                hits += 1;
+            }
+            (b, h) => panic!("brute force {b:?}, geometry {h:?} for {r:?}"),
+        }
+        assert_eq!(g.occluded(&r), brute.is_some());
+    }
+    assert!(hits > 500, "{hits} hits");
+}

@@ -20,7 +20,7 @@ use glam::{Vec3A, Vec4};
 #[repr(C)]
 pub struct Block {
     /// `v[j][axis]`: coordinate `axis` of vertex `j` of each lane's triangle (NaN in lanes
-    /// that hold no triangle, which every comparison rejects).
+    /// that hold no triangle; the test masks those lanes out).
     pub v: [[Vec4; 3]; 3],
     /// Where the lanes that hold no triangle (spheres, in order) keep their primitives, from
     /// this index on, in the array passed to the queries.
@@ -43,15 +43,15 @@ impl Block {
         let mut v = [[[f32::NAN; 4]; 3]; 3];
         let mut scalar = 0;
         for (i, p) in leaf.iter().enumerate() {
-            match p.shape {
-                Shape::Triangle(t) => {
+            match lane_triangle(p) {
+                Some(t) => {
                     for axis in 0..3 {
                         for (j, vertex) in t.v.iter().enumerate() {
                             v[j][axis][i] = vertex[axis];
                         }
                     }
                 }
-                _ => scalar |= 1 << i,
+                None => scalar |= 1 << i,
             }
         }
         Block {
@@ -71,6 +71,21 @@ impl Block {
         let vertex =
             |j: usize| Vec3A::new(self.v[j][0][lane], self.v[j][1][lane], self.v[j][2][lane]);
         Triangle::new(vertex(0), vertex(1), vertex(2))
+    }
+
+    /// The lanes' unit normals, `[x, y, z]`: `Triangle::new`'s operations, lane by lane, so
+    /// each is its triangle's normal to the bit (NaN in lanes without a triangle).
+    #[inline(always)]
+    pub fn normals(&self) -> [Vec4; 3] {
+        let e1 = [0, 1, 2].map(|axis| self.v[1][axis] - self.v[0][axis]);
+        let e2 = [0, 1, 2].map(|axis| self.v[2][axis] - self.v[0][axis]);
+        let c = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let len = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        c.map(|c| c / len)
     }
 
     /// Index, in the array of other primitives, of the shape in scalar lane `lane`.
@@ -112,16 +127,8 @@ impl Block {
         }
         // A ray starting on the triangle's plane (within the error band of the origin's signed
         // distance) does not meet it at its start. Few tests get here, so the normal is
-        // computed now rather than stored: `Triangle::new`'s operations, lane by lane.
-        let e1 = [0, 1, 2].map(|axis| self.v[1][axis] - self.v[0][axis]);
-        let e2 = [0, 1, 2].map(|axis| self.v[2][axis] - self.v[0][axis]);
-        let c = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        let len = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-        let n = c.map(|c| c / len);
+        // computed now rather than stored.
+        let n = self.normals();
         let an = n.map(Vec4::abs);
         let reach = [0, 1, 2].map(|axis| self.v[0][axis].abs() + r.o_abs[axis]);
         let band = Vec4::splat(gamma(5)) * (an[0] * reach[0] + an[1] * reach[1] + an[2] * reach[2])
@@ -183,6 +190,19 @@ impl Block {
             None => others[self.other_index(lane)].shape.intersect(ray),
         }
     }
+}
+
+/// The triangle primitive `p` puts in a block lane: its triangle, if `Triangle::new` gives it
+/// back to the bit (a block keeps only the vertices and recomputes the normal). A triangle
+/// built otherwise (through its public fields, with a zero area or another normal), like every
+/// other shape, stays a whole primitive for the scalar test.
+pub fn lane_triangle(p: &Prim) -> Option<Triangle> {
+    let Shape::Triangle(t) = p.shape else {
+        return None;
+    };
+    let again = Triangle::new(t.v[0], t.v[1], t.v[2])?;
+    let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+    (again.v.map(bits) == t.v.map(bits) && bits(again.n) == bits(t.n)).then_some(t)
 }
 
 /// A ray's origin splatted across lanes, with its watertight-test permutation and shear.

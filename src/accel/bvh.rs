@@ -1,5 +1,9 @@
-//! A bounding volume hierarchy built with the binned surface-area heuristic and flattened into
-//! an array of 32-byte nodes in depth-first order.
+//! A binary bounding volume hierarchy built with the binned surface-area heuristic (costs in
+//! blocks of four primitives) into an array of 32-byte nodes, the root first and each interior
+//! node's first child after it. The renderer collapses the sparse array the build writes
+//! ([`Bvh::build_sparse`]) into the four-wide tree of [`super::wide`]; [`Bvh::build`] compacts it
+//! in depth-first order, and its `closest` and `any` traversals are the reference the wide
+//! tree is tested against.
 
 use super::Prim;
 use crate::geometry::{Aabb, Ray};
@@ -250,7 +254,7 @@ const PARALLEL_MIN: usize = 4096;
 
 /// Build the subtree over `order` (indices into `items`) into `slots`, which has room for
 /// `2 * order.len() - 1` nodes (more than a tree with multi-primitive leaves needs; unused slots
-/// stay empty and are compacted away). `offset` is where `order` starts in the final primitive
+/// stay zero, and nothing reaches them from the root). `offset` is where `order` starts in the final primitive
 /// array, `base` the index of `slots[0]` in the sparse array. The node is written to
 /// `slots[0]`; its left child is `base + 1`, its right child `base + 2 * left.len()`.
 ///

@@ -22,7 +22,9 @@ pub struct Prim {
     pub shape: Shape,
     /// Index into the prepared material array.
     pub material: u32,
-    /// Index into [`Geometry::normals`] of a smooth triangle's vertex normals, or [`FLAT`].
+    /// A smooth triangle's vertex normals, or [`FLAT`]: an index into the normals passed to
+    /// [`Geometry::build`], and in the primitives [`Geometry::prim`] returns, into
+    /// [`Geometry::normals`].
     pub smooth: u32,
     /// Index of the primitive's area light in the render's `Emitters`, or
     /// [`crate::light::NO_LIGHT`].
@@ -166,8 +168,8 @@ impl Geometry {
         // Where each leaf's non-triangles start among `others` (all at 0 when the BVH holds
         // triangles only).
         let mut other_at = vec![0; ranges.len()];
-        let mut others = Vec::new();
-        let is_other = |p: &Prim| p.shape.kind() != ShapeKind::Triangle;
+        let mut others: Vec<Prim> = Vec::new();
+        let is_other = |p: &Prim| block::lane_triangle(p).is_none();
         if for_bvh.par_iter().any(is_other) {
             for (&(first, count), at) in ranges.iter().zip(&mut other_at) {
                 *at = others.len();
@@ -178,7 +180,7 @@ impl Geometry {
             }
         }
         let lane = |p: Option<&Prim>| match p {
-            Some(p) if p.shape.kind() == ShapeKind::Triangle => {
+            Some(p) if block::lane_triangle(p).is_some() => {
                 assert!(p.material < SMOOTH, "at most 2^31 materials");
                 let smooth = if p.smooth == FLAT { 0 } else { SMOOTH };
                 Attrs {
@@ -203,20 +205,29 @@ impl Geometry {
             .unzip();
         let attrs: Vec<Attrs> = lanes.into_iter().flatten().collect();
         let normals = &normals;
-        let lane_normals: Vec<[glam::Vec3A; 3]> = if for_bvh.par_iter().any(|p| p.smooth != FLAT) {
-            ranges
-                .par_iter()
-                .flat_map_iter(|&range| {
-                    let (leaf, count) = leaf(range);
-                    (0..4).map(move |k| match leaf[..count].get(k).map(|p| p.smooth) {
-                        Some(i) if i != FLAT => normals[i as usize],
-                        _ => [glam::Vec3A::ZERO; 3],
+        // Vertex normals move to their lane's index; a smooth primitive kept whole (a
+        // triangle a lane cannot hold exactly) gets its normals appended after the lanes'.
+        let mut lane_normals: Vec<[glam::Vec3A; 3]> =
+            if for_bvh.par_iter().any(|p| p.smooth != FLAT) {
+                ranges
+                    .par_iter()
+                    .flat_map_iter(|&range| {
+                        let (leaf, count) = leaf(range);
+                        (0..4).map(move |k| match leaf[..count].get(k) {
+                            Some(p) if p.smooth != FLAT && block::lane_triangle(p).is_some() => {
+                                normals[p.smooth as usize]
+                            }
+                            _ => [glam::Vec3A::ZERO; 3],
+                        })
                     })
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+                    .collect()
+            } else {
+                Vec::new()
+            };
+        for p in others.iter_mut().filter(|p| p.smooth != FLAT) {
+            lane_normals.push(normals[p.smooth as usize]);
+            p.smooth = (lane_normals.len() - 1) as u32;
+        }
         let in_bvh = for_bvh.len();
         drop(for_bvh);
         let slots = attrs.len();

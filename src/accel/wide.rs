@@ -89,10 +89,23 @@ fn grid_step(lo: f32, hi: f32) -> f32 {
     if hi <= lo {
         return 0.0;
     }
-    // Divided first so that huge extents do not overflow, then raised until the grid reaches.
-    let mut step = hi / 255.0 - lo / 255.0;
+    // The extent over 255, within an ulp or two; divided first when the extent overflows.
+    let extent = hi - lo;
+    let mut step = if extent.is_finite() {
+        extent / 255.0
+    } else {
+        hi / 255.0 - lo / 255.0
+    };
+    // Raised until the grid reaches: a few ulps at most, then doubling, so an extent of one
+    // ulp (where the estimate can round to 0) costs a handful of steps, not a count to 2^-31.
+    let mut raised = 0;
     while lo + 255.0 * step < hi {
-        step = step.next_up();
+        step = if raised < 8 {
+            step.next_up()
+        } else {
+            (2.0 * step).max(f32::MIN_POSITIVE)
+        };
+        raised += 1;
     }
     step
 }
@@ -115,8 +128,14 @@ struct RayBox {
 }
 
 impl RayBox {
+    /// The ray's origin and reciprocal direction, an infinite reciprocal (a direction parallel
+    /// to an axis) replaced by the largest float of its sign: `0 * inf` would be NaN where the
+    /// origin lies on a box's side, while `0 * MAX` is 0 and keeps the ray in the slab, on every
+    /// platform. Otherwise only an origin outside a slab by less than about `1 / MAX` in a
+    /// parallel direction enters it, which costs a visit, never a hit.
     #[inline(always)]
     fn new(o: Vec3A, inv_d: Vec3A) -> Self {
+        let inv_d = inv_d.clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX));
         RayBox {
             o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             inv_d: [
@@ -129,8 +148,10 @@ impl RayBox {
     }
 }
 
-/// Traversal stack size: a wide level pushes at most three children, and the binary tree is at
-/// most 48 + 32 levels deep (`bvh::MEDIAN_DEPTH` plus log2 of a `u32` primitive count).
+/// Traversal stack size: a wide level leaves at most three more entries on the stack than it
+/// took (`closest` pushes three of four children and visits the fourth; `any` pops one and
+/// pushes four), and the binary tree is at most 48 + 32 levels deep (`bvh::MEDIAN_DEPTH` plus
+/// log2 of a `u32` primitive count), so a wide tree at most 80.
 const STACK: usize = 3 * 80;
 
 impl WideNode {
@@ -139,10 +160,7 @@ impl WideNode {
     ///
     /// The slab test of [`Aabb::hit`](crate::geometry::Aabb::hit) with each slab's entry and
     /// exit sides chosen by the sign of the direction (as Embree does) instead of a min and max
-    /// of both. A NaN, from an origin exactly on a slab's side with the direction parallel to
-    /// it (`0 * inf`), drops out of the max and min (SSE's `max(a, b)` is `b` when either is
-    /// NaN, and the NaN is always `a` here), so such a ray stays in the slab, as in the scalar
-    /// test.
+    /// of both. No NaN arises: [`RayBox::new`] keeps the reciprocal direction finite.
     #[inline(always)]
     fn hit(&self, r: &RayBox, t_max: f32) -> (Vec4, u32) {
         let side = |axis: usize, hi: bool| {
@@ -465,7 +483,8 @@ fn collapse_node(
         *r = if node.count > 0 {
             leaves.push((node.index as usize, node.count as usize));
             let payload = (leaves.len() - 1) as u32;
-            assert!(payload < LEAF, "at most 2^31 leaves");
+            // Below `LEAF - 1`, so that no leaf reference equals `EMPTY`.
+            assert!(payload < LEAF - 1, "at most 2^31 - 1 leaves");
             LEAF | payload
         } else {
             collapse_node(binary, k, out, leaves)
@@ -473,4 +492,48 @@ fn collapse_node(
     }
     out[me] = WideNode::from_children(binary, &kids[..n], &refs[..n]);
     me as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::{Bvh, Prim};
+    use crate::mesh::displaced_sphere;
+
+    /// Joining the subtrees collapsed in parallel gives what the sequential collapse writes,
+    /// node for node and leaf for leaf.
+    #[test]
+    fn parallel_collapse_equals_the_sequential_one() {
+        let mesh = displaced_sphere(20_000, glam::Vec3::ZERO, 1.0, 0.05);
+        let (bvh, _) = Bvh::build(Prim::flat_triangles(&mesh));
+        let show = |p: &Part| (format!("{:?}", p.nodes), p.leaves.clone());
+        let sequential = show(&collapse_part(&bvh.nodes, 0, 0));
+        for levels in [1, 2, 3, 5] {
+            assert!(
+                show(&collapse_part(&bvh.nodes, 0, levels)) == sequential,
+                "{levels} levels"
+            );
+        }
+        assert!(sequential.1.len() > 1_000);
+    }
+
+    /// A box one ulp wide, or near the largest floats, gets a grid that reaches its end in a
+    /// few steps and contains it.
+    #[test]
+    fn grids_reach_their_end_for_any_extent() {
+        for lo in [1.999f32, -1.0, 0.0, 1e-30, 3e38, -3.4e38, 1e7] {
+            for ulps in [1, 2, 3, 1000] {
+                let mut hi = lo;
+                for _ in 0..ulps {
+                    hi = hi.next_up();
+                }
+                let step = grid_step(lo, hi);
+                assert!(lo + 255.0 * step >= hi, "{lo} {hi}: step {step}");
+                let (ql, qh) = quantize(lo, hi, lo, step);
+                assert!(lo + ql as f32 * step <= lo && lo + qh as f32 * step >= hi);
+            }
+        }
+        let step = grid_step(-3.4e38, 3.4e38);
+        assert!(step.is_finite() && -3.4e38 + 255.0 * step >= 3.4e38);
+    }
 }

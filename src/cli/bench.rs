@@ -243,21 +243,6 @@ fn median_of<T: PartialEq + std::fmt::Debug>(
     mid
 }
 
-/// A built geometry, compared by its node count (builds of the same primitives agree).
-struct BuiltOnce(Geometry);
-
-impl PartialEq for BuiltOnce {
-    fn eq(&self, other: &Self) -> bool {
-        self.0.bvh.nodes.len() == other.0.bvh.nodes.len()
-    }
-}
-
-impl std::fmt::Debug for BuiltOnce {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        write!(f, "{} wide nodes", self.0.bvh.nodes.len())
-    }
-}
-
 /// BVH build time, memory per triangle and ray rates for procedural meshes of 10k, 100k and
 /// 1M triangles (a displaced sphere of radius 1 at the origin).
 fn meshes_section(
@@ -289,13 +274,20 @@ fn meshes_section(
         let mesh = displaced_sphere(n as usize, Vec3::ZERO, 1.0, 0.05);
         let prims = Prim::flat_triangles(&mesh);
         let count = prims.len();
-        let (build, g) = median_of(runs, || {
+        // The median of `runs` builds; the last one is kept (builds of the same primitives
+        // agree), each dropped before the next starts.
+        let mut times = Vec::new();
+        let mut built = None;
+        for _ in 0..runs.max(1) {
+            drop(built.take());
             let prims = prims.clone();
             let start = Instant::now();
-            let g = Geometry::build(prims, Vec::new());
-            (start.elapsed().as_secs_f64(), BuiltOnce(g))
-        });
-        let g = g.0;
+            built = Some(Geometry::build(prims, Vec::new()));
+            times.push(start.elapsed().as_secs_f64());
+        }
+        times.sort_by(f64::total_cmp);
+        let build = times[times.len() / 2];
+        let g = built.expect("at least one build");
         let nodes = g.bvh.nodes.len();
         // The tree's nodes and its leaves' blocks of lanes.
         let bvh_bytes = (nodes * std::mem::size_of::<WideNode>()
