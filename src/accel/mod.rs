@@ -165,45 +165,46 @@ impl Geometry {
             }
             (leaf, count)
         };
-        // Where each leaf's non-triangles start among `others` (all at 0 when the BVH holds
-        // triangles only).
-        let mut other_at = vec![0; ranges.len()];
-        let mut others: Vec<Prim> = Vec::new();
-        let is_other = |p: &Prim| block::lane_triangle(p).is_none();
-        if for_bvh.par_iter().any(is_other) {
-            for (&(first, count), at) in ranges.iter().zip(&mut other_at) {
-                *at = others.len();
-                let leaf = order[first..first + count]
-                    .iter()
-                    .map(|&i| &for_bvh[i as usize]);
-                others.extend(leaf.filter(|p| is_other(p)));
-            }
-        }
-        let lane = |p: Option<&Prim>| match p {
-            Some(p) if block::lane_triangle(p).is_some() => {
-                assert!(p.material < SMOOTH, "at most 2^31 materials");
-                let smooth = if p.smooth == FLAT { 0 } else { SMOOTH };
-                Attrs {
-                    material: p.material | smooth,
-                    light: p.light,
-                }
-            }
-            _ => Attrs::NONE,
-        };
-        // Each leaf's block and lane attributes from one read of its primitives.
-        let (blocks, lanes): (Vec<Block>, Vec<[Attrs; 4]>) = ranges
+        // Each leaf's block and lane attributes from one read of its primitives. A lane holds
+        // a triangle unless its block marks it scalar.
+        let in_lane = |b: &Block, k: usize| k < b.count as usize && b.scalar & (1 << k) == 0;
+        let (mut blocks, lanes): (Vec<Block>, Vec<[Attrs; 4]>) = ranges
             .par_iter()
-            .zip(&other_at)
-            .map(|(&range, &at)| {
+            .map(|&range| {
                 let (leaf, count) = leaf(range);
-                let leaf = &leaf[..count];
-                (
-                    Block::new(leaf, at),
-                    [0, 1, 2, 3].map(|k| lane(leaf.get(k))),
-                )
+                let block = Block::new(&leaf[..count], 0);
+                let attrs = [0, 1, 2, 3].map(|k| match in_lane(&block, k) {
+                    true => {
+                        let p = &leaf[k];
+                        assert!(p.material < SMOOTH, "at most 2^31 materials");
+                        let smooth = if p.smooth == FLAT { 0 } else { SMOOTH };
+                        Attrs {
+                            material: p.material | smooth,
+                            light: p.light,
+                        }
+                    }
+                    false => Attrs::NONE,
+                });
+                (block, attrs)
             })
             .unzip();
         let attrs: Vec<Attrs> = lanes.into_iter().flatten().collect();
+        // The primitives of scalar lanes, kept whole in `others` in leaf order; each block
+        // notes where its own start.
+        let mut others: Vec<Prim> = Vec::new();
+        for (block, &(first, _)) in blocks
+            .iter_mut()
+            .zip(&ranges)
+            .filter(|(b, _)| b.scalar != 0)
+        {
+            block.other = others.len() as u32;
+            let mut scalar = block.scalar;
+            while scalar != 0 {
+                let k = scalar.trailing_zeros() as usize;
+                scalar &= scalar - 1;
+                others.push(for_bvh[order[first + k] as usize]);
+            }
+        }
         let normals = &normals;
         // Vertex normals move to their lane's index; a smooth primitive kept whole (a
         // triangle a lane cannot hold exactly) gets its normals appended after the lanes'.
@@ -211,12 +212,11 @@ impl Geometry {
             if for_bvh.par_iter().any(|p| p.smooth != FLAT) {
                 ranges
                     .par_iter()
-                    .flat_map_iter(|&range| {
-                        let (leaf, count) = leaf(range);
-                        (0..4).map(move |k| match leaf[..count].get(k) {
-                            Some(p) if p.smooth != FLAT && block::lane_triangle(p).is_some() => {
-                                normals[p.smooth as usize]
-                            }
+                    .zip(&blocks)
+                    .flat_map_iter(|(&range, block)| {
+                        let (leaf, _) = leaf(range);
+                        (0..4).map(move |k| match in_lane(block, k) {
+                            true if leaf[k].smooth != FLAT => normals[leaf[k].smooth as usize],
                             _ => [glam::Vec3A::ZERO; 3],
                         })
                     })
