@@ -316,6 +316,12 @@ impl Geometry {
         self.indices().map(|i| self.prim(i))
     }
 
+    /// True if any sphere or plane is tested in packets.
+    #[inline]
+    fn has_packets(&self) -> bool {
+        !self.spheres.packs.is_empty() || !self.planes.packs.is_empty()
+    }
+
     /// True if the scene has no primitive at all.
     pub fn is_empty(&self) -> bool {
         self.others.is_empty() && self.blocks.is_empty()
@@ -331,9 +337,12 @@ impl Geometry {
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut t_max = ray.t_max;
         let mut best: Option<u32> = None;
-        let lanes = RayLanes::new(ray);
-        self.spheres
-            .closest(&lanes, &mut t_max, &mut best, SphereLanes::hit);
+        // The ray in lanes only for scenes with packets (a mesh scene has none).
+        let lanes = self.has_packets().then(|| RayLanes::new(ray));
+        if let Some(lanes) = &lanes {
+            self.spheres
+                .closest(lanes, &mut t_max, &mut best, SphereLanes::hit);
+        }
         if !self.bvh.nodes.is_empty() {
             let r = ray.for_bvh(t_max, self.has_triangles);
             let br = BlockRay::new(&r);
@@ -346,8 +355,10 @@ impl Geometry {
                 best = Some(i);
             }
         }
-        self.planes
-            .closest(&lanes, &mut t_max, &mut best, PlaneLanes::hit);
+        if let Some(lanes) = &lanes {
+            self.planes
+                .closest(lanes, &mut t_max, &mut best, PlaneLanes::hit);
+        }
         let prim = best?;
         let s = self.prim(prim).shape.surface(ray, t_max);
         Some(Hit {
@@ -363,14 +374,15 @@ impl Geometry {
     /// True if anything blocks `ray` within `(0, ray.t_max]` (any-hit query for shadow rays).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let lanes = RayLanes::new(ray);
-        self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
-            || self.planes.any(&lanes, ray.t_max, PlaneLanes::hit)
-            || (!self.bvh.nodes.is_empty() && {
-                let r = ray.for_bvh(ray.t_max, self.has_triangles);
-                let br = BlockRay::new(&r);
-                self.bvh
-                    .any(&r, |b, r| self.blocks[b as usize].any(&self.others, &br, r))
-            })
+        (self.has_packets() && {
+            let lanes = RayLanes::new(ray);
+            self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
+                || self.planes.any(&lanes, ray.t_max, PlaneLanes::hit)
+        }) || (!self.bvh.nodes.is_empty() && {
+            let r = ray.for_bvh(ray.t_max, self.has_triangles);
+            let br = BlockRay::new(&r);
+            self.bvh
+                .any(&r, |b, r| self.blocks[b as usize].any(&self.others, &br, r))
+        })
     }
 }
