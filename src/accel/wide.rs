@@ -247,47 +247,51 @@ impl WideBvh {
             let n = &self.nodes[node];
             let (near, mut mask) = n.hit(&rb, r.t_max);
             let near = near.to_array();
-            // Test the leaves among the hit children now; keep the interior ones, nearest
-            // first, to visit.
+            // The hit children, farthest first (insertion into at most four).
             let mut next: [(u32, f32); 4] = [(0, 0.0); 4];
             let mut k = 0;
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                let c = n.child[i];
-                if c & LEAF != 0 {
-                    if near[i] <= r.t_max
-                        && let Some((p, t)) = test(c & !LEAF, &r)
-                    {
-                        r.t_max = t;
-                        best = Some((p, t));
-                    }
-                } else {
-                    // Kept farthest first (insertion into at most three).
-                    let mut j = k;
-                    while j > 0 && next[j - 1].1 < near[i] {
-                        next[j] = next[j - 1];
-                        j -= 1;
-                    }
-                    next[j] = (c, near[i]);
-                    k += 1;
+                let mut j = k;
+                while j > 0 && next[j - 1].1 < near[i] {
+                    next[j] = next[j - 1];
+                    j -= 1;
+                }
+                next[j] = (n.child[i], near[i]);
+                k += 1;
+            }
+            // In distance order: leaves are tested until the nearest interior child, which is
+            // visited next; the farther children wait on the stack.
+            let mut go = None;
+            while k > 0 {
+                k -= 1;
+                let (c, t) = next[k];
+                if t > r.t_max {
+                    k = 0;
+                    break;
+                }
+                if c & LEAF == 0 {
+                    go = Some(c);
+                    break;
+                }
+                if let Some((p, t)) = test(c & !LEAF, &r) {
+                    r.t_max = t;
+                    best = Some((p, t));
                 }
             }
-            // Nearest child next; the others on the stack, farthest deepest.
-            let mut nearest = None;
-            for &(c, t) in &next[..k] {
-                if t <= r.t_max
-                    && let Some(farther) = nearest.replace((c, t))
-                {
-                    stack[sp].write(farther);
+            for &entry in &next[..k] {
+                if entry.1 <= r.t_max {
+                    stack[sp].write(entry);
                     sp += 1;
                 }
             }
-            if let Some((c, _)) = nearest {
+            if let Some(c) = go {
                 node = c as usize;
                 continue;
             }
-            // Pop, skipping nodes that a closer hit found meanwhile has made irrelevant.
+            // Pop: test leaves, skip what a closer hit found meanwhile has made irrelevant,
+            // visit the first interior node left.
             loop {
                 if sp == 0 {
                     return best;
@@ -295,9 +299,16 @@ impl WideBvh {
                 sp -= 1;
                 // SAFETY: entries below `sp` were written before `sp` was raised past them.
                 let (c, t) = unsafe { stack[sp].assume_init() };
-                if t <= r.t_max {
+                if t > r.t_max {
+                    continue;
+                }
+                if c & LEAF == 0 {
                     node = c as usize;
                     break;
+                }
+                if let Some((p, t)) = test(c & !LEAF, &r) {
+                    r.t_max = t;
+                    best = Some((p, t));
                 }
             }
         }
