@@ -2,9 +2,9 @@
 //!
 //! Layers, imports pointing down only (`docs/architecture.md` has the diagram):
 //! - [`scene`]: the RON format ([`scene::file`]) and the loader that fills the world;
-//! - [`extract`]: the one step that reads the world and builds the render data;
+//! - [`extract`](mod@extract): the one step that reads the world and builds the render data;
 //! - [`world`]: the ECS world's component types and settings;
-//! - [`render`]: the render scene, its effects, the tiled render loop, images and output;
+//! - [`render`](mod@render): the render scene, its effects, the tiled render loop, images and output;
 //! - [`shader`]: one file per shader, given the parts of the scene it reads;
 //! - [`accel`]: ray queries over the flat primitives (SIMD packets and a BVH);
 //! - [`shape`], [`material`], [`light`], [`camera`]: the closed sets, one file per variant;

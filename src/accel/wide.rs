@@ -1,4 +1,4 @@
-//! A four-wide BVH: the binary SAH tree ([`super::bvh`]) collapsed so that each node holds the
+//! A four-wide BVH: the binary SAH tree ([`super::Bvh`]) collapsed so that each node holds the
 //! boxes of up to four children in structure-of-arrays lanes, tested against a ray in one SSE
 //! pass (`glam::Vec4`), as Embree's BVH4 does. A ray then visits about half as many nodes.
 //!

@@ -9,7 +9,7 @@ use crate::shader::Shader;
 use crate::shape::ShapeKind;
 use glam::Vec3A;
 
-/// The outcome of [`derive`].
+/// The outcome of [`derive()`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Derived {
     /// The effects to simulate.
