@@ -6,9 +6,8 @@
 //! same operations in the same order (glam's `dot` and `element_sum` sum x, y, then z), with no
 //! fused multiply-add, so it accepts exactly the hits the scalar test accepts, at the same
 //! distance. The rare lanes left (an edge function exactly zero, which needs the top-left rule
-//! and the double-precision retry, or a shape that is not a triangle) go to the scalar test on
-//! the primitive itself. A ray thus reads the block alone, not the primitives, until it has a
-//! hit.
+//! and the double-precision retry, or a shape that is not a triangle) go to the scalar test: on
+//! the triangle rebuilt from the lane, or on the whole primitive kept for a lane without one.
 
 use super::Prim;
 use crate::geometry::{Ray, gamma};

@@ -8,7 +8,8 @@
 //! checked after rounding against the decoding the traversal does (`origin + q * step`, the
 //! same two operations), so a decoded box always contains the exact one: a ray can visit a few
 //! more nodes, never miss one. The slab test on the decoded boxes is
-//! [`Aabb::hit`](crate::geometry::Aabb::hit) lane by lane, with its operations in its order.
+//! [`Aabb::hit`](crate::geometry::Aabb::hit)'s, lane by lane (entry and exit sides chosen by the
+//! direction's sign), with the reciprocal direction kept finite.
 
 use super::bvh::Node;
 use crate::geometry::Ray;
@@ -17,7 +18,7 @@ use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
 /// A child reference: an interior node's index, or, when [`LEAF`] is set, a leaf's payload in
-/// the bits below it (what the builder's `leaf` function returned for it).
+/// the bits below it (its index in the leaves [`WideBvh::collapse`] returns).
 pub type ChildRef = u32;
 /// Set in a [`ChildRef`] that is a leaf.
 pub const LEAF: u32 = 1 << 31;
