@@ -3,6 +3,8 @@
 //! any-hit answer), on rays aimed at random points, vertices and edges, rays that start on a
 //! triangle of the block, and blocks that mix spheres with triangles.
 
+mod common;
+
 use glam::{Vec3, Vec3A};
 use rtis::accel::Prim;
 use rtis::accel::block::{Block, BlockRay, lane_triangle};
@@ -12,18 +14,9 @@ use rtis::sampling::Sampler;
 use rtis::sampling::warp::uniform_sphere;
 use rtis::shape::{Shape, Sphere, Triangle};
 
-/// The scalar loop the block stands for: the nearest hit, a later primitive winning at equal
-/// distance.
+/// The scalar loop the block stands for.
 fn scalar(prims: &[Prim], r: &Ray) -> Option<(u32, f32)> {
-    let mut r = *r;
-    let mut best = None;
-    for (k, p) in prims.iter().enumerate() {
-        if let Some(t) = p.shape.intersect(&r) {
-            r.t_max = t;
-            best = Some((k as u32, t));
-        }
-    }
-    best
+    common::nearest(prims, r)
 }
 
 /// Check one ray against the block of all of `prims` (at most four); returns whether it hit.

@@ -3,6 +3,8 @@
 //! of the same primitives. A wrong split still gives right images (tests/meshes.rs compares
 //! hits with brute force) but a slower tree; the SAH cost sees it without timing anything.
 
+mod common;
+
 use glam::{Vec3, Vec3A};
 use rtis::accel::{Bvh, Prim, WideBvh, wide};
 use rtis::geometry::Ray;
@@ -330,15 +332,7 @@ fn quantised_boxes_contain_their_triangles_at_every_scale() {
 /// The nearest hit among `prims[first..first + count]` by the scalar loop (a later primitive
 /// wins at equal distance).
 fn scalar_leaf(prims: &[Prim], first: usize, count: usize, r: &Ray) -> Option<(u32, f32)> {
-    let mut r = *r;
-    let mut best = None;
-    for (k, p) in prims.iter().enumerate().skip(first).take(count) {
-        if let Some(t) = p.shape.intersect(&r) {
-            r.t_max = t;
-            best = Some((k as u32, t));
-        }
-    }
-    best
+    common::nearest(&prims[first..first + count], r).map(|(k, t)| (first as u32 + k, t))
 }
 
 /// The wide tree answers every query as the binary one does: the same nearest primitive at the

@@ -9,7 +9,7 @@
 //! and the double-precision retry, or a shape that is not a triangle) go to the scalar test: on
 //! the triangle rebuilt from the lane, or on the whole primitive kept for a lane without one.
 
-use super::Prim;
+use super::prim::Prim;
 use crate::geometry::{Ray, gamma};
 use crate::shape::{Shape, Triangle};
 use glam::{Vec3A, Vec4};

@@ -5,7 +5,7 @@
 //! in depth-first order, and its `closest` and `any` traversals are the reference the wide
 //! tree is tested against.
 
-use super::Prim;
+use super::prim::Prim;
 use crate::geometry::{Aabb, Ray};
 use glam::Vec3;
 use rayon::prelude::*;

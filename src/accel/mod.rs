@@ -4,60 +4,18 @@
 pub mod block;
 mod bvh;
 pub mod lanes;
+mod prim;
 pub mod wide;
 
 pub use bvh::{Bvh, Node};
+pub use prim::{FLAT, Prim};
 pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::{Hit, Ray};
-use crate::shape::{Shape, ShapeKind, Triangle};
+use crate::shape::{Shape, ShapeKind};
 use block::{Block, BlockRay};
 use lanes::{Lanes, PlaneLanes, RayLanes, SphereLanes};
 use rayon::prelude::*;
-
-/// A shape with the index of its material.
-#[derive(Clone, Copy, Debug)]
-pub struct Prim {
-    /// Geometry.
-    pub shape: Shape,
-    /// Index into the prepared material array.
-    pub material: u32,
-    /// A smooth triangle's vertex normals, or [`FLAT`]: an index into the normals passed to
-    /// [`Geometry::build`], and in the primitives [`Geometry::prim`] returns, into
-    /// [`Geometry::normals`].
-    pub smooth: u32,
-    /// Index of the primitive's area light in the render's `Emitters`, or
-    /// [`crate::light::NO_LIGHT`].
-    pub light: u32,
-}
-
-impl Prim {
-    /// A primitive of material 0, shaded with its geometric normal, emitting nothing: the form
-    /// benchmarks and tests build geometry in.
-    pub fn flat(shape: Shape) -> Self {
-        Prim {
-            shape,
-            material: 0,
-            smooth: FLAT,
-            light: crate::light::NO_LIGHT,
-        }
-    }
-
-    /// The non-degenerate triangles of `mesh` as [`Prim::flat`] primitives, in its own
-    /// coordinates (for benchmarks and tests; scenes go through extraction).
-    pub fn flat_triangles(mesh: &crate::mesh::MeshData) -> Vec<Prim> {
-        mesh.faces
-            .iter()
-            .filter_map(|f| {
-                let [a, b, c] = f.map(|i| mesh.positions[i as usize].as_vec3a());
-                Triangle::new(a, b, c).map(|t| Prim::flat(Shape::Triangle(t)))
-            })
-            .collect()
-    }
-}
-
-/// [`Prim::smooth`] of a primitive shaded with its geometric normal.
-pub const FLAT: u32 = u32::MAX;
 
 /// Scenes with at most this many spheres test them in packets instead of a BVH.
 pub const PACKED_SPHERES: usize = 16;
@@ -209,7 +167,9 @@ impl Geometry {
         // Vertex normals move to their lane's index; a smooth primitive kept whole (a
         // triangle a lane cannot hold exactly) gets its normals appended after the lanes'.
         let mut lane_normals: Vec<[glam::Vec3A; 3]> =
-            if for_bvh.par_iter().any(|p| p.smooth != FLAT) {
+            if attrs.iter().any(|a| a.material & SMOOTH != 0)
+                || others.iter().any(|p| p.smooth != FLAT)
+            {
                 ranges
                     .par_iter()
                     .zip(&blocks)

@@ -107,3 +107,17 @@ pub fn mitsuba_reference(file: &str) -> rtis::render::film::Image {
     .unwrap_or_else(|e| panic!("{file}: {e}"))
     .flipped_horizontally()
 }
+
+/// The nearest hit among `prims` by testing each in order, a later one winning at equal
+/// distance (the loop a BVH leaf and a block stand for): its index in `prims` and distance.
+pub fn nearest(prims: &[rtis::accel::Prim], ray: &rtis::geometry::Ray) -> Option<(u32, f32)> {
+    let mut r = *ray;
+    let mut best = None;
+    for (k, p) in prims.iter().enumerate() {
+        if let Some(t) = p.shape.intersect(&r) {
+            r.t_max = t;
+            best = Some((k as u32, t));
+        }
+    }
+    best
+}
