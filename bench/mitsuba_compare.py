@@ -123,9 +123,11 @@ def main():
     with open(os.path.join(ROOT, "scenes/cornell-physical.ron")) as f:
         text = f.read()
     with tempfile.TemporaryDirectory() as d:
-        # The scene as it is (every point light at every vertex), and with one light per
-        # vertex chosen by power (Mitsuba's own strategy).
-        for label, per_vertex in [("rtis Path, all lights", "All"), ("rtis Path, one light", "One")]:
+        # The scene as it is (every point light at every vertex), with one light per vertex
+        # chosen by power (Mitsuba's own strategy), and with one chosen by its unshadowed
+        # contribution at the vertex (pbrt-v4's importance of a point light).
+        for label, per_vertex in [("rtis Path, all lights", "All"), ("rtis Path, one light", "One"),
+                                  ("rtis Path, one by importance", "Importance")]:
             scene_file = os.path.join(d, f"{per_vertex}.ron")
             with open(scene_file, "w") as f:
                 f.write(text.replace('extends: "cornell.ron"', f'extends: "{ROOT}/scenes/cornell.ron"')

@@ -510,9 +510,68 @@ fn mis_beats_both_strategies_on_veachs_scene() {
     );
 }
 
-/// One light per vertex, chosen by power among point and area lights, estimates the same
-/// direct light as summing the point lights: a floor lit by two point lights (`I cos / d^2`
-/// each) and the rectangle of the form-factor test (`kd L F`), under every light strategy.
+/// Choosing the point light by its contribution leaves only visibility to vary: on a diffuse
+/// floor that nothing shadows, under three grey point lights, every sample gives the sum
+/// `kd / pi sum_j I_j cos_j / d_j^2` whichever light it picks, so two seeds give the same image
+/// to rounding and the mean is the exact sum. Choosing by power, the same two seeds differ.
+#[test]
+fn importance_leaves_only_visibility_to_vary() {
+    let kd = 0.5f64;
+    let points = [
+        ((-0.5f64, 2.0f64, -0.5f64), 3.0f64),
+        ((-1.0, 1.5, -0.5), 1.0),
+        ((2.0, 0.5, 1.0), 6.0),
+    ];
+    let e: f64 = points
+        .iter()
+        .map(|&((px, py, pz), i)| {
+            let d2 = px * px + py * py + pz * pz;
+            i * (py / d2.sqrt()) / d2
+        })
+        .sum();
+    let want = kd / PI * e;
+    let lamps: String = points
+        .iter()
+        .map(|&((px, py, pz), i)| {
+            format!("(light: Point(position: ({px}, {py}, {pz}), intensity: ({i}, {i}, {i}))),")
+        })
+        .collect();
+    let render = |per_vertex: &str, seed: u64| {
+        render_scene(&scene(&format!(
+            "Scene(film: (width: 16, height: 16, spp: 4), seed: {seed},
+               camera: Perspective(position: (3, 1, -0.5), look_at: (0, 0, 0), fov: 0.001),
+               model: Physical, shader: Path(max_depth: 1, lights_per_vertex: {per_vertex}),
+               entities: [
+                 (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)), material: Phong(kd: ({kd}, {kd}, {kd}))),
+                 {lamps}
+               ])"
+        )))
+    };
+    // Largest relative difference between two renders' pixels (red channel).
+    let spread = |a: &rtis::render::Rendered, b: &rtis::render::Rendered| {
+        a.image
+            .pixels
+            .iter()
+            .zip(&b.image.pixels)
+            .map(|(x, y)| ((x.x - y.x).abs() / y.x.abs().max(1e-30)) as f64)
+            .fold(0.0, f64::max)
+    };
+    let (a, b) = (render("Importance", 1), render("Importance", 2));
+    let (mean, _) = mean_and_se(&a);
+    assert!(
+        (mean - want).abs() <= 1e-5 * want,
+        "{mean:.7} vs exact {want:.7}"
+    );
+    let d = spread(&a, &b);
+    assert!(d <= 1e-5, "importance: two seeds differ by {d:.2e}");
+    let d = spread(&render("One", 1), &render("One", 2));
+    assert!(d > 0.1, "by power: two seeds differ by only {d:.2e}");
+}
+
+/// One light per vertex, chosen by power among point and area lights (or the point lights by
+/// importance), estimates the same direct light as summing the point lights: a floor lit by
+/// two point lights (`I cos / d^2` each) and the rectangle of the form-factor test (`kd L F`),
+/// under every light strategy.
 #[test]
 fn one_light_per_vertex_is_unbiased() {
     let (a, b, c, l, kd) = (1.0f64, 2.0f64, 1.0f64, 2.0, 0.5);
@@ -533,6 +592,9 @@ fn one_light_per_vertex_is_unbiased() {
         "Path(max_depth: 1, lights_per_vertex: One, lights: Mis)",
         "Path(max_depth: 1, lights_per_vertex: One, lights: Light)",
         "Path(max_depth: 1, lights_per_vertex: One, lights: Brdf)",
+        "Path(max_depth: 1, lights_per_vertex: Importance, lights: Mis)",
+        "Path(max_depth: 1, lights_per_vertex: Importance, lights: Light)",
+        "Path(max_depth: 1, lights_per_vertex: Importance, lights: Brdf)",
         "Path(max_depth: 1, lights_per_vertex: All)",
     ] {
         let lamps: String = points
@@ -560,7 +622,7 @@ fn one_light_per_vertex_is_unbiased() {
         );
         // One light per vertex traces one shadow ray per camera ray; all lights, three.
         let shadow = r.stats.shadow as f64 / r.stats.camera as f64;
-        let expect = if shader.contains("One") { 1.0 } else { 3.0 };
+        let expect = if shader.contains("All") { 3.0 } else { 1.0 };
         assert!(
             shadow <= expect + 1e-9,
             "{shader}: {shadow} shadow rays per camera ray"

@@ -84,6 +84,20 @@ impl Emitters {
         Self::with_points(self.lights.clone(), points)
     }
 
+    /// The point lights' part of the choice: `(start, share)`, where `u` in [0, 1) picks a
+    /// point light exactly when `u >= start`, and `share` is their probability all together
+    /// (`(1, 0)` when they take no part).
+    pub fn point_share(&self) -> (f64, f64) {
+        if !self.with_point_lights() {
+            return (1.0, 0.0);
+        }
+        let start = match self.lights.len() {
+            0 => 0.0,
+            n => self.cdf[n - 1],
+        };
+        (start, 1.0 - start)
+    }
+
     /// Probability that [`Emitters::choose`] picks light `i`.
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {

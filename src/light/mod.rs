@@ -4,14 +4,17 @@
 //! makes the camera-relative [`Light`] that shaders use. Point lights are summed at every
 //! shading point (the course's Eq. 3). Emitting shapes ([`Emitter`]) become [`AreaLight`]s, one
 //! per primitive, gathered in [`Emitters`], which picks one per light sample in proportion to
-//! its power.
+//! its power. [`choose_by_importance`] picks one point light at a shading point in proportion
+//! to the light it could send there.
 
 mod area;
 mod emitters;
+mod importance;
 mod point;
 
 pub use area::{AreaLight, Emitter, Emitting, LightSample};
 pub use emitters::{Chosen, Emitters, NO_LIGHT};
+pub use importance::{choose_by_importance, importance};
 pub use point::PointLight;
 
 use glam::{DVec3, Vec3A};

@@ -71,6 +71,10 @@ impl Phong {
         if wi.dot(n) <= 0.0 || wo.dot(n) <= 0.0 {
             return Vec3A::ZERO;
         }
+        // A diffuse material skips the power: the specular term would add exactly 0.
+        if self.ks == Vec3A::ZERO {
+            return self.kd * (1.0 / PI);
+        }
         let cos_r = wo.dot(reflect(wi, n)).max(0.0);
         self.kd * (1.0 / PI)
             + self.ks * ((self.shininess + 2.0) / (2.0 * PI) * cos_r.powf(self.shininess))

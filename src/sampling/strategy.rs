@@ -52,7 +52,12 @@ pub enum LightsPerVertex {
     /// Every point light (one shadow ray each, the course's Eq. 3) and one area-light sample.
     #[default]
     All,
-    /// One light, point or area, chosen in proportion to its power (Mitsuba's and pbrt's
-    /// default): one shadow ray per vertex whatever the number of lights, at some more noise.
+    /// One light, point or area, chosen in proportion to its power (Mitsuba's default): one
+    /// shadow ray per vertex whatever the number of lights, at some more noise.
     One,
+    /// One light as `One` chooses it, except that the point lights' share goes to each in
+    /// proportion to its unshadowed contribution `I cos(theta) / d^2` at the vertex (as pbrt-v4's
+    /// light BVH weighs a point light): one shadow ray per vertex, and on diffuse surfaces
+    /// under grey point lights only visibility is left to vary.
+    Importance,
 }

@@ -105,7 +105,7 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
     (
         "LightsPerVertex",
         "light choice",
-        &[("All", "All"), ("One", "One")],
+        &[("All", "All"), ("One", "One"), ("Importance", "Importance")],
     ),
 ];
 

@@ -46,7 +46,8 @@ pub struct Path {
     /// How area lights are gathered (the Physical model; the Course model samples lights).
     pub lights: LightSampling,
     /// Every point light and one area-light sample per vertex, or one light of all chosen by
-    /// power (the Physical model; the Course model's Eq. 3 sums its point lights).
+    /// power or by importance (the Physical model; the Course model's Eq. 3 sums its point
+    /// lights).
     pub lights_per_vertex: LightsPerVertex,
 }
 
@@ -62,7 +63,7 @@ impl Path {
 
     /// True if one light of all is chosen per vertex under `model`.
     pub fn one_light_under(&self, model: Model) -> bool {
-        model == Model::Physical && self.lights_per_vertex == LightsPerVertex::One
+        model == Model::Physical && self.lights_per_vertex != LightsPerVertex::All
     }
 }
 
@@ -83,6 +84,7 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     let model = tr.model;
     let lights = p.lights_under(model);
     let one_light_mode = p.one_light_under(model);
+    let by_importance = p.lights_per_vertex == LightsPerVertex::Importance;
     let max_depth = p.max_depth.unwrap_or(MAX_DEPTH).min(MAX_DEPTH);
     let mut l = Vec3A::ZERO;
     let mut beta = Vec3A::ONE;
@@ -127,9 +129,10 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                     (lights == LightSampling::Mis && tr.effects.indirect).then_some(p.sampling);
                 let sample_area = lights != LightSampling::Brdf || !tr.effects.indirect;
                 if one_light_mode {
-                    // One light of all, chosen by power. Under `Brdf` the area lights are
-                    // left to the sampled rays, and a chosen area light adds nothing.
-                    l += beta * one_light(tr, &si, &phong, mis, sample_area);
+                    // One light of all, chosen by power (point lights by importance under
+                    // `Importance`). Under `Brdf` the area lights are left to the sampled rays,
+                    // and a chosen area light adds nothing.
+                    l += beta * one_light(tr, &si, &phong, mis, sample_area, by_importance);
                 } else {
                     l += beta * point_lights(tr, &si, &phong);
                     if sample_area {

@@ -6,7 +6,7 @@
 use super::Tracer;
 use crate::effects::Effects;
 use crate::geometry::{Hit, Origins, Ray};
-use crate::light::{AreaLight, Chosen, Light, NO_LIGHT};
+use crate::light::{AreaLight, Chosen, Light, NO_LIGHT, choose_by_importance};
 use crate::material::{Material, Model, Phong, reflect};
 use crate::sampling::{Sampling, hemisphere, power_heuristic};
 use crate::stats::RayKind;
@@ -155,7 +155,9 @@ pub fn area_lights(
 
 /// One light of all, point or area, chosen in proportion to its power and divided by the
 /// chance of choosing it (the path tracer's `lights_per_vertex: One`): one shadow ray. With
-/// `area` false a chosen area light adds nothing (BRDF-sampled rays gather area lights).
+/// `area` false a chosen area light adds nothing (BRDF-sampled rays gather area lights). With
+/// `by_importance` (`lights_per_vertex: Importance`) the point lights' share of the choice goes
+/// to each in proportion to its unshadowed contribution at the vertex instead.
 #[inline]
 pub fn one_light(
     tr: &mut Tracer,
@@ -163,6 +165,7 @@ pub fn one_light(
     phong: &Phong,
     mis: Option<Sampling>,
     area: bool,
+    by_importance: bool,
 ) -> Vec3A {
     if phong.is_black() {
         return Vec3A::ZERO;
@@ -170,6 +173,17 @@ pub fn one_light(
     let u = tr.sampler.next_f64();
     let (u1, u2) = tr.sampler.next_2d();
     match tr.emitters.choose_any(u) {
+        Some(Chosen::Point(..)) if by_importance => {
+            // The point lights' share, spent again on their contributions here: u's place
+            // within the share picks the light.
+            let (start, share) = tr.emitters.point_share();
+            let v = ((u - start) / share).clamp(0.0, 1.0 - f64::EPSILON / 2.0);
+            let lights = tr.lights;
+            let Some((j, p)) = choose_by_importance(lights, si.hit.p, si.n, v) else {
+                return Vec3A::ZERO;
+            };
+            point_light(tr, si, phong, &lights[j]) * (1.0 / (share * p)) as f32
+        }
         Some(Chosen::Point(j, pmf)) => {
             let light = tr.lights[j];
             point_light(tr, si, phong, &light) / pmf
@@ -235,6 +249,10 @@ pub fn brdf_pdf(phong: &Phong, wo: Vec3A, n: Vec3A, wi: Vec3A, sampling: Samplin
         Sampling::Cosine => hemisphere::cosine_pdf(cos_i),
         Sampling::Brdf => {
             let pd = diffuse_probability(phong);
+            // A diffuse material skips the lobe: its share would add exactly 0.
+            if pd == 1.0 {
+                return cos_i / PI;
+            }
             let cos_a = wi.dot(reflect(wo, n));
             pd * cos_i / PI + (1.0 - pd) * hemisphere::phong_lobe_pdf(cos_a, phong.shininess)
         }

@@ -1,0 +1,163 @@
+//! Choosing one point light at a shading point in proportion to the light it could send there.
+//!
+//! The path tracer's `lights_per_vertex: Importance` picks its point light this way: light `j`
+//! is chosen with probability `w_j / sum_k w_k`, where `w_j = I_j cos(theta_j) / d_j^2` is its
+//! unshadowed irradiance at the point (`I_j` the largest channel of its intensity, `theta_j`
+//! the angle between the normal and the direction to the light, zero below the surface). This
+//! is the importance pbrt-v4's light BVH gives a point light. On a diffuse surface lit by grey
+//! lights, the estimate `L_j f cos / P(j)` is then the same for every choice: only visibility
+//! is left to vary.
+
+use super::Light;
+use glam::Vec3A;
+
+/// The unshadowed irradiance `I cos(theta) / d^2` that `light` sends to `p` across the unit
+/// normal `n`, with `I` its largest channel, in double precision (finite for every finite
+/// input: `I <= f32::MAX` and `d^2 >= 2^-149`). Zero when the light is below the surface or
+/// coincides with `p`, exactly when [`Light::incident`] gives no light facing `n`.
+#[inline]
+pub fn importance(light: &Light, p: Vec3A, n: Vec3A) -> f64 {
+    let Some(inc) = light.incident(p) else {
+        return 0.0;
+    };
+    // The same cosine the light's term tests, so that a light with a term has a weight.
+    let cos = inc.wi.dot(n);
+    if cos <= 0.0 {
+        return 0.0;
+    }
+    let i_max = match light {
+        Light::Point(l) => l.intensity.max_element(),
+    };
+    let d = f64::from(inc.dist);
+    f64::from(i_max.max(0.0)) * f64::from(cos) / (d * d)
+}
+
+/// How many lights' weights [`choose_by_importance`] keeps between its two passes; the weights
+/// of any further lights are computed twice.
+const CACHED: usize = 16;
+
+/// The point light that `u`, uniform in [0, 1), picks among `lights` at `p` with normal `n`,
+/// each in proportion to its [`importance`], with the probability of picking it; `None` when
+/// no light has any importance there (none lights the point).
+#[inline]
+pub fn choose_by_importance(lights: &[Light], p: Vec3A, n: Vec3A, u: f64) -> Option<(usize, f64)> {
+    // Total importance, keeping the first lights' weights for the second pass.
+    let mut cached = [0.0f64; CACHED];
+    let mut total = 0.0;
+    for (j, light) in lights.iter().enumerate() {
+        let w = importance(light, p, n);
+        if let Some(c) = cached.get_mut(j) {
+            *c = w;
+        }
+        total += w;
+    }
+    if total <= 0.0 {
+        return None;
+    }
+    let target = u * total;
+    let mut acc = 0.0;
+    let mut last = None;
+    // The first light whose cumulative share exceeds u.
+    for (j, light) in lights.iter().enumerate() {
+        let w = match cached.get(j) {
+            Some(&w) => w,
+            None => importance(light, p, n),
+        };
+        if w <= 0.0 {
+            continue;
+        }
+        acc += w;
+        last = Some((j, w / total));
+        if target < acc {
+            break;
+        }
+    }
+    // Rounding can leave u * total at or above the sum: the last light of weight then takes it.
+    last
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::PointLight;
+
+    fn point(x: f32, y: f32, z: f32, i: f32) -> Light {
+        Light::Point(PointLight {
+            position: Vec3A::new(x, y, z),
+            intensity: Vec3A::new(i, 0.5 * i, 0.25 * i),
+        })
+    }
+
+    /// On a grid of `u`, each light is chosen as often as its probability says, to within one
+    /// grid step, and the probability returned is its importance over the total.
+    #[test]
+    fn choice_follows_importance() {
+        let lights = [
+            point(0.0, 1.0, 0.0, 2.0),
+            point(3.0, 1.0, 0.0, 5.0),
+            point(0.0, -1.0, 0.0, 9.0), // below the surface: never chosen
+            point(-1.0, 0.5, 2.0, 0.5),
+        ];
+        let (p, n) = (Vec3A::ZERO, Vec3A::Y);
+        let w: Vec<f64> = lights.iter().map(|l| importance(l, p, n)).collect();
+        let total: f64 = w.iter().sum();
+        assert_eq!(w[2], 0.0);
+        // Light 0: I = 2, d = 1, cos = 1.
+        assert!((w[0] - 2.0).abs() < 1e-6, "{}", w[0]);
+        let steps = 100_000;
+        let mut counts = [0usize; 4];
+        for k in 0..steps {
+            let u = (k as f64 + 0.5) / steps as f64;
+            let (j, pmf) = choose_by_importance(&lights, p, n, u).unwrap();
+            assert_eq!(pmf, w[j] / total);
+            counts[j] += 1;
+        }
+        for j in 0..4 {
+            let want = w[j] / total * steps as f64;
+            assert!(
+                (counts[j] as f64 - want).abs() <= 1.0,
+                "light {j}: {} of {steps}, want {want:.1}",
+                counts[j]
+            );
+        }
+    }
+
+    /// No light above the surface, or none at all: nothing to choose. A light at the point
+    /// itself has no direction and no weight.
+    #[test]
+    fn nothing_to_choose() {
+        let below = [point(0.0, -1.0, 0.0, 1.0), point(0.0, 0.0, 0.0, 1.0)];
+        assert_eq!(
+            choose_by_importance(&below, Vec3A::ZERO, Vec3A::Y, 0.3),
+            None
+        );
+        assert_eq!(choose_by_importance(&[], Vec3A::ZERO, Vec3A::Y, 0.3), None);
+        // The largest u below 1 still picks a light.
+        let one = [point(0.0, 1.0, 0.0, 1.0), point(0.0, 2.0, 0.0, 1.0)];
+        let u = 1.0 - f64::EPSILON / 2.0;
+        assert_eq!(
+            choose_by_importance(&one, Vec3A::ZERO, Vec3A::Y, u).map(|c| c.0),
+            Some(1)
+        );
+    }
+
+    /// Extreme but valid inputs keep finite weights: the brightest light a scene may hold at
+    /// the smallest distance, and the faintest at the largest.
+    #[test]
+    fn extreme_weights_stay_finite() {
+        let near = Light::Point(PointLight {
+            position: Vec3A::new(0.0, 1e-20, 0.0),
+            intensity: Vec3A::splat(f32::MAX),
+        });
+        let far = Light::Point(PointLight {
+            position: Vec3A::new(0.0, 1e18, 0.0),
+            intensity: Vec3A::splat(f32::MIN_POSITIVE),
+        });
+        for l in [near, far] {
+            let w = importance(&l, Vec3A::ZERO, Vec3A::Y);
+            assert!(w.is_finite() && w > 0.0, "{w}");
+        }
+        let (j, pmf) = choose_by_importance(&[near, far], Vec3A::ZERO, Vec3A::Y, 0.5).unwrap();
+        assert_eq!((j, pmf), (0, 1.0));
+    }
+}
