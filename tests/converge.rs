@@ -175,3 +175,49 @@ fn base64_matches_the_standard() {
     assert_eq!(base64(b"foo"), "Zm9v");
     assert_eq!(base64(b"foobar"), "Zm9vYmFy");
 }
+
+/// Under the Physical model with several point lights and no emitter, a Path scene gets one
+/// curve per light choice. At equal spp, choosing the light by importance has well under the
+/// error of choosing it by power: on a floor under three lights at different distances, with
+/// a sphere's shadow, only visibility is left to vary once the light is chosen by importance.
+#[test]
+fn light_choice_curves_for_point_lit_path_scenes() {
+    let s = rtis::extract(&scene(
+        "Scene(film: (width: 24, height: 20), model: Physical, shader: Path(max_depth: 2),
+           camera: Perspective(position: (0, 4, -4), look_at: (0, 0, 0), fov: 60),
+           entities: [
+             (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)), material: Phong(kd: (0.7, 0.7, 0.7))),
+             (shape: Sphere(center: (0, 0.7, 0), radius: 0.7), material: Phong(kd: (0.5, 0.5, 0.5))),
+             (light: Point(position: (-1.5, 1.5, 0.5), intensity: (2, 2, 2))),
+             (light: Point(position: (1, 3, -1), intensity: (6, 6, 6))),
+             (light: Point(position: (4, 6, 5), intensity: (40, 40, 40))),
+           ])",
+    ));
+    let rungs = converge::ladder(&s);
+    let families: Vec<&str> = rungs.iter().map(|r| r.family.as_str()).collect();
+    for f in ["Path all lights", "Path one light", "Path by importance"] {
+        assert_eq!(families.iter().filter(|&&x| x == f).count(), 5, "{f}");
+    }
+    assert_eq!(rungs.len(), 3 * 5 + 4);
+    let reference = render(
+        &converge::with_settings(&s, converge::reference_shader(), 1024),
+        &|| {},
+    )
+    .image;
+    let at_16: Vec<converge::Rung> = rungs
+        .into_iter()
+        .filter(|r| r.label == "spp=16" && r.family != "Path 16 spp")
+        .collect();
+    let rows: Vec<converge::Row> = converge::sweep(&s, &reference, 0.0, &at_16, 1, 4, &mut |_| {})
+        .into_iter()
+        .map(|m| m.row)
+        .collect();
+    let err = |fam: &str| rows.iter().find(|r| r.family == fam).unwrap().rmse;
+    let (all, one, importance) = (
+        err("Path all lights"),
+        err("Path one light"),
+        err("Path by importance"),
+    );
+    eprintln!("RMSE at 16 spp: all {all:.5}, one {one:.5}, importance {importance:.5}");
+    assert!(importance < 0.5 * one, "{rows:#?}");
+}

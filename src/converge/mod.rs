@@ -69,7 +69,9 @@ pub fn reference_shader() -> Shader {
 /// D in {1, 2, 3}, then the Path tracer of the same model at growing spp (the unbiased curve the
 /// Global shader approximates). A Path scene gets spp and max-depth ladders; with area lights
 /// under the Physical model, one spp ladder per light strategy (MIS, light sampling only, BRDF
-/// sampling only), so that the plot shows what MIS buys.
+/// sampling only), so that the plot shows what MIS buys; with point lights only, two or more of
+/// them, under the Physical model, one spp ladder per light choice (every light at every
+/// vertex, one by power, one by importance), so that the plot shows what each choice costs.
 pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
     let mut rungs = Vec::new();
     let rung = |family: &str, label: String, shader, spp| Rung {
@@ -80,19 +82,33 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
     };
     match scene.shader {
         Shader::Path(p) => {
-            let strategies = if scene.effects.emission && scene.model == Model::Physical {
+            let physical = scene.model == Model::Physical;
+            let lights = |lights| Path { lights, ..p };
+            let per_vertex = |lights_per_vertex| Path {
+                lights_per_vertex,
+                ..p
+            };
+            let curves = if scene.effects.emission && physical {
                 vec![
-                    ("Path MIS", LightSampling::Mis),
-                    ("Path light", LightSampling::Light),
-                    ("Path BRDF", LightSampling::Brdf),
+                    ("Path MIS", lights(LightSampling::Mis)),
+                    ("Path light", lights(LightSampling::Light)),
+                    ("Path BRDF", lights(LightSampling::Brdf)),
+                ]
+            } else if physical && scene.lights.len() > 1 {
+                vec![
+                    ("Path all lights", per_vertex(LightsPerVertex::All)),
+                    ("Path one light", per_vertex(LightsPerVertex::One)),
+                    (
+                        "Path by importance",
+                        per_vertex(LightsPerVertex::Importance),
+                    ),
                 ]
             } else {
-                vec![("Path", p.lights)]
+                vec![("Path", p)]
             };
-            for (family, lights) in strategies {
+            for (family, path) in curves {
                 for spp in [1, 4, 16, 64, 256] {
-                    let shader = Shader::Path(Path { lights, ..p });
-                    rungs.push(rung(family, format!("spp={spp}"), shader, spp));
+                    rungs.push(rung(family, format!("spp={spp}"), Shader::Path(path), spp));
                 }
             }
             for d in [1, 2, 3, 5] {
