@@ -349,7 +349,7 @@ fn wide_tree_finds_what_the_binary_tree_finds() {
     let (mut hits, mut blocked) = (0, 0);
     for r in rays(20_000, 3) {
         let expect = g.bvh.closest(&g.prims, &r);
-        assert_eq!(wide.closest(&r, leaf), expect, "{r:?}");
+        assert_eq!(wide.closest(&r, leaf, |_| {}), expect, "{r:?}");
         let occluded = g.bvh.any(&g.prims, &r);
         assert_eq!(wide.any(&r, any), occluded, "{r:?}");
         hits += expect.is_some() as usize;
@@ -372,11 +372,15 @@ fn small_wide_trees() {
     assert_eq!(wide.nodes[0].child[1..], [wide::EMPTY; 3]);
     assert_eq!(ranges, [(0, 3)], "the one leaf holds all three");
     let down = Ray::new(Vec3A::new(0.2, 0.2, 1.0), -Vec3A::Z);
-    let hit = wide.closest(&down, |b, _| Some((b, 1.0)));
+    let hit = wide.closest(&down, |b, _| Some((b, 1.0)), |_| {});
     assert_eq!(hit, Some((0, 1.0)));
     let (empty, no_leaves) = WideBvh::collapse(&[]);
     assert!(no_leaves.is_empty());
-    assert!(empty.closest(&down, |_, _| Some((0, 1.0))).is_none());
+    assert!(
+        empty
+            .closest(&down, |_, _| Some((0, 1.0)), |_| {})
+            .is_none()
+    );
     assert!(!empty.any(&down, |_, _| true));
 }
 
@@ -410,7 +414,7 @@ fn axis_parallel_rays_on_box_sides_agree() {
                 let r = Ray::new(o, Vec3A::new(0.0, 0.0, dz));
                 let expect = scalar_leaf(&g.prims, 0, g.prims.len(), &r);
                 assert_eq!(g.bvh.closest(&g.prims, &r), expect, "{r:?}");
-                assert_eq!(wide.closest(&r, leaf), expect, "{r:?}");
+                assert_eq!(wide.closest(&r, leaf, |_| {}), expect, "{r:?}");
                 assert_eq!(wide.any(&r, |b, r| leaf(b, r).is_some()), expect.is_some());
                 hits += expect.is_some() as usize;
             }

@@ -310,7 +310,8 @@ impl Geometry {
                 let hit = self.blocks[b as usize].closest(&self.others, &br, r);
                 hit.map(|(lane, t)| (4 * b + lane, t))
             };
-            if let Some((i, t)) = self.bvh.closest(&r, leaf) {
+            let touch = |b: u32| wide::prefetch(&self.blocks[b as usize]);
+            if let Some((i, t)) = self.bvh.closest(&r, leaf, touch) {
                 t_max = t;
                 best = Some(i);
             }

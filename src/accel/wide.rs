@@ -118,6 +118,26 @@ pub struct WideBvh {
     pub nodes: Vec<WideNode>,
 }
 
+/// Ask the CPU to bring every cache line of `x` into its caches, so that a miss on it overlaps
+/// with the work done before it is read. Does nothing where no prefetch instruction is known.
+#[inline(always)]
+pub fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let p = x as *const T as *const i8;
+        let mut off = 0;
+        while off < std::mem::size_of::<T>() {
+            // SAFETY: a prefetch is a hint: it never faults and changes no state the program
+            // can observe, and `p + off` lies within `x`.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(off)) };
+            off += 64;
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
 /// A ray splatted across the four lanes of a node test.
 #[derive(Clone, Copy)]
 struct RayBox {
@@ -229,11 +249,18 @@ impl WideBvh {
 
     /// Nearest primitive hit: its index and distance. `test(leaf, ray)` is the nearest hit in
     /// `(0, ray.t_max]` among the primitives of the leaf with payload `leaf`.
+    ///
+    /// Every child whose box the ray enters is prefetched as soon as the node test finds it:
+    /// interior nodes here, leaves by `touch(leaf)` (which [`prefetch`]es the leaf's data, or
+    /// does nothing), so that the cache misses of an incoherent ray overlap instead of
+    /// following one another. Any-hit traversal ([`WideBvh::any`]) does not prefetch: it
+    /// measured no faster with it.
     #[inline]
     pub fn closest(
         &self,
         ray: &Ray,
         mut test: impl FnMut(u32, &Ray) -> Option<(u32, f32)>,
+        touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
         if self.nodes.is_empty() {
             return None;
@@ -254,6 +281,12 @@ impl WideBvh {
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
+                let c = n.child[i];
+                if c & LEAF == 0 {
+                    prefetch(&self.nodes[c as usize]);
+                } else {
+                    touch(c & !LEAF);
+                }
                 let mut j = k;
                 while j > 0 && next[j - 1].1 < near[i] {
                     next[j] = next[j - 1];
