@@ -366,9 +366,33 @@ fn compact(sparse: &[Node]) -> Vec<Node> {
     out
 }
 
+/// The bin of centroid coordinate `c` on `BINS` bins from `lo`, `scale` bins per unit: the
+/// floor of `(c - lo) scale`, at most `BINS - 1`, and 0 for NaN (`0 * inf` on a one-ulp-wide
+/// range), as `(x as usize).min(BINS - 1)` gives it.
 #[inline]
 fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
-    (((c - lo) * scale) as usize).min(BINS - 1)
+    let x = (c - lo) * scale;
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{
+            _mm_cvttss_si32, _mm_max_ss, _mm_min_ss, _mm_set_ss, _mm_setzero_ps,
+        };
+        // `maxss` returns its second operand when either is NaN, so NaN becomes 0 and the value
+        // is clamped to [0, BINS - 1] before the truncation: three instructions where Rust's
+        // saturating `as usize` takes a dozen, a fifth of the build's binning time.
+        // SAFETY: SSE2 is in the x86-64 baseline; these intrinsics only compute on registers.
+        unsafe {
+            let clamped = _mm_min_ss(
+                _mm_max_ss(_mm_set_ss(x), _mm_setzero_ps()),
+                _mm_set_ss((BINS - 1) as f32),
+            );
+            _mm_cvttss_si32(clamped) as usize
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        (x as usize).min(BINS - 1)
+    }
 }
 
 /// Boxes of a set of items and of their centroids.
@@ -446,4 +470,41 @@ fn partition(v: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
         }
     }
     i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fast bin index equals the saturating conversion it replaces on every kind of value:
+    /// NaN, infinities, signed zeros, negatives, bin edges and their neighbours, and a sweep.
+    #[test]
+    fn bin_of_matches_saturating_conversion() {
+        let reference = |x: f32| (x as usize).min(BINS - 1);
+        let mut xs = vec![
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0,
+            -0.0,
+            -1.0,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+            1e-45,
+            4e9,
+            2f32.powi(31),
+            2f32.powi(63),
+        ];
+        for b in 0..=BINS + 1 {
+            let e = b as f32;
+            xs.extend([e, e.next_down(), e.next_up()]);
+        }
+        xs.extend((0..100_000).map(|k| k as f32 * 0.000_17 - 0.5));
+        for x in xs {
+            // bin_of computes (c - lo) * scale: with lo = 0 and scale = 1 that is x itself.
+            assert_eq!(bin_of(x, 0.0, 1.0), reference(x), "{x}");
+        }
+        // 0 * inf: a centroid at the low end of a range too thin for its scale.
+        assert_eq!(bin_of(1.0, 1.0, f32::INFINITY), reference(f32::NAN));
+    }
 }
