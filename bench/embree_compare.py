@@ -20,7 +20,8 @@ and size, then one line of ratios:
 
 The temporary folder is removed at the end.
 
-How each engine is measured:
+How each engine is measured (every time on both sides is the median of --runs, default 5,
+builds or ray passes: on a shared machine single timings vary by tens of percent):
 
 - build_s. rtis: its BVH build (rayon, --threads threads), from triangles already set up.
   Embree: the scene commit, i.e. its BVH build, which runs on TBB's worker pool over all the
@@ -59,7 +60,7 @@ release binary must exist: `cargo build --release`.
 
 Usage:
     python3 bench/embree_compare.py [--triangles 10000,100000,1000000] [--threads T[,U...]]
-                                    [--rtis target/release/rtis]
+                                    [--runs 5] [--rtis target/release/rtis]
 """
 
 import argparse
@@ -141,9 +142,10 @@ def resident_bytes():
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 
-def run_rtis(rtis, sizes, threads, dump):
-    """rtis's JSON rows for `sizes`, in order, traced on `threads` threads; dumps into `dump`."""
-    cmd = [rtis, "bench", "--section", "meshes", "--json",
+def run_rtis(rtis, sizes, threads, dump, runs):
+    """rtis's JSON rows for `sizes`, in order, traced on `threads` threads, each figure the
+    median of `runs` builds and passes; dumps into `dump`."""
+    cmd = [rtis, "bench", "--section", "meshes", "--json", "--runs", str(runs),
            "--triangles", ",".join(map(str, sizes))]
     if dump:
         cmd += ["--dump", dump]
@@ -201,17 +203,22 @@ def main():
     p.add_argument("--threads", type=positive_ints, default=None, metavar="T[,U...]",
                    help="ray-tracing threads for both engines, one run per count "
                    f"(default: all available, here {available_threads()})")
+    p.add_argument("--runs", type=int, default=5,
+                   help="builds and ray passes per engine and mesh; each figure is their median "
+                   "(default 5: on a shared machine single timings vary by tens of percent)")
     p.add_argument("--rtis", default=os.path.join(ROOT, "target", "release", "rtis"),
                    help="rtis binary (default target/release/rtis)")
     # Internal: measure Embree on one dumped mesh in this (fresh) process; see embree_worker.
-    p.add_argument("--embree-worker", nargs=3, metavar=("DIR", "N", "THREADS"),
+    p.add_argument("--embree-worker", nargs=4, metavar=("DIR", "N", "THREADS", "RUNS"),
                    help=argparse.SUPPRESS)
     a = p.parse_args()
     if a.embree_worker:
         ensure_deps()
-        dump, n, threads = a.embree_worker
-        print(json.dumps(embree_worker(dump, int(n), int(threads))))
+        dump, n, threads, runs = a.embree_worker
+        print(json.dumps(embree_worker(dump, int(n), int(threads), int(runs))))
         return
+    if a.runs < 1:
+        fail(f"--runs must be at least 1, not {a.runs}")
     if not (os.path.isfile(a.rtis) and os.access(a.rtis, os.X_OK)):
         fail(f"no rtis binary at {a.rtis}: run `cargo build --release` first, or pass --rtis")
     ensure_deps()
@@ -219,16 +226,16 @@ def main():
     sizes = list(dict.fromkeys(a.triangles))
     with tempfile.TemporaryDirectory(prefix="rtis-embree-") as dump:
         for t_index, threads in enumerate(threads_list):
-            rtis_rows = run_rtis(a.rtis, sizes, threads, dump if t_index == 0 else None)
+            rtis_rows = run_rtis(a.rtis, sizes, threads, dump if t_index == 0 else None, a.runs)
             for n, r in zip(sizes, rtis_rows):
-                compare(n, r, run_worker(dump, n, threads))
+                compare(n, r, run_worker(dump, n, threads, a.runs))
 
 
-def run_worker(dump, n, threads):
+def run_worker(dump, n, threads, runs):
     """Embree's row for mesh-N, measured in a child process so its memory baseline is clean
     (no pages left by an earlier scene for this one to reuse)."""
     cmd = [sys.executable, os.path.abspath(__file__), "--embree-worker", dump, str(n),
-           str(threads)]
+           str(threads), str(runs)]
     r = subprocess.run(cmd, stdout=subprocess.PIPE, text=True)
     if r.returncode != 0:
         fail(f"the Embree measurement of mesh-{n} failed (exit status {r.returncode})")
@@ -268,8 +275,9 @@ def compare(n, r, e):
     }), flush=True)
 
 
-def embree_worker(dump, n, threads):
-    """Embree's row for mesh-N of `dump`, on `threads` query threads, in this process."""
+def embree_worker(dump, n, threads, runs):
+    """Embree's row for mesh-N of `dump`, on `threads` query threads, in this process, each
+    figure the median of `runs`."""
     import embreex
     import numpy as np
     from concurrent.futures import ThreadPoolExecutor
@@ -287,7 +295,7 @@ def embree_worker(dump, n, threads):
     vertices, faces, rays = load(dump, n)
     with ThreadPoolExecutor(max_workers=threads) as pool:
         pool.submit(int).result()  # start a worker before any timing
-        row = measure_embree(device, vertices, faces, rays, threads, pool)
+        row = measure_embree(device, vertices, faces, rays, threads, pool, runs)
     row.update({
         "embree_version": repr(device).split(":")[-1].strip(),  # "Embree version:  4.4.0"
         "embreex_version": embreex.__version__,
@@ -298,8 +306,15 @@ def embree_worker(dump, n, threads):
     return row
 
 
-def measure_embree(device, vertices, faces, rays, threads, pool):
-    """Embree's figures for one mesh: build, memory, both ray sets on `threads` threads."""
+def median(values):
+    """The middle value (the upper one of the two middle values for an even count, as rtis
+    bench takes it)."""
+    return sorted(values)[len(values) // 2]
+
+
+def measure_embree(device, vertices, faces, rays, threads, pool, runs):
+    """Embree's figures for one mesh: build, memory, both ray sets on `threads` threads;
+    times are medians of `runs` builds and passes."""
     import numpy as np
     from embreex import rtcore_scene as rtcs
     from embreex.mesh_construction import TriangleMesh
@@ -311,10 +326,10 @@ def measure_embree(device, vertices, faces, rays, threads, pool):
     # MEMORY_BUILDS times, all kept alive (so none reuses another's freed pages), and the largest
     # growth is kept: a build can land partly in pages already resident (a single reading at 10k
     # triangles, under 1 MB, is now and then a third to a half low), never the other way, and
-    # the readings agree to a few percent otherwise. build_s is the first build's, as rtis's is
-    # its only build.
+    # the readings agree to a few percent otherwise. build_s is the median of max(runs, 3)
+    # builds' times, as rtis's is the median of its `runs` builds.
     scenes, builds, grown, mesh_bytes = [], [], [], []
-    for _ in range(MEMORY_BUILDS):
+    for _ in range(max(MEMORY_BUILDS, runs)):
         trim_heap()
         before = resident_bytes()
         start = time.perf_counter()
@@ -333,17 +348,21 @@ def measure_embree(device, vertices, faces, rays, threads, pool):
     for kind in ("incoherent", "coherent"):
         o, d = rays[kind]
         chunks = [(o[i:i + CHUNK], d[i:i + CHUNK]) for i in range(0, len(o), CHUNK)]
-        t0 = time.perf_counter()
-        # run() releases the GIL around its rtcIntersect1 loop, so the chunks run in parallel.
-        ids = list(pool.map(lambda c: scene.run(c[0], c[1], query="INTERSECT"), chunks))
-        mrays[kind] = len(o) / (time.perf_counter() - t0) / 1e6
+        rates = []
+        for _ in range(runs):
+            t0 = time.perf_counter()
+            # run() releases the GIL around its rtcIntersect1 loop, so the chunks run in
+            # parallel.
+            ids = list(pool.map(lambda c: scene.run(c[0], c[1], query="INTERSECT"), chunks))
+            rates.append(len(o) / (time.perf_counter() - t0) / 1e6)
+        mrays[kind] = median(rates)
         hits[kind] = int(sum(int(np.count_nonzero(i != -1)) for i in ids))
     del scene, scenes
     return {
         "engine": "embree",
         "triangles": len(faces),
         "threads": threads,
-        "build_s": builds[0][1],
+        "build_s": median([b[1] for b in builds]),
         "bytes_per_triangle": max(grown) / len(faces),
         "incoherent_mrays": mrays["incoherent"],
         "coherent_mrays": mrays["coherent"],
@@ -351,7 +370,7 @@ def measure_embree(device, vertices, faces, rays, threads, pool):
         "incoherent_hits": hits["incoherent"],
         # TBB's default pool: every hardware thread of the process's affinity mask.
         "build_threads": available_threads(),
-        "mesh_copy_s": builds[0][0],
+        "mesh_copy_s": median([b[0] for b in builds]),
         "mesh_bytes_per_triangle": max(mesh_bytes) / len(faces),
         "bytes_per_triangle_builds": [round(g / len(faces), 1) for g in grown],
     }
