@@ -274,6 +274,19 @@ impl WideBvh {
         loop {
             let n = &self.nodes[node];
             let (near, mut mask) = n.hit(&rb, r.t_max);
+            // One child entered (the common case for coherent rays): no ordering to do.
+            if mask != 0 && mask & (mask - 1) == 0 {
+                let c = n.child[mask.trailing_zeros() as usize];
+                if c & LEAF == 0 {
+                    node = c as usize;
+                    continue;
+                }
+                if let Some((p, t)) = test(c & !LEAF, &r) {
+                    r.t_max = t;
+                    best = Some((p, t));
+                }
+                mask = 0;
+            }
             let near = near.to_array();
             // The hit children, farthest first (insertion into at most four).
             let mut next: [(u32, f32); 4] = [(0, 0.0); 4];
