@@ -17,19 +17,19 @@ use glam::Vec3A;
 /// coincides with `p`, exactly when [`Light::incident`] gives no light facing `n`.
 #[inline]
 pub fn importance(light: &Light, p: Vec3A, n: Vec3A) -> f64 {
-    let Some(inc) = light.incident(p) else {
-        return 0.0;
+    let (position, i_max) = match light {
+        Light::Point(l) => (l.position, l.intensity.max_element()),
     };
-    // The same cosine the light's term tests, so that a light with a term has a weight.
-    let cos = inc.wi.dot(n);
-    if cos <= 0.0 {
-        return 0.0;
-    }
-    let i_max = match light {
-        Light::Point(l) => l.intensity.max_element(),
-    };
-    let d = f64::from(inc.dist);
-    f64::from(i_max.max(0.0)) * f64::from(cos) / (d * d)
+    // The direction and cosine exactly as `Light::incident` and the light's term compute them,
+    // so that a light with a term has a weight. Computed whatever the case and then selected:
+    // whether a light is above the surface varies from vertex to vertex, and a branch on it
+    // would be mispredicted.
+    let to = position - p;
+    let d2 = to.length_squared();
+    let cos = (to / d2.sqrt()).dot(n);
+    let lit = d2 != 0.0 && d2.is_finite() && cos > 0.0;
+    let w = f64::from(i_max.max(0.0)) * f64::from(cos) / f64::from(d2);
+    if lit { w } else { 0.0 }
 }
 
 /// How many lights' weights [`choose_by_importance`] keeps between its two passes; the weights
@@ -44,9 +44,9 @@ pub fn choose_by_importance(lights: &[Light], p: Vec3A, n: Vec3A, u: f64) -> Opt
     // Total importance, keeping the first lights' weights for the second pass.
     let mut cached = [0.0f64; CACHED];
     let mut total = 0.0;
-    for (j, light) in lights.iter().enumerate() {
+    for (k, light) in lights.iter().enumerate() {
         let w = importance(light, p, n);
-        if let Some(c) = cached.get_mut(j) {
+        if let Some(c) = cached.get_mut(k) {
             *c = w;
         }
         total += w;
@@ -54,26 +54,25 @@ pub fn choose_by_importance(lights: &[Light], p: Vec3A, n: Vec3A, u: f64) -> Opt
     if total <= 0.0 {
         return None;
     }
+    let weight = |k: usize| match cached.get(k) {
+        Some(&w) => w,
+        None => importance(&lights[k], p, n),
+    };
+    // The first light whose cumulative weight exceeds u * total: the number of lights whose
+    // cumulative weight does not (a prefix, as the sums never decrease), counted without a
+    // branch on the data. A light of weight 0 adds nothing to the sum, so it is never first.
     let target = u * total;
     let mut acc = 0.0;
-    let mut last = None;
-    // The first light whose cumulative share exceeds u.
-    for (j, light) in lights.iter().enumerate() {
-        let w = match cached.get(j) {
-            Some(&w) => w,
-            None => importance(light, p, n),
-        };
-        if w <= 0.0 {
-            continue;
-        }
-        acc += w;
-        last = Some((j, w / total));
-        if target < acc {
-            break;
-        }
+    let mut j = 0;
+    for k in 0..lights.len() {
+        acc += weight(k);
+        j += usize::from(acc <= target);
     }
-    // Rounding can leave u * total at or above the sum: the last light of weight then takes it.
-    last
+    // Rounding can leave u * total at or above the sum: the last light of weight takes it.
+    if j == lights.len() {
+        j = (0..lights.len()).rev().find(|&k| weight(k) > 0.0)?;
+    }
+    Some((j, weight(j) / total))
 }
 
 #[cfg(test)]
