@@ -5,6 +5,10 @@ mod cli;
 use clap::Parser;
 use std::process::ExitCode;
 
+/// The system allocator, with huge pages for large blocks (`cli/allocator.rs`).
+#[global_allocator]
+static ALLOCATOR: cli::allocator::HugePages = cli::allocator::HugePages;
+
 fn main() -> ExitCode {
     // Like every Unix filter: a closed pipe (`rtis bench | head`) ends the process quietly
     // instead of making each print fail.

@@ -1,5 +1,6 @@
 //! Subcommands of the `rtis` binary.
 
+pub mod allocator;
 mod bench;
 mod check;
 mod converge;
