@@ -232,7 +232,7 @@ def venv_script(args):
 
 
 def embree(_runs):
-    out = venv_script(["bench/embree_compare.py", "--triangles", "10000,100000,1000000"])
+    out = venv_script(["bench/embree_compare.py", "--triangles", "10000,100000,1000000", "--runs", "5"])
     rows = [json.loads(l) for l in out.splitlines() if l.startswith("{")]
     lines = [
         "| triangles | engine | threads | build s | bytes/triangle | coherent Mrays/s | incoherent Mrays/s |",

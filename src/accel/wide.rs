@@ -125,13 +125,16 @@ pub fn prefetch<T>(x: &T) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let p = x as *const T as *const i8;
-        let mut off = 0;
-        while off < std::mem::size_of::<T>() {
+        // Every cache line `x` touches, from the one holding its first byte to the one holding
+        // its last (a 160-byte block at 48 mod 64 spans four).
+        let start = x as *const T as usize;
+        let end = start + std::mem::size_of::<T>();
+        let mut line = start & !63;
+        while line < end {
             // SAFETY: a prefetch is a hint: it never faults and changes no state the program
-            // can observe, and `p + off` lies within `x`.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(off)) };
-            off += 64;
+            // can observe; the address is in a cache line that `x` occupies.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(line as *const i8) };
+            line += 64;
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
@@ -268,6 +271,13 @@ impl WideBvh {
         let mut r = *ray;
         let rb = RayBox::new(ray.o, ray.inv_d);
         let mut best = None;
+        // Test leaf `c`; a hit shortens the ray and becomes the best so far.
+        let mut leaf = |c: u32, r: &mut Ray, best: &mut Option<(u32, f32)>| {
+            if let Some((p, t)) = test(c & !LEAF, r) {
+                r.t_max = t;
+                *best = Some((p, t));
+            }
+        };
         let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
         let mut sp = 0usize;
         let mut node = 0usize;
@@ -281,10 +291,7 @@ impl WideBvh {
                     node = c as usize;
                     continue;
                 }
-                if let Some((p, t)) = test(c & !LEAF, &r) {
-                    r.t_max = t;
-                    best = Some((p, t));
-                }
+                leaf(c, &mut r, &mut best);
                 mask = 0;
             }
             let near = near.to_array();
@@ -322,10 +329,7 @@ impl WideBvh {
                     go = Some(c);
                     break;
                 }
-                if let Some((p, t)) = test(c & !LEAF, &r) {
-                    r.t_max = t;
-                    best = Some((p, t));
-                }
+                leaf(c, &mut r, &mut best);
             }
             for &entry in &next[..k] {
                 if entry.1 <= r.t_max {
@@ -353,10 +357,7 @@ impl WideBvh {
                     node = c as usize;
                     break;
                 }
-                if let Some((p, t)) = test(c & !LEAF, &r) {
-                    r.t_max = t;
-                    best = Some((p, t));
-                }
+                leaf(c, &mut r, &mut best);
             }
         }
     }

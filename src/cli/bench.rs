@@ -274,20 +274,22 @@ fn meshes_section(
         let mesh = displaced_sphere(n as usize, Vec3::ZERO, 1.0, 0.05);
         let prims = Prim::flat_triangles(&mesh);
         let count = prims.len();
-        // The median of `runs` builds; the last one is kept (builds of the same primitives
-        // agree), each dropped before the next starts.
+        // The median of `runs` builds, all kept until the last is done, so that each writes
+        // fresh memory as the first does (and as `bench/embree_compare.py` measures Embree's
+        // builds) instead of pages a dropped build left warm; the last one is kept (builds of the
+        // same primitives agree).
         let mut times = Vec::new();
-        let mut built = None;
+        let mut built = Vec::new();
         for _ in 0..runs.max(1) {
-            drop(built.take());
             let prims = prims.clone();
             let start = Instant::now();
-            built = Some(Geometry::build(prims, Vec::new()));
+            built.push(Geometry::build(prims, Vec::new()));
             times.push(start.elapsed().as_secs_f64());
         }
         times.sort_by(f64::total_cmp);
         let build = times[times.len() / 2];
-        let g = built.expect("at least one build");
+        let g = built.pop().expect("at least one build");
+        drop(built);
         let nodes = g.bvh.nodes.len();
         // The tree's nodes and its leaves' blocks of lanes.
         let bvh_bytes = (nodes * std::mem::size_of::<WideNode>()

@@ -17,8 +17,8 @@ pub enum Chosen<'a> {
 }
 
 /// Every area light of a render, with the cumulative distribution of their powers; when one
-/// light is chosen per vertex (`Path(lights_per_vertex: One)`), the point lights' powers take
-/// part too, after the area lights.
+/// light is chosen per vertex (`Path(lights_per_vertex: One)` or `Importance`), the point
+/// lights' powers take part too, after the area lights.
 #[derive(Clone, Debug, Default)]
 pub struct Emitters {
     /// The lights; a primitive refers to its light by index here.

@@ -17,16 +17,14 @@ use glam::Vec3A;
 /// coincides with `p`, exactly when [`Light::incident`] gives no light facing `n`.
 #[inline]
 pub fn importance(light: &Light, p: Vec3A, n: Vec3A) -> f64 {
-    let (position, i_max) = match light {
-        Light::Point(l) => (l.position, l.intensity.max_element()),
+    let ((wi, _, d2), i_max) = match light {
+        Light::Point(l) => (l.toward(p), l.intensity.max_element()),
     };
     // The direction and cosine exactly as `Light::incident` and the light's term compute them,
     // so that a light with a term has a weight. Computed whatever the case and then selected:
     // whether a light is above the surface varies from vertex to vertex, and a branch on it
     // would be mispredicted.
-    let to = position - p;
-    let d2 = to.length_squared();
-    let cos = (to / d2.sqrt()).dot(n);
+    let cos = wi.dot(n);
     let lit = d2 != 0.0 && d2.is_finite() && cos > 0.0;
     let w = f64::from(i_max.max(0.0)) * f64::from(cos) / f64::from(d2);
     if lit { w } else { 0.0 }
@@ -68,7 +66,8 @@ pub fn choose_by_importance(lights: &[Light], p: Vec3A, n: Vec3A, u: f64) -> Opt
         acc += weight(k);
         j += usize::from(acc <= target);
     }
-    // Rounding can leave u * total at or above the sum: the last light of weight takes it.
+    // Defensive: `u < 1` and the same sums in the same order keep u * total below the last
+    // cumulative weight, but should that ever fail, the last light of weight takes it.
     if j == lights.len() {
         j = (0..lights.len()).rev().find(|&k| weight(k) > 0.0)?;
     }
@@ -118,6 +117,41 @@ mod tests {
                 "light {j}: {} of {steps}, want {want:.1}",
                 counts[j]
             );
+        }
+    }
+
+    /// Past the weights kept between the passes (more than 16 lights), the choice and its
+    /// probability are still those of the cumulative weights, checked against a direct search.
+    #[test]
+    fn many_lights_choose_as_few_do() {
+        let lights: Vec<Light> = (0..40)
+            .map(|k| {
+                let a = k as f32 * 0.37;
+                // Every fifth light below the surface: weight 0.
+                let y = if k % 5 == 0 {
+                    -1.0
+                } else {
+                    0.5 + 0.1 * k as f32
+                };
+                point(a.cos() * 2.0, y, a.sin() * 2.0, 1.0 + (k % 7) as f32)
+            })
+            .collect();
+        let (p, n) = (Vec3A::new(0.1, 0.0, -0.2), Vec3A::Y);
+        let w: Vec<f64> = lights.iter().map(|l| importance(l, p, n)).collect();
+        let total: f64 = w.iter().sum();
+        for k in 0..1000 {
+            let u = (k as f64 + 0.5) / 1000.0;
+            let (j, pmf) = choose_by_importance(&lights, p, n, u).unwrap();
+            let mut acc = 0.0;
+            let first = w
+                .iter()
+                .position(|&x| {
+                    acc += x;
+                    acc > u * total
+                })
+                .unwrap();
+            assert_eq!((j, pmf), (first, w[first] / total), "u = {u}");
+            assert!(w[j] > 0.0);
         }
     }
 

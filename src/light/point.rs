@@ -22,16 +22,27 @@ impl PointLight {
     /// `L_i = I / d^2` along the unit direction to the light.
     #[inline]
     pub fn incident(&self, p: Vec3A) -> Option<Incident> {
-        let to = self.position - p;
-        let d2 = to.length_squared();
+        let (wi, dist, d2) = self.toward(p);
         if d2 == 0.0 || !d2.is_finite() {
             return None;
         }
-        let dist = d2.sqrt();
         Some(Incident {
-            wi: to / dist,
+            wi,
             dist,
             li: self.intensity / d2,
         })
+    }
+
+    /// The unit direction from `p` to the light, the distance and its square, as
+    /// [`PointLight::incident`] computes them (NaN directions when `p` is the light's position
+    /// or the distance overflows: `incident` then gives no light). Choosing a light by its
+    /// contribution (`light::importance`) reads the same bits, so a light whose term is not
+    /// zero always has a weight.
+    #[inline]
+    pub fn toward(&self, p: Vec3A) -> (Vec3A, f32, f32) {
+        let to = self.position - p;
+        let d2 = to.length_squared();
+        let dist = d2.sqrt();
+        (to / dist, dist, d2)
     }
 }

@@ -307,8 +307,10 @@ pub enum ShaderDesc {
         #[serde(default)]
         lights: LightSampling,
         /// Lights sampled at each vertex under the Physical model: `All` (default: every point
-        /// light, one shadow ray each, and one area-light sample) or `One` (one light of all,
-        /// chosen by power: one shadow ray). The Course model sums its point lights.
+        /// light, one shadow ray each, and one area-light sample), `One` (one light of all,
+        /// chosen by power: one shadow ray) or `Importance` (one light, the point lights' share
+        /// spent on each by its unshadowed contribution `I cos / d^2` at the vertex). The Course
+        /// model sums its point lights.
         #[serde(default)]
         lights_per_vertex: LightsPerVertex,
     },

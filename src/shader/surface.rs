@@ -182,7 +182,13 @@ pub fn one_light(
             let Some((j, p)) = choose_by_importance(lights, si.hit.p, si.n, v) else {
                 return Vec3A::ZERO;
             };
-            point_light(tr, si, phong, &lights[j]) * (1.0 / (share * p)) as f32
+            // A light chosen with a chance below f32's range (about 1e-38) would weigh inf, and
+            // inf * 0 is NaN when it is shadowed: such a sample, never drawn in practice, adds 0.
+            let weight = (1.0 / (share * p)) as f32;
+            if !weight.is_finite() {
+                return Vec3A::ZERO;
+            }
+            point_light(tr, si, phong, &lights[j]) * weight
         }
         Some(Chosen::Point(j, pmf)) => {
             let light = tr.lights[j];
