@@ -510,6 +510,30 @@ fn mis_beats_both_strategies_on_veachs_scene() {
     );
 }
 
+/// Grey point lights: position and intensity.
+type Lamps = [((f64, f64, f64), f64)];
+
+/// Irradiance `sum I cos / d^2` that `points` send to the origin across the normal +y.
+fn irradiance_at_origin(points: &Lamps) -> f64 {
+    points
+        .iter()
+        .map(|&((px, py, pz), i)| {
+            let d2 = px * px + py * py + pz * pz;
+            i * (py / d2.sqrt()) / d2
+        })
+        .sum()
+}
+
+/// `points` as scene entities.
+fn lamps(points: &Lamps) -> String {
+    points
+        .iter()
+        .map(|&((px, py, pz), i)| {
+            format!("(light: Point(position: ({px}, {py}, {pz}), intensity: ({i}, {i}, {i}))),")
+        })
+        .collect()
+}
+
 /// Choosing the point light by its contribution leaves only visibility to vary: on a diffuse
 /// floor that nothing shadows, under three grey point lights, every sample gives the sum
 /// `kd / pi sum_j I_j cos_j / d_j^2` whichever light it picks, so two seeds give the same image
@@ -522,20 +546,8 @@ fn importance_leaves_only_visibility_to_vary() {
         ((-1.0, 1.5, -0.5), 1.0),
         ((2.0, 0.5, 1.0), 6.0),
     ];
-    let e: f64 = points
-        .iter()
-        .map(|&((px, py, pz), i)| {
-            let d2 = px * px + py * py + pz * pz;
-            i * (py / d2.sqrt()) / d2
-        })
-        .sum();
-    let want = kd / PI * e;
-    let lamps: String = points
-        .iter()
-        .map(|&((px, py, pz), i)| {
-            format!("(light: Point(position: ({px}, {py}, {pz}), intensity: ({i}, {i}, {i}))),")
-        })
-        .collect();
+    let want = kd / PI * irradiance_at_origin(&points);
+    let lamps = lamps(&points);
     let render = |per_vertex: &str, seed: u64| {
         render_scene(&scene(&format!(
             "Scene(film: (width: 16, height: 16, spp: 4), seed: {seed},
@@ -580,14 +592,7 @@ fn one_light_per_vertex_is_unbiased() {
         ((-0.5f64, 2.0f64, -0.5f64), 3.0f64),
         ((-1.0, 1.5, -0.5), 1.0),
     ];
-    let e_points: f64 = points
-        .iter()
-        .map(|&((px, py, pz), i)| {
-            let d2 = px * px + py * py + pz * pz;
-            i * (py / d2.sqrt()) / d2
-        })
-        .sum();
-    let want = kd / PI * e_points + kd * l * f;
+    let want = kd / PI * irradiance_at_origin(&points) + kd * l * f;
     for shader in [
         "Path(max_depth: 1, lights_per_vertex: One, lights: Mis)",
         "Path(max_depth: 1, lights_per_vertex: One, lights: Light)",
@@ -597,12 +602,7 @@ fn one_light_per_vertex_is_unbiased() {
         "Path(max_depth: 1, lights_per_vertex: Importance, lights: Brdf)",
         "Path(max_depth: 1, lights_per_vertex: All)",
     ] {
-        let lamps: String = points
-            .iter()
-            .map(|&((px, py, pz), i)| {
-                format!("(light: Point(position: ({px}, {py}, {pz}), intensity: ({i}, {i}, {i}))),")
-            })
-            .collect();
+        let lamps = lamps(&points);
         let text = format!(
             "Scene(film: (width: 32, height: 32, spp: 16),
                camera: Perspective(position: (3, 1, -0.5), look_at: (0, 0, 0), fov: 0.001),
