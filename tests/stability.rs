@@ -267,9 +267,11 @@ mod random_scenes {
                 0u32..6,
                 prop_oneof![Just("Uniform"), Just("Cosine"), Just("Brdf")],
                 prop_oneof![Just("Mis"), Just("Light"), Just("Brdf")],
+                prop_oneof![Just("All"), Just("One"), Just("Importance")],
             )
-                .prop_map(|(d, rr, smp, lights)| format!(
-                    "Path(max_depth: {d}, rr_depth: {rr}, sampling: {smp}, lights: {lights})"
+                .prop_map(|(d, rr, smp, lights, per_vertex)| format!(
+                    "Path(max_depth: {d}, rr_depth: {rr}, sampling: {smp}, lights: {lights}, \
+                     lights_per_vertex: {per_vertex})"
                 )),
         ]
     }
