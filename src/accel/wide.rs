@@ -312,7 +312,7 @@ impl WideBvh {
                     next[j] = next[j - 1];
                     j -= 1;
                 }
-                next[j] = (n.child[i], near[i]);
+                next[j] = (c, near[i]);
                 k += 1;
             }
             // In distance order: leaves are tested until the nearest interior child, which is

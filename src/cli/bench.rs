@@ -243,6 +243,21 @@ fn median_of<T: PartialEq + std::fmt::Debug>(
     mid
 }
 
+/// A built geometry, compared by its node count (builds of the same primitives agree).
+struct BuiltOnce(Geometry);
+
+impl PartialEq for BuiltOnce {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.bvh.nodes.len() == other.0.bvh.nodes.len()
+    }
+}
+
+impl std::fmt::Debug for BuiltOnce {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "{} wide nodes", self.0.bvh.nodes.len())
+    }
+}
+
 /// BVH build time, memory per triangle and ray rates for procedural meshes of 10k, 100k and
 /// 1M triangles (a displaced sphere of radius 1 at the origin).
 fn meshes_section(
@@ -274,22 +289,16 @@ fn meshes_section(
         let mesh = displaced_sphere(n as usize, Vec3::ZERO, 1.0, 0.05);
         let prims = Prim::flat_triangles(&mesh);
         let count = prims.len();
-        // The median of `runs` builds, all kept until the last is done, so that each writes
-        // fresh memory as the first does (and as `bench/embree_compare.py` measures Embree's
-        // builds) instead of pages a dropped build left warm; the last one is kept (builds of the
-        // same primitives agree).
-        let mut times = Vec::new();
-        let mut built = Vec::new();
-        for _ in 0..runs.max(1) {
+        // The median of `runs` builds. `median_of` keeps every build until the last is done, so
+        // each writes fresh memory as the first does (and as `bench/embree_compare.py` measures
+        // Embree's builds) instead of pages a dropped build left warm.
+        let (build, g) = median_of(runs, || {
             let prims = prims.clone();
             let start = Instant::now();
-            built.push(Geometry::build(prims, Vec::new()));
-            times.push(start.elapsed().as_secs_f64());
-        }
-        times.sort_by(f64::total_cmp);
-        let build = times[times.len() / 2];
-        let g = built.pop().expect("at least one build");
-        drop(built);
+            let g = Geometry::build(prims, Vec::new());
+            (start.elapsed().as_secs_f64(), BuiltOnce(g))
+        });
+        let g = g.0;
         let nodes = g.bvh.nodes.len();
         // The tree's nodes and its leaves' blocks of lanes.
         let bvh_bytes = (nodes * std::mem::size_of::<WideNode>()
