@@ -7,7 +7,7 @@
 
 use crate::accel::{FLAT, Geometry, Prim};
 use crate::geometry::Placement;
-use crate::light::{AreaLight, Emitter, Emitters, Emitting, NO_LIGHT};
+use crate::light::{AreaLight, Emitter, Emitters, Emitting, Light, NO_LIGHT, PointLight};
 use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
 use crate::shader::Shader;
@@ -98,13 +98,22 @@ pub fn extract(scene: &Scene) -> RenderScene {
             }
         }
     }
+    let mut geometry = Geometry::build(prims, normals);
+    // Planes that no ray crosses keep every ray on the camera's side; a point light there
+    // needs no plane tested on its shadow rays.
+    let crossable = |m: u32| matches!(materials[m as usize], Material::Transmissive(_));
+    geometry.orient_planes(&camera.starts(), crossable);
     let lights: Vec<_> = scene
         .world
         .query::<&WorldLight>()
         .iter()
-        .map(|l| l.extract(origin))
+        .map(|l| match l.extract(origin) {
+            Light::Point(p) => Light::Point(PointLight {
+                in_room: geometry.in_room(p.position),
+                ..p
+            }),
+        })
         .collect();
-    let geometry = Geometry::build(prims, normals);
     let emitters = Emitters::new(area_lights);
 
     // The effects, derived once from the parts, before the render scene is assembled.

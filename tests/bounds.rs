@@ -191,8 +191,8 @@ fn scaled(shape: Shape, k: f32) -> Shape {
             r: s.r * k,
         }),
         Shape::Plane(p) => Shape::Plane(Plane {
-            n: p.n,
             dist: p.dist * k,
+            ..p
         }),
         Shape::Triangle(t) => Shape::Triangle(Triangle {
             v: t.v.map(|v| v * k),

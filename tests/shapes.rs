@@ -364,3 +364,41 @@ fn t_max_is_inclusive() {
         assert_eq!(at(4.0f32.next_down()), None, "{shape:?}");
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+
+    /// An oriented plane (`Plane::side`) is tested alike by the scalar code and the packets,
+    /// for origins on the plane (within its band), just off it on either side, and away from
+    /// it; and within the band only a ray leaving the plane's side meets it, at once.
+    #[test]
+    fn oriented_planes_agree_in_scalar_and_packets(
+        (s, p0, n, d, side, off, o_err) in scale().prop_flat_map(|s| (
+            Just(s),
+            point(s),
+            unit(),
+            unit(),
+            prop_oneof![Just(-1.0f32), Just(0.0), Just(1.0)],
+            prop_oneof![Just(0.0f32), -1e-6f32..1e-6, -1e-3f32..1e-3, -1.0f32..1.0],
+            prop_oneof![Just(0.0f32), 0.0f32..1e-5],
+        ))
+    ) {
+        let plane = Plane::through(p0, n).oriented(side);
+        let ray = Ray {
+            o_err: o_err * s,
+            ..Ray::new(p0 + off * s * n, d)
+        };
+        let scalar = Shape::Plane(plane).intersect(&ray);
+        let g = Geometry::build(vec![Prim::flat(Shape::Plane(plane))], Vec::new());
+        prop_assert_eq!(scalar, g.intersect(&ray).map(|h| h.t));
+        let signed = plane.n.dot(ray.o) - plane.dist;
+        if signed.abs() <= plane.band(&ray) {
+            // On the plane: met at once exactly when leaving the oriented side.
+            let leaving = side * plane.n.dot(d) < 0.0;
+            prop_assert_eq!(scalar.is_some(), leaving);
+            if let Some(t) = scalar {
+                prop_assert!(t > 0.0 && t <= 2.0 * plane.band(&ray) / plane.n.dot(d).abs());
+            }
+        }
+    }
+}

@@ -60,6 +60,8 @@ pub struct PlaneLanes {
     n_abs_sum: Vec4,
     /// `gamma(4) |dist|`.
     dist_err: Vec4,
+    /// [`Plane::side`] (0 in unused lanes).
+    side: Vec4,
 }
 
 impl SphereLanes {
@@ -136,6 +138,7 @@ impl PlaneLanes {
             dist: v(|p| p.dist),
             n_abs_sum: v(|p| p.n.abs().element_sum()),
             dist_err: v(|p| gamma(4) * p.dist.abs()),
+            side: v(|p| p.side),
         }
     }
 
@@ -145,9 +148,18 @@ impl PlaneLanes {
         let denom = dot(self.n, r.d);
         let s = self.dist - dot(self.n, r.o);
         let band = self.n_abs_sum * r.plane_k + self.dist_err;
-        let t = s / denom;
-        let ok = (s * denom).cmpgt(Vec4::ZERO) & s.abs().cmpgt(band) & t.cmple(Vec4::splat(t_max));
-        (t, ok)
+        let mut t = s / denom;
+        let beyond = s.abs().cmpgt(band);
+        // Beyond the band: `s` on the side `d` goes to.
+        let mut ok = (s * denom).cmpgt(Vec4::ZERO) & beyond;
+        // Within it: only a ray leaving an oriented plane's side, met at once (rare: a ray from
+        // a crease heading out of the room).
+        let leaving = (self.side * denom).cmplt(Vec4::ZERO) & !beyond;
+        if leaving.any() {
+            t = Vec4::select(leaving, t.max(Vec4::splat(f32::MIN_POSITIVE)), t);
+            ok |= leaving;
+        }
+        (t, ok & t.cmple(Vec4::splat(t_max)))
     }
 }
 

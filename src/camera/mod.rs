@@ -98,6 +98,17 @@ pub enum Camera {
 }
 
 impl Camera {
+    /// The corners of the region camera rays start from: every primary ray's origin is a
+    /// convex combination of them (the centre of projection, four times, for a pinhole).
+    pub fn starts(&self) -> [Vec3A; 4] {
+        match self {
+            Camera::Perspective(c) => [c.origin; 4],
+            Camera::Orthographic(c) => {
+                [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(u, v)| c.ray(u, v).o)
+            }
+        }
+    }
+
     /// The primary ray through image point `(u, v)`, both in `[0, 1]`, `(0, 0)` the top-left.
     #[inline]
     pub fn ray(&self, u: f32, v: f32) -> Ray {

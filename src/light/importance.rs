@@ -83,6 +83,7 @@ mod tests {
         Light::Point(PointLight {
             position: Vec3A::new(x, y, z),
             intensity: Vec3A::new(i, 0.5 * i, 0.25 * i),
+            in_room: false,
         })
     }
 
@@ -181,10 +182,12 @@ mod tests {
         let near = Light::Point(PointLight {
             position: Vec3A::new(0.0, 1e-20, 0.0),
             intensity: Vec3A::splat(f32::MAX),
+            in_room: false,
         });
         let far = Light::Point(PointLight {
             position: Vec3A::new(0.0, 1e18, 0.0),
             intensity: Vec3A::splat(f32::MIN_POSITIVE),
+            in_room: false,
         });
         for l in [near, far] {
             let w = importance(&l, Vec3A::ZERO, Vec3A::Y);

@@ -53,6 +53,7 @@ impl WorldLight {
             } => Light::Point(PointLight {
                 position: (position - origin).as_vec3a(),
                 intensity,
+                in_room: false,
             }),
         }
     }
@@ -70,6 +71,21 @@ impl Light {
     pub fn power(&self) -> f32 {
         match self {
             Light::Point(l) => l.power(),
+        }
+    }
+
+    /// Where the light is (render coordinates).
+    pub fn position(&self) -> Vec3A {
+        match self {
+            Light::Point(l) => l.position,
+        }
+    }
+
+    /// True if no plane can block a shadow ray towards the light ([`PointLight::in_room`]).
+    #[inline]
+    pub fn in_room(&self) -> bool {
+        match self {
+            Light::Point(l) => l.in_room,
         }
     }
 

@@ -10,6 +10,10 @@ pub struct PointLight {
     pub position: Vec3A,
     /// Radiant intensity, W/sr.
     pub intensity: Vec3A,
+    /// True if no plane can block a shadow ray towards the light: it is on the side of every
+    /// plane that rays are kept on (`Geometry::in_room` in `accel`). Set by extraction;
+    /// shadow rays towards it then skip the planes.
+    pub in_room: bool,
 }
 
 impl PointLight {

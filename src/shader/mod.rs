@@ -95,6 +95,14 @@ impl Tracer<'_> {
         self.stats.count(RayKind::Shadow);
         !self.geometry.occluded(ray)
     }
+
+    /// [`Tracer::unoccluded`] for a shadow ray towards a point light that no plane can hide
+    /// ([`Light::in_room`]): the planes are not tested.
+    #[inline]
+    pub fn unoccluded_in_room(&mut self, ray: &Ray) -> bool {
+        self.stats.count(RayKind::Shadow);
+        !self.geometry.occluded_in_room(ray)
+    }
 }
 
 /// Radiance arriving at the camera along the camera ray `ray` under `shader`.

@@ -112,9 +112,13 @@ fn point_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light: &Light) 
         return Vec3A::ZERO;
     }
     // Shadow ray V^s: stop just short of the light, so that a surface the light sits on does
-    // not block it.
-    let visible =
-        !tr.effects.shadows || tr.unoccluded(&si.origins.ray(inc.wi, inc.dist * SHADOW_END));
+    // not block it. No plane can block it when the light is in the planes' room.
+    let shadow = si.origins.ray(inc.wi, inc.dist * SHADOW_END);
+    let visible = !tr.effects.shadows
+        || match light.in_room() {
+            true => tr.unoccluded_in_room(&shadow),
+            false => tr.unoccluded(&shadow),
+        };
     if visible {
         inc.li * reflectance(tr.model, phong, inc.wi, si.wo, si.n)
     } else {

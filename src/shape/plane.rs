@@ -5,12 +5,19 @@ use crate::geometry::{Placement, Ray, gamma};
 use glam::Vec3A;
 
 /// The two-sided plane `{p : n.p = dist}` with unit normal `n`.
+///
+/// A plane that no ray may cross (one that does not refract) and that has every camera ray
+/// start strictly on one side is *oriented* towards that side (`side`): every ray then starts
+/// on that side, or within the plane's error band (see [`Plane::intersect`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Plane {
     /// Unit normal.
     pub n: Vec3A,
     /// Signed distance from the origin along `n`.
     pub dist: f32,
+    /// The side rays are kept on: `1` where `n.p > dist`, `-1` where `n.p < dist`, `0` for
+    /// none (the plane is not oriented: rays may be on either side).
+    pub side: f32,
 }
 
 impl Plane {
@@ -22,6 +29,7 @@ impl Plane {
         Plane {
             n,
             dist: n.as_dvec3().dot(at.point_f64(point)) as f32,
+            side: 0.0,
         }
     }
 
@@ -30,7 +38,25 @@ impl Plane {
         Plane {
             n,
             dist: n.dot(point),
+            side: 0.0,
         }
+    }
+
+    /// This plane oriented towards `side` (`1`, `-1`, or `0` for none).
+    pub fn oriented(self, side: f32) -> Self {
+        Plane { side, ..self }
+    }
+
+    /// The side of the plane `p` lies on beyond the error band of a ray starting there with
+    /// origin error `o_err`: `1` where `n.p > dist`, `-1` where `n.p < dist`, `0` within the
+    /// band.
+    pub fn side_of(&self, p: Vec3A, o_err: f32) -> f32 {
+        let s = self.n.dot(p) - self.dist;
+        let band = self.band(&Ray {
+            o_err,
+            ..Ray::bare(p, self.n, f32::INFINITY)
+        });
+        if s.abs() <= band { 0.0 } else { s.signum() }
     }
 
     /// Distance to the plane in `(0, t_max]`; `None` for rays parallel to it, and for a ray
@@ -40,16 +66,27 @@ impl Plane {
     /// is at most `gamma(4) (|n|.|o| + |dist|)`, and the origin's own error moves it by at most
     /// `(sum |n_i|) o_err`; with `|n|.|o| <= (sum |n_i|) max |o_i|` both fit in
     /// [`Plane::band`]. Within that band the origin is on the plane: a ray that starts on a
-    /// plane never meets it again.
+    /// plane does not meet it there, unless it leaves an oriented plane's side. Such a ray
+    /// started at a crease, on a neighbouring surface within the band, and runs into this
+    /// plane: it meets it at once (at the smallest positive distance, if the rounded crossing
+    /// is not ahead), instead of leaking through to the other side.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         let denom = self.n.dot(ray.d);
         let s = self.dist - self.n.dot(ray.o);
-        // `s` on the side `d` goes to (t > 0), and beyond the band.
-        if s * denom <= 0.0 || s.abs() <= self.band(ray) {
-            return None;
-        }
-        let t = s / denom;
+        let t = if s.abs() <= self.band(ray) {
+            // On the plane: only a ray leaving the side rays are kept on meets it.
+            if self.side * denom >= 0.0 {
+                return None;
+            }
+            (s / denom).max(f32::MIN_POSITIVE)
+        } else {
+            // `s` on the side `d` goes to (t > 0).
+            if s * denom <= 0.0 {
+                return None;
+            }
+            s / denom
+        };
         (t <= ray.t_max).then_some(t)
     }
 
