@@ -74,13 +74,6 @@ impl Light {
         }
     }
 
-    /// Where the light is (render coordinates).
-    pub fn position(&self) -> Vec3A {
-        match self {
-            Light::Point(l) => l.position,
-        }
-    }
-
     /// True if no plane can block a shadow ray towards the light ([`PointLight::in_room`]).
     #[inline]
     pub fn in_room(&self) -> bool {
