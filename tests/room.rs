@@ -85,6 +85,26 @@ fn planes_are_oriented_towards_the_camera() {
     );
     assert_eq!(planes(&on)[0].side, 0.0, "the camera stands on the plane");
 
+    // An orthographic camera starts its rays across its image rectangle (4 units tall, 5
+    // wide, centred at the origin): a plane that cuts the rectangle has rays on both sides.
+    let ortho = |x: f32| {
+        prepared(&format!(
+            "Scene(film: (width: 50, height: 40),
+              camera: Orthographic(position: (0, 0, 0), look_at: (0, 0, 1), height: 4),
+              entities: [(shape: InfinitePlane(point: ({x}, 0, 0), normal: (1, 0, 0)), material: Mirror())])"
+        ))
+    };
+    assert_eq!(
+        planes(&ortho(3.0))[0].side,
+        -1.0,
+        "the rectangle ends at x = 2.5"
+    );
+    assert_eq!(
+        planes(&ortho(2.0))[0].side,
+        0.0,
+        "the plane cuts the rectangle"
+    );
+
     let behind = prepared(
         "Scene(entities: [
             (shape: InfinitePlane(point: (0, -1, 0), normal: (0, 1, 0)), material: Mirror()),
