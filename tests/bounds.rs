@@ -1,5 +1,6 @@
 //! The rounding-error bounds of the shapes (src/shape/*.rs, src/accel/lanes.rs) are safe and
-//! consistent: rays that start on a surface (within rounding) never meet it at their start,
+//! consistent: rays that start on a surface (within rounding) never meet it at their start
+//! (planes here are not oriented; `tests/room.rs` and `tests/shapes.rs` test oriented ones),
 //! in every code path (scalar, SIMD lanes, BVH); every hit point lies within its bounds; and
 //! the bounds scale exactly with the scene. Scaling every coordinate by a power of two changes
 //! no rounding, so a bound that is a sum of terms of the right dimension (lengths, or squared
@@ -119,7 +120,7 @@ fn rays_starting_on_a_sphere_meet_only_its_far_side() {
     assert!(checked > 3000);
 }
 
-/// A ray that starts on a plane (a point projected onto it in f32) never meets it, wherever
+/// A ray that starts on an unoriented plane (a point projected onto it in f32) never meets it, wherever
 /// the plane is (up to 1e4 from the origin) and whichever way the ray goes; in the scalar test
 /// and the packet of planes.
 #[test]

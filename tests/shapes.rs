@@ -373,17 +373,20 @@ proptest! {
     /// it; and within the band only a ray leaving the plane's side meets it, at once.
     #[test]
     fn oriented_planes_agree_in_scalar_and_packets(
-        (s, p0, n, d, side, off, o_err) in scale().prop_flat_map(|s| (
+        (s, p0, n, d, parallel, side, off, o_err) in scale().prop_flat_map(|s| (
             Just(s),
             point(s),
             unit(),
             unit(),
+            any::<bool>(),
             prop_oneof![Just(-1.0f32), Just(0.0), Just(1.0)],
             prop_oneof![Just(0.0f32), -1e-6f32..1e-6, -1e-3f32..1e-3, -1.0f32..1.0],
             prop_oneof![Just(0.0f32), 0.0f32..1e-5],
         ))
     ) {
         let plane = Plane::through(p0, n).oriented(side);
+        // Some rays run parallel to the plane (`n.d` zero or nearly).
+        let d = if parallel { (d - d.dot(n) * n).normalize_or(n.any_orthonormal_vector()) } else { d };
         let ray = Ray {
             o_err: o_err * s,
             ..Ray::new(p0 + off * s * n, d)
@@ -400,5 +403,35 @@ proptest! {
                 prop_assert!(t > 0.0 && t <= 2.0 * plane.band(&ray) / plane.n.dot(d).abs());
             }
         }
+    }
+}
+
+/// Degenerate rays get the same answer from the scalar test and the packets, oriented or not:
+/// a NaN or infinite origin, a NaN direction, and a direction along the plane (`n.d = 0`),
+/// which never meets it.
+#[test]
+fn oriented_planes_treat_degenerate_rays_alike() {
+    for side in [-1.0, 0.0, 1.0] {
+        let plane = Plane::through(Vec3A::ZERO, Vec3A::Y).oriented(side);
+        let g = Geometry::build(vec![Prim::flat(Shape::Plane(plane))], Vec::new());
+        let rays = [
+            Ray::new(Vec3A::new(f32::NAN, 0.0, 0.0), -Vec3A::Y),
+            Ray::new(Vec3A::new(0.0, f32::INFINITY, 0.0), -Vec3A::Y),
+            Ray::new(Vec3A::new(0.0, f32::NAN, 0.0), Vec3A::Y),
+            Ray::new(Vec3A::ZERO, Vec3A::X),
+            Ray::new(Vec3A::ZERO, Vec3A::new(f32::NAN, 0.0, 0.0)),
+        ];
+        for ray in &rays {
+            let scalar = Shape::Plane(plane).intersect(ray);
+            assert_eq!(
+                scalar.map(f32::to_bits),
+                g.intersect(ray).map(|h| h.t.to_bits())
+            );
+        }
+        assert_eq!(
+            Shape::Plane(plane).intersect(&rays[3]),
+            None,
+            "along the plane"
+        );
     }
 }

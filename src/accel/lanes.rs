@@ -149,12 +149,14 @@ impl PlaneLanes {
         let s = self.dist - dot(self.n, r.o);
         let band = self.n_abs_sum * r.plane_k + self.dist_err;
         let mut t = s / denom;
-        let beyond = s.abs().cmpgt(band);
+        // The scalar test's predicates, NaN included (a NaN `s` is neither within the band nor
+        // on the side `d` goes to).
+        let within = s.abs().cmple(band);
         // Beyond the band: `s` on the side `d` goes to.
-        let mut ok = (s * denom).cmpgt(Vec4::ZERO) & beyond;
-        // Within it: only a ray leaving an oriented plane's side, met at once (rare: a ray from
-        // a crease heading out of the room).
-        let leaving = (self.side * denom).cmplt(Vec4::ZERO) & !beyond;
+        let mut ok = (s * denom).cmpgt(Vec4::ZERO) & !within;
+        // Within it: only a ray leaving an oriented plane's side, met where it crosses or at
+        // the smallest positive distance (rare: a ray from a crease heading out of the room).
+        let leaving = (self.side * denom).cmplt(Vec4::ZERO) & within;
         if leaving.any() {
             t = Vec4::select(leaving, t.max(Vec4::splat(f32::MIN_POSITIVE)), t);
             ok |= leaving;

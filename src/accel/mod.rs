@@ -213,10 +213,13 @@ impl Geometry {
     /// the starts lie on both sides.
     ///
     /// Why this holds for every ray and not only camera rays: a ray that starts on a plane's
-    /// side stays there until it meets the plane, so its nearest hit is on that side too; and
-    /// a ray spawned at a hit leaves towards the viewer's side of that surface. What rounding
-    /// leaves is an origin within the band of a plane it did not start on (at a crease);
-    /// an oriented plane stops such a ray at once if it heads out ([`crate::shape::Plane::intersect`]).
+    /// side stays there until it meets the plane, so its nearest hit is on that side too. A
+    /// ray spawned at that hit starts within its `o_err` of it (on either side of the surface
+    /// it leaves: glass and smooth normals send rays out of the back), and a plane's band holds
+    /// `sum |n_i| o_err`; so an origin is never beyond the band on the wrong side. What
+    /// rounding leaves is an origin within the band of a plane it did not start on (at a
+    /// crease); an oriented plane stops such a ray if it heads out
+    /// ([`crate::shape::Plane::intersect`]).
     pub fn orient_planes(&mut self, starts: &[glam::Vec3A], crossable: impl Fn(u32) -> bool) {
         let slots = self.attrs.len();
         for p in &mut self.others {

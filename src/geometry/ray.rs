@@ -8,7 +8,9 @@
 //! origin lies within the error band of a surface starts *on* it, and does not meet it at its
 //! start. That is what keeps a shadow ray from a crease between two walls from being blocked by
 //! the neighbouring wall (seam acne), and a ray from re-hitting the surface it left, without any
-//! epsilon.
+//! epsilon. One exception: an *oriented* plane (`shape::Plane::side`, one no ray crosses) does
+//! stop a ray that starts within its band and heads out of its side, which would otherwise
+//! leak out of a room through a crease.
 
 use glam::Vec3A;
 

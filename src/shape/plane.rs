@@ -60,7 +60,7 @@ impl Plane {
     }
 
     /// Distance to the plane in `(0, t_max]`; `None` for rays parallel to it, and for a ray
-    /// that starts on it.
+    /// that starts on it, unless that ray leaves an oriented plane's side (below).
     ///
     /// `s = dist - n.o` is the signed distance from the origin to the plane. Its rounding error
     /// is at most `gamma(4) (|n|.|o| + |dist|)`, and the origin's own error moves it by at most
@@ -68,15 +68,17 @@ impl Plane {
     /// [`Plane::band`]. Within that band the origin is on the plane: a ray that starts on a
     /// plane does not meet it there, unless it leaves an oriented plane's side. Such a ray
     /// started at a crease, on a neighbouring surface within the band, and runs into this
-    /// plane: it meets it at once (at the smallest positive distance, if the rounded crossing
-    /// is not ahead), instead of leaking through to the other side.
+    /// plane: it meets it where it crosses, or at the smallest positive distance if the
+    /// rounded crossing is not ahead, instead of leaking through to the other side.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
         let denom = self.n.dot(ray.d);
         let s = self.dist - self.n.dot(ray.o);
         let t = if s.abs() <= self.band(ray) {
-            // On the plane: only a ray leaving the side rays are kept on meets it.
-            if self.side * denom >= 0.0 {
+            // On the plane: only a ray leaving the side rays are kept on meets it (not a ray
+            // parallel to the plane, nor a NaN direction).
+            let leaving = self.side * denom < 0.0;
+            if !leaving {
                 return None;
             }
             (s / denom).max(f32::MIN_POSITIVE)
