@@ -98,11 +98,17 @@ pub fn extract(scene: &Scene) -> RenderScene {
             }
         }
     }
-    let mut geometry = Geometry::build(prims, normals);
-    // Planes that no ray crosses keep every ray on the camera's side; a point light there
-    // needs no plane tested on its shadow rays.
-    let crossable = |m: u32| matches!(materials[m as usize], Material::Transmissive(_));
-    geometry.orient_planes(&camera.starts(), crossable);
+    // Planes that no ray crosses (not glass) keep every ray on the camera's side; a point
+    // light there needs no plane tested on its shadow rays.
+    let starts = camera.starts();
+    for p in &mut prims {
+        if let Shape::Plane(plane) = p.shape
+            && !matches!(materials[p.material as usize], Material::Transmissive(_))
+        {
+            p.shape = Shape::Plane(plane.oriented(plane.facing(&starts)));
+        }
+    }
+    let geometry = Geometry::build(prims, normals);
     let lights: Vec<_> = scene
         .world
         .query::<&WorldLight>()

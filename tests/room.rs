@@ -1,4 +1,4 @@
-//! Oriented planes (`Plane::side`, `Geometry::orient_planes`): rays stay in the room the
+//! Oriented planes (`Plane::side`, `Plane::facing`): rays stay in the room the
 //! camera is in, and shadow rays towards a light in that room skip the planes without changing
 //! a pixel.
 
@@ -229,10 +229,7 @@ fn skipping_planes_on_shadow_rays_changes_no_pixel() {
         r.film.height = 40;
         assert!(r.lights.iter().all(Light::in_room), "{file}");
         let skipped = render(&r, &|| {});
-        for l in &mut r.lights {
-            let Light::Point(p) = l;
-            p.in_room = false;
-        }
+        common::lights_out_of_room(&mut r);
         let tested = render(&r, &|| {});
         assert!(tested.stats.shadow > 1000);
         let differ = (skipped.image.pixels.iter())

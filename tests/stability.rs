@@ -44,10 +44,7 @@ fn room(width: u32, height: u32, s: f64, t: DVec3, shadows: bool) -> String {
 /// `tests/room.rs`): that is what puts the planes' error bands to the test.
 fn seam_pixels(width: u32, height: u32, s: f64, t: DVec3) -> usize {
     let mut lit = rtis::extract(&scene(&room(width, height, s, t, true)));
-    for light in &mut lit.lights {
-        let rtis::light::Light::Point(p) = light;
-        p.in_room = false;
-    }
+    common::lights_out_of_room(&mut lit);
     let on = render(&lit, &|| {});
     let off = render(
         &rtis::extract(&scene(&room(width, height, s, t, false))),

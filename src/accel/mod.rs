@@ -206,45 +206,8 @@ impl Geometry {
         }
     }
 
-    /// Orient every plane that no ray may cross towards the side all of `starts` lie on
-    /// (see [`Plane`](crate::shape::Plane)). `starts` are the corners of the region camera rays
-    /// start from (a point for a pinhole camera); `crossable(material)` is true for a material
-    /// rays pass through. A plane stays unoriented when some start is within its error band or
-    /// the starts lie on both sides.
-    ///
-    /// Why this holds for every ray and not only camera rays: a ray that starts on a plane's
-    /// side stays there until it meets the plane, so its nearest hit is on that side too. A
-    /// ray spawned at that hit starts within its `o_err` of it (on either side of the surface
-    /// it leaves: glass and smooth normals send rays out of the back), and a plane's band holds
-    /// `sum |n_i| o_err`; so an origin is never beyond the band on the wrong side. What
-    /// rounding leaves is an origin within the band of a plane it did not start on (at a
-    /// crease); an oriented plane stops such a ray if it heads out
-    /// ([`crate::shape::Plane::intersect`]).
-    pub fn orient_planes(&mut self, starts: &[glam::Vec3A], crossable: impl Fn(u32) -> bool) {
-        let slots = self.attrs.len();
-        for p in &mut self.others {
-            let (Shape::Plane(plane), false) = (p.shape, crossable(p.material)) else {
-                continue;
-            };
-            let sides: Vec<f32> = starts.iter().map(|&o| plane.side_of(o, 0.0)).collect();
-            let side = match sides.first() {
-                Some(&first) if first != 0.0 && sides.iter().all(|&x| x == first) => first,
-                _ => 0.0,
-            };
-            p.shape = Shape::Plane(plane.oriented(side));
-        }
-        // Repack the planes' lanes (planes are `others`' last entries, in lane order).
-        let items: Vec<(u32, crate::shape::Plane)> = (self.others.iter().enumerate())
-            .filter_map(|(k, p)| match p.shape {
-                Shape::Plane(plane) => Some(((slots + k) as u32, plane)),
-                _ => None,
-            })
-            .collect();
-        self.planes = lanes::pack(&items, PlaneLanes::pack);
-    }
-
     /// True if no plane can block a segment from any ray's origin to `p`: every plane is
-    /// oriented ([`Geometry::orient_planes`]) and `p` is on its side, beyond its error band.
+    /// oriented ([`crate::shape::Plane::side`]) and `p` is on its side, beyond its error band.
     /// A shadow ray towards such a point skips the planes ([`Geometry::occluded_in_room`]).
     pub fn in_room(&self, p: glam::Vec3A) -> bool {
         self.others.iter().all(|prim| match prim.shape {

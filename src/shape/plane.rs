@@ -47,16 +47,35 @@ impl Plane {
         Plane { side, ..self }
     }
 
+    /// The side every point of `starts` lies on beyond the band (`1` or `-1`), or `0` when one
+    /// is within it or they lie on both sides: the side to orient a plane no ray crosses
+    /// towards, given the corners of the region camera rays start from.
+    ///
+    /// Why every ray then stays on that side, not only camera rays: a ray that starts on a
+    /// plane's side stays there until it meets the plane, so its nearest hit is on that side
+    /// too. A ray spawned at that hit starts within its `o_err` of it (on either side of the
+    /// surface it leaves: glass and smooth normals send rays out of the back), and the band
+    /// holds `sum |n_i| o_err`; so an origin is never beyond the band on the wrong side. What
+    /// rounding leaves is an origin within the band of a plane it did not start on (at a
+    /// crease); an oriented plane stops such a ray if it heads out ([`Plane::intersect`]).
+    pub fn facing(&self, starts: &[Vec3A]) -> f32 {
+        let mut sides = starts.iter().map(|&o| self.side_of(o, 0.0));
+        match sides.next() {
+            Some(first) if first != 0.0 && sides.all(|x| x == first) => first,
+            _ => 0.0,
+        }
+    }
+
     /// The side of the plane `p` lies on beyond the error band of a ray starting there with
     /// origin error `o_err`: `1` where `n.p > dist`, `-1` where `n.p < dist`, `0` within the
     /// band.
     pub fn side_of(&self, p: Vec3A, o_err: f32) -> f32 {
         let s = self.n.dot(p) - self.dist;
-        let band = self.band(&Ray {
-            o_err,
-            ..Ray::bare(p, self.n, f32::INFINITY)
-        });
-        if s.abs() <= band { 0.0 } else { s.signum() }
+        if s.abs() <= self.band_at(p, o_err) {
+            0.0
+        } else {
+            s.signum()
+        }
     }
 
     /// Distance to the plane in `(0, t_max]`; `None` for rays parallel to it, and for a ray
@@ -95,7 +114,13 @@ impl Plane {
     /// The error band of the origin's signed distance to the plane (see [`Plane::intersect`]).
     #[inline]
     pub fn band(&self, ray: &Ray) -> f32 {
-        let k = gamma(4) * ray.o.abs().max_element() + ray.o_err;
+        self.band_at(ray.o, ray.o_err)
+    }
+
+    /// [`Plane::band`] for a ray from `o` whose origin error is `o_err`.
+    #[inline]
+    fn band_at(&self, o: Vec3A, o_err: f32) -> f32 {
+        let k = gamma(4) * o.abs().max_element() + o_err;
         self.n.abs().element_sum() * k + gamma(4) * self.dist.abs()
     }
 

@@ -121,3 +121,12 @@ pub fn nearest(prims: &[rtis::accel::Prim], ray: &rtis::geometry::Ray) -> Option
     }
     best
 }
+
+/// Mark every point light of `scene` as outside the planes' room, so that its shadow rays test
+/// the planes too (the renderer skips them for lights in the room).
+pub fn lights_out_of_room(scene: &mut rtis::RenderScene) {
+    for light in &mut scene.lights {
+        let rtis::light::Light::Point(p) = light;
+        p.in_room = false;
+    }
+}
