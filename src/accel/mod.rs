@@ -5,10 +5,12 @@ pub mod block;
 mod bvh;
 pub mod lanes;
 mod prim;
+mod simd;
 pub mod wide;
 
 pub use bvh::{Bvh, Node};
 pub use prim::{FLAT, Prim};
+pub use simd::Isa;
 pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::{Hit, Ray};

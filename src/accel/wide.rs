@@ -1,10 +1,11 @@
-//! A four-wide BVH: the binary SAH tree ([`super::Bvh`]) collapsed so that each node holds the
-//! boxes of up to four children in structure-of-arrays lanes, tested against a ray in one SSE
-//! pass (`glam::Vec4`), as Embree's BVH4 does. A ray then visits about half as many nodes.
+//! An eight-wide BVH: the binary SAH tree ([`super::Bvh`]) collapsed so that each node holds
+//! the boxes of up to eight children in structure-of-arrays lanes, tested against a ray in one
+//! AVX2 pass where the CPU has it and in two SSE halves elsewhere ([`super::simd`]), as
+//! Embree's BVH8 does. A ray then visits about a third as many nodes as in the binary tree.
 //!
 //! Child boxes are quantised to 8 bits per coordinate on a grid spanning the node's box
-//! (Embree's compressed nodes, Ylitie et al. 2017), so a node is 64 bytes, one cache line, half
-//! of what full-precision boxes take. The grid rounds every box outwards, with each coordinate
+//! (Embree's compressed nodes, Ylitie et al. 2017), so a node is 128 bytes, two cache lines,
+//! about half of what full-precision boxes take. The grid rounds every box outwards, with each coordinate
 //! checked after rounding against the decoding the traversal does (`origin + q * step`, the
 //! same two operations), so a decoded box always contains the exact one: a ray can visit a few
 //! more nodes, never miss one. The slab test on the decoded boxes is
@@ -12,8 +13,9 @@
 //! direction's sign), with the reciprocal direction kept finite.
 
 use super::bvh::Node;
+use super::simd::{Isa, Lanes8, baseline::Halves};
 use crate::geometry::Ray;
-use glam::{Vec3A, Vec4};
+use glam::Vec3A;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
@@ -25,7 +27,10 @@ pub const LEAF: u32 = 1 << 31;
 /// An unused child slot, which no ray enters.
 pub const EMPTY: ChildRef = u32::MAX;
 
-/// Four child boxes, one per lane, on the node's 8-bit grid, and their references.
+/// Children per node.
+pub const WIDTH: usize = 8;
+
+/// Eight child boxes, one per lane, on the node's 8-bit grid, and their references.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct WideNode {
@@ -34,36 +39,11 @@ pub struct WideNode {
     /// The grid's step per axis (0 on an axis where the node's box is flat).
     pub step: [f32; 3],
     /// `lo[axis][slot]`: smallest corner of each child's box, in steps from the origin.
-    pub lo: [[u8; 4]; 3],
+    pub lo: [[u8; WIDTH]; 3],
     /// Largest corner of each child's box, in steps from the origin.
-    pub hi: [[u8; 4]; 3],
+    pub hi: [[u8; WIDTH]; 3],
     /// The children; unused slots are [`EMPTY`].
-    pub child: [ChildRef; 4],
-}
-
-/// Four grid coordinates as floats: two unpacks and a conversion with SSE2 (part of every
-/// x86-64 CPU), four conversions elsewhere.
-#[inline(always)]
-fn widen(q: [u8; 4]) -> Vec4 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{
-            _mm_cvtepi32_ps, _mm_cvtsi32_si128, _mm_setzero_si128, _mm_unpacklo_epi8,
-            _mm_unpacklo_epi16,
-        };
-        // SAFETY: SSE2 is in the x86-64 baseline; these intrinsics only move and convert
-        // register values.
-        unsafe {
-            let zero = _mm_setzero_si128();
-            let bytes = _mm_cvtsi32_si128(i32::from_le_bytes(q));
-            let words = _mm_unpacklo_epi8(bytes, zero);
-            Vec4::from(_mm_cvtepi32_ps(_mm_unpacklo_epi16(words, zero)))
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        Vec4::new(q[0] as f32, q[1] as f32, q[2] as f32, q[3] as f32)
-    }
+    pub child: [ChildRef; WIDTH],
 }
 
 /// The grid coordinates of `[lo, hi]` on the grid `origin + q * step`, rounded outwards: the
@@ -116,6 +96,9 @@ fn grid_step(lo: f32, hi: f32) -> f32 {
 pub struct WideBvh {
     /// Nodes, root first, each node's interior children after it.
     pub nodes: Vec<WideNode>,
+    /// The instruction set the traversals run ([`Isa::detect`] unless
+    /// [`WideBvh::set_isa`] chose another).
+    isa: Isa,
 }
 
 /// Ask the CPU to bring every cache line of `x` into its caches, so that a miss on it overlaps
@@ -141,95 +124,104 @@ pub fn prefetch<T>(x: &T) {
     let _ = x;
 }
 
-/// A ray splatted across the four lanes of a node test.
+/// A ray splatted across the eight lanes of a node test.
 #[derive(Clone, Copy)]
-struct RayBox {
-    o: [Vec4; 3],
-    inv_d: [Vec4; 3],
+struct RayBox<L> {
+    o: [L; 3],
+    inv_d: [L; 3],
     /// Per axis, true if the ray runs towards smaller coordinates: it then enters a slab by
     /// its largest side.
     back: [bool; 3],
 }
 
-impl RayBox {
+impl<L: Lanes8> RayBox<L> {
     /// The ray's origin and reciprocal direction, an infinite reciprocal (a direction parallel
     /// to an axis) replaced by the largest float of its sign: `0 * inf` would be NaN where the
     /// origin lies on a box's side, while `0 * MAX` is 0 and keeps the ray in the slab, on every
     /// platform. Otherwise only an origin outside a slab by less than about `1 / MAX` in a
     /// parallel direction enters it, which costs a visit, never a hit.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    fn new(o: Vec3A, inv_d: Vec3A) -> Self {
+    unsafe fn new(o: Vec3A, inv_d: Vec3A) -> Self {
         let inv_d = inv_d.clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX));
-        RayBox {
-            o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
-            inv_d: [
-                Vec4::splat(inv_d.x),
-                Vec4::splat(inv_d.y),
-                Vec4::splat(inv_d.z),
-            ],
-            back: inv_d.to_array().map(f32::is_sign_negative),
+        // SAFETY: the caller's.
+        unsafe {
+            RayBox {
+                o: [L::splat(o.x), L::splat(o.y), L::splat(o.z)],
+                inv_d: [L::splat(inv_d.x), L::splat(inv_d.y), L::splat(inv_d.z)],
+                back: [inv_d.x, inv_d.y, inv_d.z].map(f32::is_sign_negative),
+            }
         }
     }
 }
 
-/// Traversal stack size: a wide level leaves at most three more entries on the stack than it
-/// took (`closest` pushes three of four children and visits the fourth; `any` pops one and
-/// pushes four), and the binary tree is at most 48 + 32 levels deep (`bvh::MEDIAN_DEPTH` plus
+/// Traversal stack size: a wide level leaves at most seven more entries on the stack than it
+/// took (`closest` pushes seven of eight children and visits the eighth; `any` pops one and
+/// pushes eight), and the binary tree is at most 48 + 32 levels deep (`bvh::MEDIAN_DEPTH` plus
 /// log2 of a `u32` primitive count), so a wide tree at most 80.
-const STACK: usize = 3 * 80;
+const STACK: usize = (WIDTH - 1) * 80;
 
 impl WideNode {
-    /// Entry distances of the four children and the lanes whose box the ray enters within
+    /// Entry distances of the eight children and the lanes whose box the ray enters within
     /// `(0, t_max]`.
     ///
     /// The slab test of [`Aabb::hit`](crate::geometry::Aabb::hit) with each slab's entry and
     /// exit sides chosen by the sign of the direction (as Embree does) instead of a min and max
     /// of both. No NaN arises: [`RayBox::new`] keeps the reciprocal direction finite.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    fn hit(&self, r: &RayBox, t_max: f32) -> (Vec4, u32) {
-        let side = |axis: usize, hi: bool| {
-            let q = if hi { self.hi[axis] } else { self.lo[axis] };
-            let plane = Vec4::splat(self.origin[axis]) + widen(q) * Vec4::splat(self.step[axis]);
-            (plane - r.o[axis]) * r.inv_d[axis]
-        };
-        let enter = [0, 1, 2].map(|axis| side(axis, r.back[axis]));
-        let exit = [0, 1, 2].map(|axis| side(axis, !r.back[axis]));
-        let near = enter[0].max(enter[1].max(enter[2].max(Vec4::ZERO)));
-        let far = exit[0].min(exit[1].min(exit[2].min(Vec4::INFINITY)))
-            * Vec4::splat(1.0 + 4.0 * f32::EPSILON);
-        let ok = near.cmple(far) & near.cmple(Vec4::splat(t_max));
-        (near, ok.bitmask() & self.used())
+    unsafe fn hit<L: Lanes8>(&self, r: &RayBox<L>, t_max: f32) -> (L, u32) {
+        // SAFETY: the caller's. (No closure here: one would be compiled without the
+        // traversal's target feature and keep the AVX2 intrinsics calls.)
+        unsafe {
+            let (x, y, z) = (
+                self.side(r, 0, false),
+                self.side(r, 1, false),
+                self.side(r, 2, false),
+            );
+            let near = x.max(y.max(z.max(L::splat(0.0))));
+            let (x, y, z) = (
+                self.side(r, 0, true),
+                self.side(r, 1, true),
+                self.side(r, 2, true),
+            );
+            let far = x
+                .min(y.min(z.min(L::splat(f32::INFINITY))))
+                .mul(L::splat(1.0 + 4.0 * f32::EPSILON));
+            let ok = near.le(far) & near.le(L::splat(t_max));
+            (near, ok & L::ne_u32(&self.child, EMPTY))
+        }
     }
 
-    /// The slots (bits) that hold a child.
+    /// The distances along `r` to the eight children's entry sides on `axis` (exit sides if
+    /// `exit`): the side facing the ray's origin is the entry one.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    fn used(&self) -> u32 {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{
-                __m128i, _mm_castsi128_ps, _mm_cmpeq_epi32, _mm_loadu_si128, _mm_movemask_ps,
-                _mm_set1_epi32,
-            };
-            // SAFETY: SSE2 is in the x86-64 baseline; the load reads the 16 bytes of `child`.
-            unsafe {
-                let child = _mm_loadu_si128(self.child.as_ptr() as *const __m128i);
-                let empty = _mm_cmpeq_epi32(child, _mm_set1_epi32(EMPTY as i32));
-                !(_mm_movemask_ps(_mm_castsi128_ps(empty)) as u32) & 0b1111
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            let used = self.child.map(|c| (c != EMPTY) as u32);
-            used[0] | used[1] << 1 | used[2] << 2 | used[3] << 3
+    unsafe fn side<L: Lanes8>(&self, r: &RayBox<L>, axis: usize, exit: bool) -> L {
+        let q = if r.back[axis] != exit {
+            &self.hi[axis]
+        } else {
+            &self.lo[axis]
+        };
+        // SAFETY: the caller's.
+        unsafe {
+            let plane = L::splat(self.origin[axis]).add(L::widen(q).mul(L::splat(self.step[axis])));
+            plane.sub(r.o[axis]).mul(r.inv_d[axis])
         }
     }
 }
 
 impl WideBvh {
     /// Collapse a binary tree (nodes in the layout of [`super::Bvh`]: an interior node's first
-    /// child follows it and `index` is its second) into four-wide nodes. Each wide node takes a
+    /// child follows it and `index` is its second) into eight-wide nodes. Each wide node takes a
     /// binary node's children and keeps opening the largest interior one among them until it
-    /// has four, so the levels it skips are those a ray would most often visit.
+    /// has eight, so the levels it skips are those a ray would most often visit.
     ///
     /// Returns the tree and its leaves, each a binary leaf's `(first, count)`: a leaf child's
     /// payload is its index there. Leaves and nodes come in depth-first order; the top levels'
@@ -244,10 +236,18 @@ impl WideBvh {
             // A single leaf: a root with one child.
             let node = WideNode::from_children(binary, &[0], &[LEAF]);
             let leaves = vec![(root.index as usize, root.count as usize)];
-            return (WideBvh { nodes: vec![node] }, leaves);
+            let bvh = WideBvh {
+                nodes: vec![node],
+                isa: Isa::detect(),
+            };
+            return (bvh, leaves);
         }
         let part = collapse_part(binary, 0, PARALLEL_LEVELS);
-        (WideBvh { nodes: part.nodes }, part.leaves)
+        let bvh = WideBvh {
+            nodes: part.nodes,
+            isa: Isa::detect(),
+        };
+        (bvh, part.leaves)
     }
 
     /// Nearest primitive hit: its index and distance. `test(leaf, ray)` is the nearest hit in
@@ -262,6 +262,81 @@ impl WideBvh {
     pub fn closest(
         &self,
         ray: &Ray,
+        test: impl FnMut(u32, &Ray) -> Option<(u32, f32)>,
+        touch: impl Fn(u32),
+    ) -> Option<(u32, f32)> {
+        match self.isa {
+            // SAFETY: `set_isa` and `detect` only choose AVX2 where the CPU has it.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => unsafe { self.closest_avx2(ray, test, touch) },
+            // SAFETY: the baseline runs on every CPU.
+            _ => unsafe { self.closest_in::<Halves>(ray, test, touch) },
+        }
+    }
+
+    /// True if `test(leaf, ray)` holds for some leaf whose box the ray enters within
+    /// `(0, ray.t_max]` (any-hit query for shadow rays).
+    #[inline]
+    pub fn any(&self, ray: &Ray, test: impl FnMut(u32, &Ray) -> bool) -> bool {
+        match self.isa {
+            // SAFETY: `set_isa` and `detect` only choose AVX2 where the CPU has it.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => unsafe { self.any_avx2(ray, test) },
+            // SAFETY: the baseline runs on every CPU.
+            _ => unsafe { self.any_in::<Halves>(ray, test) },
+        }
+    }
+
+    /// The instruction set the traversals run.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// Run the traversals in `isa` from now on, if this CPU has it; returns whether it does
+    /// (the answers are the same in every instruction set, only the speed differs).
+    pub fn set_isa(&mut self, isa: Isa) -> bool {
+        let ok = isa.available();
+        if ok {
+            self.isa = isa;
+        }
+        ok
+    }
+
+    /// [`WideBvh::closest`] compiled for AVX2, with the leaf test inlined into it.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn closest_avx2(
+        &self,
+        ray: &Ray,
+        test: impl FnMut(u32, &Ray) -> Option<(u32, f32)>,
+        touch: impl Fn(u32),
+    ) -> Option<(u32, f32)> {
+        // SAFETY: the caller's.
+        unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch) }
+    }
+
+    /// [`WideBvh::any`] compiled for AVX2, with the leaf test inlined into it.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn any_avx2(&self, ray: &Ray, test: impl FnMut(u32, &Ray) -> bool) -> bool {
+        // SAFETY: the caller's.
+        unsafe { self.any_in::<super::simd::avx2::Avx2>(ray, test) }
+    }
+
+    /// [`WideBvh::closest`] with the node test in lanes `L`.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn closest_in<L: Lanes8>(
+        &self,
+        ray: &Ray,
         mut test: impl FnMut(u32, &Ray) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
@@ -269,7 +344,8 @@ impl WideBvh {
             return None;
         }
         let mut r = *ray;
-        let rb = RayBox::new(ray.o, ray.inv_d);
+        // SAFETY: the caller's.
+        let rb = unsafe { RayBox::<L>::new(ray.o, ray.inv_d) };
         let mut best = None;
         // Test leaf `c`; a hit shortens the ray and becomes the best so far.
         let mut leaf = |c: u32, r: &mut Ray, best: &mut Option<(u32, f32)>| {
@@ -283,7 +359,8 @@ impl WideBvh {
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
-            let (near, mut mask) = n.hit(&rb, r.t_max);
+            // SAFETY: the caller's.
+            let (near, mut mask) = unsafe { n.hit(&rb, r.t_max) };
             // One child entered (the common case for coherent rays): no ordering to do.
             if mask != 0 && mask & (mask - 1) == 0 {
                 let c = n.child[mask.trailing_zeros() as usize];
@@ -294,9 +371,10 @@ impl WideBvh {
                 leaf(c, &mut r, &mut best);
                 mask = 0;
             }
-            let near = near.to_array();
-            // The hit children, farthest first (insertion into at most four).
-            let mut next: [(u32, f32); 4] = [(0, 0.0); 4];
+            // SAFETY: the caller's.
+            let near = unsafe { near.to_array() };
+            // The hit children, farthest first (insertion into at most eight).
+            let mut next: [(u32, f32); WIDTH] = [(0, 0.0); WIDTH];
             let mut k = 0;
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
@@ -362,20 +440,24 @@ impl WideBvh {
         }
     }
 
-    /// True if `test(leaf, ray)` holds for some leaf whose box the ray enters within
-    /// `(0, ray.t_max]` (any-hit query for shadow rays).
-    #[inline]
-    pub fn any(&self, ray: &Ray, mut test: impl FnMut(u32, &Ray) -> bool) -> bool {
+    /// [`WideBvh::any`] with the node test in lanes `L`.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn any_in<L: Lanes8>(&self, ray: &Ray, mut test: impl FnMut(u32, &Ray) -> bool) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        let rb = RayBox::new(ray.o, ray.inv_d);
+        // SAFETY: the caller's.
+        let rb = unsafe { RayBox::<L>::new(ray.o, ray.inv_d) };
         let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
         let mut sp = 0usize;
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];
-            let (_, mut mask) = n.hit(&rb, ray.t_max);
+            // SAFETY: the caller's.
+            let (_, mut mask) = unsafe { n.hit(&rb, ray.t_max) };
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -410,9 +492,9 @@ impl WideNode {
         let mut node = WideNode {
             origin: [0.0; 3],
             step: [0.0; 3],
-            lo: [[0; 4]; 3],
-            hi: [[0; 4]; 3],
-            child: [EMPTY; 4],
+            lo: [[0; WIDTH]; 3],
+            hi: [[0; WIDTH]; 3],
+            child: [EMPTY; WIDTH],
         };
         if kids.is_empty() {
             return node;
@@ -440,7 +522,7 @@ impl WideNode {
     /// The decoded box of child `slot` (what the traversal tests), or `None` if unused.
     pub fn child_box(&self, slot: usize) -> Option<(glam::Vec3, glam::Vec3)> {
         (self.child[slot] != EMPTY).then(|| {
-            let decode = |q: [[u8; 4]; 3]| {
+            let decode = |q: [[u8; WIDTH]; 3]| {
                 glam::Vec3::from_array(
                     [0, 1, 2].map(|a| self.origin[a] + q[a][slot] as f32 * self.step[a]),
                 )
@@ -450,8 +532,8 @@ impl WideNode {
     }
 }
 
-/// Wide levels whose subtrees are collapsed in parallel (up to 4^3 = 64 tasks).
-const PARALLEL_LEVELS: u32 = 3;
+/// Wide levels whose subtrees are collapsed in parallel (up to 8^2 = 64 tasks).
+const PARALLEL_LEVELS: u32 = 2;
 
 /// A collapsed subtree, its root first, with node indices and leaf payloads counted from 0.
 struct Part {
@@ -459,16 +541,18 @@ struct Part {
     leaves: Vec<(usize, usize)>,
 }
 
-/// The up to four binary nodes a wide node over binary interior node `i` takes as children:
-/// `i`'s two, then the largest interior one among them opened until there are four, kept in
+/// The up to eight binary nodes a wide node over binary interior node `i` takes as children:
+/// `i`'s two, then the largest interior one among them opened until there are eight, kept in
 /// tree order.
-fn children(binary: &[Node], i: usize) -> ([usize; 4], usize) {
+fn children(binary: &[Node], i: usize) -> ([usize; WIDTH], usize) {
     let area = |k: usize| {
         let d = binary[k].max - binary[k].min;
         d.x * d.y + d.y * d.z + d.z * d.x
     };
-    let (mut kids, mut n) = ([i + 1, binary[i].index as usize, 0, 0], 2);
-    while n < 4 {
+    let mut kids = [0; WIDTH];
+    (kids[0], kids[1]) = (i + 1, binary[i].index as usize);
+    let mut n = 2;
+    while n < WIDTH {
         let open = (0..n)
             .filter(|&k| binary[kids[k]].count == 0)
             .max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
@@ -500,7 +584,7 @@ fn collapse_part(binary: &[Node], i: usize, levels: u32) -> Part {
         .map(|&k| (binary[k].count == 0).then(|| collapse_part(binary, k, levels - 1)))
         .collect();
     part.nodes.push(WideNode::from_children(binary, &[], &[]));
-    let mut refs = [EMPTY; 4];
+    let mut refs = [EMPTY; WIDTH];
     for ((r, &k), sub) in refs.iter_mut().zip(&kids[..n]).zip(subs) {
         *r = match sub {
             None => {
@@ -536,7 +620,7 @@ fn collapse_node(
     let (kids, n) = children(binary, i);
     let me = out.len();
     out.push(WideNode::from_children(binary, &[], &[]));
-    let mut refs = [EMPTY; 4];
+    let mut refs = [EMPTY; WIDTH];
     for (r, &k) in refs.iter_mut().zip(&kids[..n]) {
         let node = binary[k];
         *r = if node.count > 0 {

@@ -5,7 +5,7 @@ use clap::Args;
 use glam::{Vec3, Vec3A};
 use rtis::RenderScene;
 use rtis::accel::block::Block;
-use rtis::accel::{Attrs, Geometry, Prim, WideNode};
+use rtis::accel::{Attrs, Geometry, Isa, Prim, WideNode};
 use rtis::converge::{reference_shader, with_settings};
 use rtis::geometry::Ray;
 use rtis::mesh::displaced_sphere;
@@ -44,6 +44,37 @@ pub struct BenchArgs {
     /// `mesh-N.coherent.f32` and `mesh-N.incoherent.f32` (ox oy oz dx dy dz per ray).
     #[arg(long)]
     dump: Option<std::path::PathBuf>,
+    /// Instruction set of the meshes section's BVH node test: the widest this CPU runs
+    /// (auto), or one named, to measure what it is worth. The answers are the same in each.
+    #[arg(long, value_enum, default_value_t = IsaArg::Auto)]
+    isa: IsaArg,
+}
+
+/// `--isa`: the node test's instruction set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum IsaArg {
+    /// The widest this CPU runs.
+    Auto,
+    /// Two four-lane SSE2 halves (any x86-64 CPU).
+    Baseline,
+    /// One eight-lane AVX2 register.
+    Avx2,
+}
+
+impl IsaArg {
+    /// The instruction set meant, or an error if this CPU does not run it.
+    fn isa(self) -> Result<Isa, CliError> {
+        let isa = match self {
+            IsaArg::Auto => return Ok(Isa::detect()),
+            IsaArg::Baseline => Isa::Baseline,
+            IsaArg::Avx2 => Isa::Avx2,
+        };
+        if isa.available() {
+            Ok(isa)
+        } else {
+            Err(format!("--isa {}: this CPU does not run it", isa.name()).into())
+        }
+    }
 }
 
 /// One figure of the bench: a table row, or with `--json` a JSON line.
@@ -262,12 +293,16 @@ impl std::fmt::Debug for BuiltOnce {
 /// 1M triangles (a displaced sphere of radius 1 at the origin).
 fn meshes_section(
     json: bool,
+    isa: Isa,
     runs: u32,
     sizes: &[u32],
     dump: Option<&std::path::Path>,
 ) -> Result<(), CliError> {
     if !json {
-        println!("-- meshes: displaced sphere, 1M rays of each kind");
+        println!(
+            "-- meshes: displaced sphere, 1M rays of each kind, node test in {}",
+            isa.name()
+        );
         println!(
             "{:>9} {:>9} {:>8} {:>9} {:>10} {:>10} {:>10} {:>12}",
             "triangles",
@@ -298,7 +333,8 @@ fn meshes_section(
             let g = Geometry::build(prims, Vec::new());
             (start.elapsed().as_secs_f64(), BuiltOnce(g))
         });
-        let g = g.0;
+        let mut g = g.0;
+        assert!(g.bvh.set_isa(isa), "checked by IsaArg::isa");
         let nodes = g.bvh.nodes.len();
         // The tree's nodes and its leaves' blocks of lanes.
         let bvh_bytes = (nodes * std::mem::size_of::<WideNode>()
@@ -352,7 +388,8 @@ fn meshes_section(
             dump_work(dir, n, &mesh, &camera, &incoherent)?;
         }
         let row = serde_json::json!({
-            "section": "meshes", "engine": "rtis", "triangles": count, "build_s": build,
+            "section": "meshes", "engine": "rtis", "isa": isa.name(), "triangles": count,
+            "build_s": build,
             "nodes": nodes, "threads": rayon::current_num_threads(),
             "bvh_bytes_per_triangle": bvh_bytes, "attribute_bytes_per_triangle": prim_bytes,
             "bytes_per_triangle": bvh_bytes + prim_bytes,
@@ -425,7 +462,13 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     });
     let wants = |s: Section| a.section == Section::All || a.section == s;
     if wants(Section::Meshes) {
-        meshes_section(a.json, a.runs, &a.triangles, a.dump.as_deref())?;
+        meshes_section(
+            a.json,
+            a.isa.isa()?,
+            a.runs,
+            &a.triangles,
+            a.dump.as_deref(),
+        )?;
     }
     if wants(Section::Effects) {
         effects_section(&a.scenes, a.runs, a.shrink, a.json)?;

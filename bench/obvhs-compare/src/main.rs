@@ -57,7 +57,7 @@ fn main() {
             + g.attrs.len() * std::mem::size_of::<Attrs>()) as f64
             / count as f64;
         let (r, hits) = rate(&rays, |o, d| g.intersect(&Ray::new(o, d)).is_some());
-        line(count, "rtis BVH4, quantised", build, bytes, r, hits);
+        line(count, "rtis BVH8, quantised", build, bytes, r, hits);
         // obvhs.
         let otris: Vec<obvhs::triangle::Triangle> = tris
             .iter()
