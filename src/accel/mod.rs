@@ -68,7 +68,7 @@ pub struct Geometry {
     pub others: Vec<Prim>,
     /// How many primitives the BVH holds.
     pub in_bvh: usize,
-    /// Four-wide BVH; a leaf's payload indexes `blocks`.
+    /// Eight-wide BVH; a leaf's payload indexes `blocks`.
     pub bvh: WideBvh,
     /// The BVH's leaves, each with its triangles in lanes.
     pub blocks: Vec<Block>,
