@@ -518,13 +518,13 @@ impl WideNode {
         }
         let inv_step = node.step.map(|s| 1.0 / s);
         for (slot, (&k, &c)) in kids.iter().zip(refs).enumerate() {
-            for axis in 0..3 {
+            for (axis, &inv) in inv_step.iter().enumerate() {
                 let (ql, qh) = quantize(
                     binary[k].min[axis],
                     binary[k].max[axis],
                     node.origin[axis],
                     node.step[axis],
-                    inv_step[axis],
+                    inv,
                 );
                 node.lo[axis][slot] = ql;
                 node.hi[axis][slot] = qh;
