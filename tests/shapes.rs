@@ -217,6 +217,15 @@ proptest! {
         }
         let bvh = Geometry::build(prims(&many), Vec::new());
         prop_assert!(!packed.spheres.packs.is_empty() && bvh.in_bvh > 0);
+        // The BVH in every instruction set this CPU runs: the same answers to the bit.
+        let isas: Vec<Geometry> = rtis::accel::Isa::all_available()
+            .into_iter()
+            .map(|isa| {
+                let mut g = bvh.clone();
+                assert!(g.bvh.set_isa(isa));
+                g
+            })
+            .collect();
         let scalar = |ray: &Ray| -> Option<(usize, f32)> {
             shapes.iter().enumerate().filter_map(|(i, sh)| sh.intersect(ray).map(|t| (i, t)))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
@@ -231,6 +240,11 @@ proptest! {
             let want = scalar(&ray).map(|(_, t)| t);
             let got_packed = packed.intersect(&ray).map(|h| h.t);
             let got_bvh = bvh.intersect(&ray).map(|h| h.t);
+            for g in &isas {
+                let hit = g.intersect(&ray).map(|h| (h.prim, h.t.to_bits()));
+                prop_assert_eq!(hit, bvh.intersect(&ray).map(|h| (h.prim, h.t.to_bits())));
+                prop_assert_eq!(g.occluded(&ray), bvh.occluded(&ray), "{:?}", g.bvh.isa());
+            }
             prop_assert_eq!(want, got_packed, "packets");
             prop_assert_eq!(want.is_some(), got_bvh.is_some(), "BVH");
             if let (Some(a), Some(b)) = (want, got_bvh) {
