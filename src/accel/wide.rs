@@ -714,9 +714,18 @@ mod tests {
             let (lo, hi) = (decode(lo as u8).max(origin + lo * step), origin + hi * step);
             let hi = hi.min(decode(255)).max(lo);
             let (ql, qh) = quantize(lo, hi, origin, step, 1.0 / step);
-            assert!(decode(ql) <= lo && decode(qh) >= hi, "{lo} {hi} on {origin} + q {step}");
-            assert!(ql == 255 || decode(ql + 1) > lo, "{lo}: {ql} not the largest");
-            assert!(qh == 0 || decode(qh - 1) < hi, "{hi}: {qh} not the smallest");
+            assert!(
+                decode(ql) <= lo && decode(qh) >= hi,
+                "{lo} {hi} on {origin} + q {step}"
+            );
+            assert!(
+                ql == 255 || decode(ql + 1) > lo,
+                "{lo}: {ql} not the largest"
+            );
+            assert!(
+                qh == 0 || decode(qh - 1) < hi,
+                "{hi}: {qh} not the smallest"
+            );
         }
     }
 
