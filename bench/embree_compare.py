@@ -20,8 +20,15 @@ and size, then one line of ratios:
 
 The temporary folder is removed at the end.
 
-How each engine is measured (every time on both sides is the median of --runs, default 5,
-builds or ray passes: on a shared machine single timings vary by tens of percent):
+How the runs are paired: the machine's speed drifts by tens of percent over minutes, so the
+engines take turns. For each size, --runs (default 5) rounds each run rtis once (a fresh
+`rtis bench` process) and Embree once (a fresh worker process), in alternating order (rtis
+first in even rounds); in a round each engine builds three times and traces each ray set three
+times (ROUND_RUNS), after a throw-away warm-up build, and reports the medians. Each engine's
+line gives the median of its rounds' figures; the ratio line gives the median of the rounds'
+ratios, each taken between two measurements seconds apart.
+
+How each engine is measured:
 
 - build_s. rtis: its BVH build (rayon, --threads threads), from triangles already set up.
   Embree: the scene commit, i.e. its BVH build, which runs on TBB's worker pool over all the
@@ -84,6 +91,10 @@ CHUNK = 16384
 HIT_TOLERANCE = 1e-4
 # Embree scenes built per mesh for the memory reading (the largest is kept).
 MEMORY_BUILDS = 3
+# Builds and passes of each ray set per engine in one round; the round's figures are their
+# medians. Three on both sides: Embree's worker builds MEMORY_BUILDS scenes anyway, and a
+# process's first build is the slowest on both sides.
+ROUND_RUNS = 3
 
 
 def fail(message):
@@ -204,7 +215,8 @@ def main():
                    help="ray-tracing threads for both engines, one run per count "
                    f"(default: all available, here {available_threads()})")
     p.add_argument("--runs", type=int, default=5,
-                   help="builds and ray passes per engine and mesh; each figure is their median "
+                   help="rounds per mesh, the engines taking turns (each builds and traces "
+                   f"{ROUND_RUNS} times per round); each figure is the median over the rounds "
                    "(default 5: on a shared machine single timings vary by tens of percent)")
     p.add_argument("--rtis", default=os.path.join(ROOT, "target", "release", "rtis"),
                    help="rtis binary (default target/release/rtis)")
@@ -226,9 +238,21 @@ def main():
     sizes = list(dict.fromkeys(a.triangles))
     with tempfile.TemporaryDirectory(prefix="rtis-embree-") as dump:
         for t_index, threads in enumerate(threads_list):
-            rtis_rows = run_rtis(a.rtis, sizes, threads, dump if t_index == 0 else None, a.runs)
-            for n, r in zip(sizes, rtis_rows):
-                compare(n, r, run_worker(dump, n, threads, a.runs))
+            for n in sizes:
+                rounds = []
+                for k in range(a.runs):
+                    # The first round of the first thread count writes the mesh and rays.
+                    write = dump if t_index == 0 and k == 0 else None
+                    ours = lambda: run_rtis(a.rtis, [n], threads, write, ROUND_RUNS)[0]  # noqa: E731
+                    theirs = lambda: run_worker(dump, n, threads, ROUND_RUNS)  # noqa: E731
+                    if k % 2 == 0:
+                        r = ours()
+                        e = theirs()
+                    else:
+                        e = theirs()
+                        r = ours()
+                    rounds.append((r, e))
+                compare(n, rounds)
 
 
 def run_worker(dump, n, threads, runs):
@@ -245,8 +269,24 @@ def run_worker(dump, n, threads, runs):
         fail(f"the Embree measurement of mesh-{n} printed no JSON: {r.stdout!r}")
 
 
-def compare(n, r, e):
-    """Print rtis's row, Embree's row and their ratios for mesh-N; warn if the hits differ."""
+def median_row(rows):
+    """The first row with each numeric figure replaced by its median over `rows`, except the
+    byte counts, replaced by their largest (Embree's readings can only be low: see
+    measure_embree; rtis's are the same in every round)."""
+    out = dict(rows[0])
+    for k, v in out.items():
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            values = [row[k] for row in rows]
+            out[k] = max(values) if k.endswith("bytes_per_triangle") else median(values)
+    return out
+
+
+def compare(n, rounds):
+    """Print rtis's row, Embree's row (medians over the rounds) and the medians of the rounds'
+    ratios for mesh-N; warn if the hits differ."""
+    r = median_row([r for r, _ in rounds])
+    e = median_row([e for _, e in rounds])
+    e["rounds"] = len(rounds)
     if e["triangles"] != r["triangles"]:
         print(f"embree_compare: warning: mesh-{n} has {e['triangles']} faces, "
               f"rtis kept {r['triangles']} triangles", file=sys.stderr)
@@ -263,16 +303,28 @@ def compare(n, r, e):
                   file=sys.stderr)
     print(json.dumps(ours), flush=True)
     print(json.dumps(e), flush=True)
-    print(json.dumps({
+
+    ratios = {
+        "embree_over_rtis_build_s": lambda r, e: e["build_s"] / r["build_s"],
+        "rtis_over_embree_incoherent_mrays":
+            lambda r, e: r["incoherent_mrays"] / e["incoherent_mrays"],
+        "rtis_over_embree_coherent_mrays": lambda r, e: r["coherent_mrays"] / e["coherent_mrays"],
+        # Against the largest of Embree's readings (median_row), as its line reports.
+        "rtis_over_embree_bytes_per_triangle":
+            lambda r, _: r["bytes_per_triangle"] / e["bytes_per_triangle"],
+    }
+    line = {
         "ratio": "rtis_vs_embree",
         "triangles": ours["triangles"],
         "threads": ours["threads"],
-        "embree_over_rtis_build_s": e["build_s"] / ours["build_s"],
-        "rtis_over_embree_incoherent_mrays": ours["incoherent_mrays"] / e["incoherent_mrays"],
-        "rtis_over_embree_coherent_mrays": ours["coherent_mrays"] / e["coherent_mrays"],
-        "rtis_over_embree_bytes_per_triangle":
-            ours["bytes_per_triangle"] / e["bytes_per_triangle"],
-    }), flush=True)
+        "rounds": len(rounds),
+    }
+    for name, f in ratios.items():
+        each = [f(r, e) for r, e in rounds]
+        line[name] = median(each)
+        # The spread of the rounds' ratios: how far one round can be trusted.
+        line[name + "_range"] = [min(each), max(each)]
+    print(json.dumps(line), flush=True)
 
 
 def embree_worker(dump, n, threads, runs):

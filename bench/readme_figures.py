@@ -253,7 +253,7 @@ def embree(_runs):
                 f"{r['rtis_over_embree_bytes_per_triangle']:.2f}x | {r['rtis_over_embree_coherent_mrays']:.2f}x | "
                 f"{r['rtis_over_embree_incoherent_mrays']:.2f}x |"
             )
-    return "\n".join(lines + ["", stamp(f"`bench/embree_compare.py` (Embree {version}, embreex; medians of 5 builds and passes on both sides)")])
+    return "\n".join(lines + ["", stamp(f"`bench/embree_compare.py` (Embree {version}, embreex; 5 rounds, the engines taking turns: medians, and ratios the medians of the rounds' ratios)")])
 
 
 def mitsuba(_runs):

@@ -320,6 +320,13 @@ fn meshes_section(
     } else {
         sizes
     };
+    // Warm-up: a throw-away build big enough to run in parallel, so that rayon's workers exist
+    // before the first measured build (as bench/embree_compare.py warms Embree's TBB workers
+    // with a throw-away scene of 30,000 triangles).
+    drop(Geometry::build(
+        Prim::flat_triangles(&displaced_sphere(30_000, Vec3::ZERO, 1.0, 0.05)),
+        Vec::new(),
+    ));
     for &n in sizes {
         let mesh = displaced_sphere(n as usize, Vec3::ZERO, 1.0, 0.05);
         let prims = Prim::flat_triangles(&mesh);
