@@ -241,7 +241,8 @@ def main():
             for n in sizes:
                 rounds = []
                 for k in range(a.runs):
-                    # The first round of the first thread count writes the mesh and rays.
+                    # The first round of the first thread count writes the mesh and rays; rtis
+                    # goes first in it (k = 0 is even), before the Embree worker reads them.
                     write = dump if t_index == 0 and k == 0 else None
                     ours = lambda: run_rtis(a.rtis, [n], threads, write, ROUND_RUNS)[0]  # noqa: E731
                     theirs = lambda: run_worker(dump, n, threads, ROUND_RUNS)  # noqa: E731
@@ -291,9 +292,9 @@ def compare(n, rounds):
         print(f"embree_compare: warning: mesh-{n} has {e['triangles']} faces, "
               f"rtis kept {r['triangles']} triangles", file=sys.stderr)
     ours = {"engine": "rtis"}
-    for k in ("triangles", "threads", "build_s", "bytes_per_triangle", "incoherent_mrays",
+    for k in ("isa", "triangles", "threads", "build_s", "bytes_per_triangle", "incoherent_mrays",
               "coherent_mrays", "coherent_hits", "incoherent_hits"):
-        ours[k] = r[k]
+        ours[k] = r.get(k) if k == "isa" else r[k]  # older binaries print no isa
     ours["build_threads"] = r["threads"]  # rtis builds its BVH with rayon too
     for kind in ("coherent", "incoherent"):
         rays = e[f"{kind}_rays"]
@@ -304,6 +305,7 @@ def compare(n, rounds):
     print(json.dumps(ours), flush=True)
     print(json.dumps(e), flush=True)
 
+    embree_bytes = e["bytes_per_triangle"]
     ratios = {
         "embree_over_rtis_build_s": lambda r, e: e["build_s"] / r["build_s"],
         "rtis_over_embree_incoherent_mrays":
@@ -311,7 +313,7 @@ def compare(n, rounds):
         "rtis_over_embree_coherent_mrays": lambda r, e: r["coherent_mrays"] / e["coherent_mrays"],
         # Against the largest of Embree's readings (median_row), as its line reports.
         "rtis_over_embree_bytes_per_triangle":
-            lambda r, _: r["bytes_per_triangle"] / e["bytes_per_triangle"],
+            lambda r, _: r["bytes_per_triangle"] / embree_bytes,
     }
     line = {
         "ratio": "rtis_vs_embree",

@@ -6,7 +6,7 @@
 mod common;
 
 use glam::{Vec3, Vec3A};
-use rtis::accel::{Bvh, Isa, Prim, WideBvh, wide};
+use rtis::accel::{Bvh, Isa, Prim, WideBvh, require_all_isas, wide};
 use rtis::geometry::Ray;
 use rtis::mesh::displaced_sphere;
 use rtis::sampling::Sampler;
@@ -390,6 +390,7 @@ fn wide_tree_finds_what_the_binary_tree_finds() {
 /// and the test says so.)
 #[test]
 fn every_instruction_set_visits_the_same_leaves() {
+    require_all_isas();
     let g = build(mesh_prims(20_000));
     let (wide, ranges) = collapse(&g.bvh);
     let trees = each_isa(&wide);
@@ -425,6 +426,8 @@ fn every_instruction_set_visits_the_same_leaves() {
                 log.borrow_mut().push(b | 1 << 30);
                 leaf(b, r).is_some()
             });
+            // The distance to the bit.
+            let hit = hit.map(|(p, t)| (p, t.to_bits()));
             (hit, blocked, log.into_inner())
         };
         let base = trace(&trees[0]);

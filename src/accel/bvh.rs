@@ -1,9 +1,9 @@
 //! A binary bounding volume hierarchy built with the binned surface-area heuristic (costs in
 //! blocks of four primitives) into an array of 32-byte nodes, the root first and each interior
 //! node's first child after it. The renderer collapses the sparse array the build writes
-//! ([`Bvh::build_sparse`]) into the four-wide tree of [`super::wide`]; [`Bvh::build`] compacts it
-//! in depth-first order, and its `closest` and `any` traversals are the reference the wide
-//! tree is tested against.
+//! ([`Bvh::build_sparse`]) into the eight-wide tree of [`super::wide`]; [`Bvh::build`]
+//! compacts it in depth-first order, and its `closest` and `any` traversals are the reference
+//! the wide tree is tested against.
 
 use super::prim::Prim;
 use crate::geometry::{Aabb, Ray};

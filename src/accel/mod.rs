@@ -10,7 +10,7 @@ pub mod wide;
 
 pub use bvh::{Bvh, Node};
 pub use prim::{FLAT, Prim};
-pub use simd::Isa;
+pub use simd::{Isa, require_all_isas};
 pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::{Hit, Ray};

@@ -5,9 +5,10 @@
 //!
 //! Child boxes are quantised to 8 bits per coordinate on a grid spanning the node's box
 //! (Embree's compressed nodes, Ylitie et al. 2017), so a node is 128 bytes, two cache lines,
-//! about half of what full-precision boxes take. The grid rounds every box outwards, with each coordinate
-//! checked after rounding against the decoding the traversal does (`origin + q * step`, the
-//! same two operations), so a decoded box always contains the exact one: a ray can visit a few
+//! about half of what full-precision boxes take. The grid rounds every box outwards, with each
+//! coordinate checked after rounding against the decoding the traversal does (`origin + q *
+//! step`, the same two operations), so a decoded box always contains the exact one: a ray can
+//! visit a few
 //! more nodes, never miss one. The slab test on the decoded boxes is
 //! [`Aabb::hit`](crate::geometry::Aabb::hit)'s, lane by lane (entry and exit sides chosen by the
 //! direction's sign), with the reciprocal direction kept finite.
@@ -50,7 +51,7 @@ pub struct WideNode {
 /// decoded interval contains `[lo, hi]`, which lies within `[origin, origin + 255 step]`, and
 /// is the tightest that does (the largest `q` decoding to at most `lo`, the smallest decoding to
 /// at least `hi`). `inv_step` is `1 / step`, computed once per node: the estimate it gives can
-/// be a step off near a grid line, which the decoding checks after it correct.
+/// be a step off near a grid line, and the decoding checks that follow correct it.
 fn quantize(lo: f32, hi: f32, origin: f32, step: f32, inv_step: f32) -> (u8, u8) {
     let decode = |q: u8| origin + q as f32 * step;
     if step == 0.0 {
@@ -278,8 +279,10 @@ impl WideBvh {
         test: impl FnMut(u32, &Ray) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
+        debug_assert!(self.isa.available());
         match self.isa {
-            // SAFETY: `set_isa` and `detect` only choose AVX2 where the CPU has it.
+            // SAFETY: `isa` is private to this file and set only by `collapse` and `Default`
+            // (both `Isa::detect`) and by `set_isa`, which checks: AVX2 only where the CPU has it.
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => unsafe { self.closest_avx2(ray, test, touch) },
             // SAFETY: the baseline runs on every CPU.
@@ -291,8 +294,10 @@ impl WideBvh {
     /// `(0, ray.t_max]` (any-hit query for shadow rays).
     #[inline]
     pub fn any(&self, ray: &Ray, test: impl FnMut(u32, &Ray) -> bool) -> bool {
+        debug_assert!(self.isa.available());
         match self.isa {
-            // SAFETY: `set_isa` and `detect` only choose AVX2 where the CPU has it.
+            // SAFETY: `isa` is private to this file and set only by `collapse` and `Default`
+            // (both `Isa::detect`) and by `set_isa`, which checks: AVX2 only where the CPU has it.
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => unsafe { self.any_avx2(ray, test) },
             // SAFETY: the baseline runs on every CPU.
@@ -626,6 +631,12 @@ fn collapse_part(binary: &[Node], i: usize, levels: u32) -> Part {
                 LEAF | (part.leaves.len() - 1) as u32
             }
             Some(sub) => {
+                // Within the bounds `collapse_node` checks for one subtree, now for the join.
+                assert!(
+                    part.nodes.len() + sub.nodes.len() < LEAF as usize
+                        && part.leaves.len() + sub.leaves.len() < (LEAF - 1) as usize,
+                    "at most 2^31 - 1 nodes and leaves"
+                );
                 let (node_at, leaf_at) = (part.nodes.len() as u32, part.leaves.len() as u32);
                 part.nodes.extend(sub.nodes.into_iter().map(|mut node| {
                     for c in node.child.iter_mut().filter(|c| **c != EMPTY) {

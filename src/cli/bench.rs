@@ -454,6 +454,8 @@ fn dump_work(
 
 /// Run `rtis bench`.
 pub fn run(a: BenchArgs) -> Result<(), CliError> {
+    // Refused before any figure, whichever sections run.
+    let isa = a.isa.isa()?;
     let threads = rayon::current_num_threads();
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     let head = serde_json::json!({
@@ -469,13 +471,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     });
     let wants = |s: Section| a.section == Section::All || a.section == s;
     if wants(Section::Meshes) {
-        meshes_section(
-            a.json,
-            a.isa.isa()?,
-            a.runs,
-            &a.triangles,
-            a.dump.as_deref(),
-        )?;
+        meshes_section(a.json, isa, a.runs, &a.triangles, a.dump.as_deref())?;
     }
     if wants(Section::Effects) {
         effects_section(&a.scenes, a.runs, a.shrink, a.json)?;

@@ -1,9 +1,10 @@
 //! [`Lanes8`] in one AVX2 register.
 //!
-//! Every method is unsafe: its caller must have found AVX2 ([`super::Isa::available`]),. The methods are `#[inline(always)]` without a
-//! target feature of their own, so that they and the intrinsics in them inline into the wide
-//! BVH's AVX2 traversals (which enable AVX2); a closure between the two would be compiled
-//! without it and keep every intrinsic a call, so the node test has none.
+//! Every method is unsafe: its caller must have found AVX2 ([`super::Isa::available`]). The
+//! methods are `#[inline(always)]` without a target feature of their own, so that they and the
+//! intrinsics in them inline into the wide BVH's AVX2 traversals (which enable AVX2); a closure
+//! between the two would be compiled without it and keep every intrinsic a call, so the node
+//! test has none.
 
 use super::Lanes8;
 use std::arch::x86_64::*;

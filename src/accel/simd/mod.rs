@@ -71,10 +71,9 @@ impl Default for Isa {
 /// to the bit.
 ///
 /// # Safety
-/// Every method may use its instruction set: callers must have checked that the CPU runs it
-/// (for [`Isa::Avx2`], [`Isa::available`]). The methods are unsafe so that the AVX2 ones can
-/// be compiled with AVX2 enabled, and so inlined into the AVX2 traversals; a safe method
-/// calling the intrinsics would stay a call per operation.
+/// Every method may run instructions of its set, which only the caller can vouch for: callers
+/// must have checked that the CPU runs it (for [`Isa::Avx2`], [`Isa::available`]). The
+/// baseline's methods are unsafe only because the trait's are.
 pub trait Lanes8: Copy {
     /// `x` in every lane.
     unsafe fn splat(x: f32) -> Self;
@@ -96,4 +95,103 @@ pub trait Lanes8: Copy {
     unsafe fn to_array(self) -> [f32; 8];
     /// The lanes (bits 0 to 7) of `x` that differ from `v`.
     unsafe fn ne_u32(x: &[u32; 8], v: u32) -> u32;
+}
+
+/// For tests that compare instruction sets: panics if the environment asks for all of them
+/// (`RTIS_REQUIRE_AVX2=1`, which `.ci/run` sets) and the CPU lacks one, so that a CI machine
+/// without AVX2 cannot pass by comparing the baseline with itself.
+pub fn require_all_isas() {
+    if std::env::var_os("RTIS_REQUIRE_AVX2").is_some_and(|v| v == "1") {
+        assert!(
+            Isa::Avx2.available(),
+            "RTIS_REQUIRE_AVX2=1 but this CPU has no AVX2"
+        );
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::avx2::Avx2;
+    use super::baseline::Halves;
+    use super::*;
+
+    /// Every lane operation gives the same bits in both instruction sets, on the values where
+    /// implementations differ if they differ at all: NaN in either operand, zeros of both
+    /// signs, infinities, equal operands, subnormals and bytes at both ends.
+    #[test]
+    fn every_lane_operation_agrees_bit_for_bit() {
+        super::require_all_isas();
+        if !Isa::Avx2.available() {
+            eprintln!("no AVX2 here: nothing to compare");
+            return;
+        }
+        let specials = [
+            f32::NAN,
+            -f32::NAN,
+            0.0,
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            1.0,
+            -1.0,
+            1e-45,
+            f32::MAX,
+            -3.5,
+            2.0,
+        ];
+        let n = specials.len();
+        let lanes = |k: usize| -> [f32; 8] { std::array::from_fn(|i| specials[(k + 3 * i) % n]) };
+        let bits = |v: [f32; 8]| v.map(f32::to_bits);
+        for a in 0..n {
+            for b in 0..n {
+                let (x, y) = (lanes(a), lanes(b));
+                // SAFETY: AVX2 is present (checked above); the baseline runs everywhere.
+                unsafe {
+                    let h = |v: [f32; 8]| {
+                        Halves([
+                            glam::Vec4::from_slice(&v[..4]),
+                            glam::Vec4::from_slice(&v[4..]),
+                        ])
+                    };
+                    let (hx, hy) = (h(x), h(y));
+                    // An `Avx2` is a `__m256`: eight `f32` lanes in order.
+                    let v = |v: [f32; 8]| std::mem::transmute::<[f32; 8], Avx2>(v);
+                    let (vx, vy) = (v(x), v(y));
+                    assert_eq!(bits(hx.add(hy).to_array()), bits(vx.add(vy).to_array()));
+                    assert_eq!(bits(hx.sub(hy).to_array()), bits(vx.sub(vy).to_array()));
+                    assert_eq!(bits(hx.mul(hy).to_array()), bits(vx.mul(vy).to_array()));
+                    assert_eq!(bits(hx.min(hy).to_array()), bits(vx.min(vy).to_array()));
+                    assert_eq!(bits(hx.max(hy).to_array()), bits(vx.max(vy).to_array()));
+                    assert_eq!(hx.le(hy), vx.le(vy), "{x:?} <= {y:?}");
+                    assert_eq!(
+                        bits(Halves::splat(x[0]).to_array()),
+                        bits(Avx2::splat(x[0]).to_array())
+                    );
+                }
+            }
+        }
+        for q in [[0u8, 1, 2, 127, 128, 254, 255, 7], [255; 8], [0; 8]] {
+            // SAFETY: as above.
+            unsafe {
+                assert_eq!(
+                    bits(Halves::widen(&q).to_array()),
+                    bits(Avx2::widen(&q).to_array())
+                );
+            }
+        }
+        for c in [
+            [0u32, 1, u32::MAX, 5, u32::MAX, 0, 1 << 31, 2],
+            [u32::MAX; 8],
+            [3; 8],
+        ] {
+            // SAFETY: as above.
+            unsafe {
+                assert_eq!(
+                    Halves::ne_u32(&c, u32::MAX),
+                    Avx2::ne_u32(&c, u32::MAX),
+                    "{c:?}"
+                );
+            }
+        }
+    }
 }
