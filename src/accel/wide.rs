@@ -1,7 +1,8 @@
 //! An eight-wide BVH: the binary SAH tree ([`super::Bvh`]) collapsed so that each node holds
 //! the boxes of up to eight children in structure-of-arrays lanes, tested against a ray in one
-//! AVX2 pass where the CPU has it and in two SSE halves elsewhere ([`super::simd`]), as
-//! Embree's BVH8 does. A ray then visits about a third as many nodes as in the binary tree.
+//! AVX2 pass where the CPU has it and in two SSE halves elsewhere ([`super::Isa`], chosen at
+//! run time), as Embree's BVH8 does. A ray then visits about a third as many nodes as in the
+//! binary tree.
 //!
 //! Child boxes are quantised to 8 bits per coordinate on a grid spanning the node's box
 //! (Embree's compressed nodes, Ylitie et al. 2017), so a node is 128 bytes, two cache lines,
@@ -234,7 +235,7 @@ impl WideBvh {
     /// Collapse a binary tree (nodes in the layout of [`super::Bvh`]: an interior node's first
     /// child follows it and `index` is its second) into eight-wide nodes. Each wide node takes a
     /// binary node's children and keeps opening interior ones among them until it has eight
-    /// (twigs first, then the largest: see [`children`]), so the levels it skips are those a
+    /// (twigs first, then the largest: see `children`), so the levels it skips are those a
     /// ray would most often visit.
     ///
     /// Returns the tree and its leaves, each a binary leaf's `(first, count)`: a leaf child's
