@@ -69,9 +69,12 @@ impl Item {
             max: self.max.into(),
         }
     }
+    /// The centroid's coordinate on `axis`. Read through arrays: glam's `Vec3` index is a
+    /// `match`, three compares per read, and the build reads this twice per item and level.
     #[inline]
     fn centroid(&self, axis: usize) -> f32 {
-        0.5 * (self.min[axis] + self.max[axis])
+        let (min, max): (&[f32; 3], &[f32; 3]) = (self.min.as_ref(), self.max.as_ref());
+        0.5 * (min[axis] + max[axis])
     }
 }
 
@@ -279,7 +282,10 @@ fn build_node(
     }
     let extent = cbounds.max - cbounds.min;
     let axis = extent.max_position();
-    let split = if extent[axis] > 0.0 && depth < MEDIAN_DEPTH {
+    // A leaf's worth of primitives stays a leaf without binning: any split costs at least
+    // the traversal (1) plus the children's non-negative share, so never less than the leaf
+    // (one block, cost 1), and `best_split` would say so after binning them.
+    let split = if extent[axis] > 0.0 && depth < MEDIAN_DEPTH && order.len() > MAX_LEAF {
         best_split(order, &cbounds, axis, bounds.area())
     } else {
         None
