@@ -143,9 +143,9 @@ pub fn prefetch<T>(x: &T) {
 struct RayBox<L> {
     o: [L; 3],
     inv_d: [L; 3],
-    /// Per axis, true if the ray runs towards smaller coordinates: it then enters a slab by
-    /// its largest side.
-    back: [bool; 3],
+    /// Bit `axis` set if the ray runs towards smaller coordinates on that axis (the sign bit
+    /// of its reciprocal direction): it then enters a slab by its largest side.
+    back: u32,
 }
 
 impl<L: Lanes8> RayBox<L> {
@@ -165,7 +165,7 @@ impl<L: Lanes8> RayBox<L> {
             RayBox {
                 o: [L::splat(o.x), L::splat(o.y), L::splat(o.z)],
                 inv_d: [L::splat(inv_d.x), L::splat(inv_d.y), L::splat(inv_d.z)],
-                back: [inv_d.x, inv_d.y, inv_d.z].map(f32::is_sign_negative),
+                back: inv_d.is_negative_bitmask(),
             }
         }
     }
@@ -218,7 +218,7 @@ impl WideNode {
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
     unsafe fn side<L: Lanes8>(&self, r: &RayBox<L>, axis: usize, exit: bool) -> L {
-        let q = if r.back[axis] != exit {
+        let q = if ((r.back >> axis) & 1 != 0) != exit {
             &self.hi[axis]
         } else {
             &self.lo[axis]
