@@ -321,7 +321,7 @@ impl WideBvh {
         ok
     }
 
-    /// [`WideBvh::closest`] compiled for AVX2, with the leaf test inlined into it.
+    /// [`WideBvh::closest`] compiled for AVX2, the node test inlined into it (the leaf test, a closure, may stay a call).
     ///
     /// # Safety
     /// The CPU must have AVX2.
@@ -337,7 +337,7 @@ impl WideBvh {
         unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch) }
     }
 
-    /// [`WideBvh::any`] compiled for AVX2, with the leaf test inlined into it.
+    /// [`WideBvh::any`] compiled for AVX2, the node test inlined into it (the leaf test, a closure, may stay a call).
     ///
     /// # Safety
     /// The CPU must have AVX2.
