@@ -321,7 +321,8 @@ impl WideBvh {
         ok
     }
 
-    /// [`WideBvh::closest`] compiled for AVX2, the node test inlined into it (the leaf test, a closure, may stay a call).
+    /// [`WideBvh::closest`] compiled for AVX2, the node test inlined into it (the leaf test, a
+    /// closure, may stay a call).
     ///
     /// # Safety
     /// The CPU must have AVX2.
@@ -337,7 +338,8 @@ impl WideBvh {
         unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch) }
     }
 
-    /// [`WideBvh::any`] compiled for AVX2, the node test inlined into it (the leaf test, a closure, may stay a call).
+    /// [`WideBvh::any`] compiled for AVX2, the node test inlined into it (the leaf test, a
+    /// closure, may stay a call).
     ///
     /// # Safety
     /// The CPU must have AVX2.
