@@ -165,6 +165,13 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
     eprintln!("effects {}", prepared.effects);
+    if prepared.geometry.in_bvh > 0 {
+        eprintln!(
+            "BVH: {} primitives, node test in {}",
+            prepared.geometry.in_bvh,
+            prepared.geometry.bvh.isa().name()
+        );
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;

@@ -1,0 +1,119 @@
+//! The binary on a CPU older than this one (src/accel/simd/): run under QEMU's user-mode
+//! emulator as its baseline x86-64 CPU (`-cpu qemu64`: SSE2 and SSE3, no AVX, no SSE4, no
+//! POPCNT), which stops a process with SIGILL at its first instruction the CPU lacks. There
+//! the binary must pick the baseline node test, render a mesh scene (closest-hit and shadow
+//! queries through the BVH) to the same pixels, bit for bit, as the native run (AVX2 on a CI
+//! machine), and refuse `--isa avx2` with an error instead of crashing.
+//!
+//! Needs `qemu-x86_64` (Debian's qemu-user), which `.ci/run` installs; without it the test
+//! says so and passes, unless `RTIS_REQUIRE_QEMU=1` (set by `.ci/run`) asks for it.
+
+#![cfg(all(target_arch = "x86_64", target_os = "linux"))]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const RTIS: &str = env!("CARGO_BIN_EXE_rtis");
+
+/// `qemu-x86_64` on the PATH, if there.
+fn qemu() -> Option<PathBuf> {
+    let found = std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|dir| dir.join("qemu-x86_64"))
+            .find(|p| p.is_file())
+    });
+    if found.is_none() {
+        let required = std::env::var_os("RTIS_REQUIRE_QEMU").is_some_and(|v| v == "1");
+        assert!(
+            !required,
+            "RTIS_REQUIRE_QEMU=1 but no qemu-x86_64 on the PATH"
+        );
+        eprintln!("no qemu-x86_64 (Debian's qemu-user): the older CPU is not tested here");
+    }
+    found
+}
+
+/// `rtis args`, natively or under `qemu-x86_64 -cpu qemu64`.
+fn rtis(emulated: Option<&Path>, args: &[&str]) -> Output {
+    let mut cmd = match emulated {
+        Some(qemu) => {
+            let mut c = Command::new(qemu);
+            c.args(["-cpu", "qemu64", RTIS]);
+            c
+        }
+        None => Command::new(RTIS),
+    };
+    cmd.args(args).output().expect("run rtis")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn an_older_cpu_renders_the_same_image_through_the_baseline_node_test() {
+    let Some(qemu) = qemu() else { return };
+    let dir = std::env::temp_dir().join(format!("rtis-cpu-dispatch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/mesh.ron");
+    let render = |emulated: Option<&Path>, name: &str| {
+        let path = dir.join(name);
+        let out = rtis(
+            emulated,
+            &[
+                "render",
+                scene,
+                "--width",
+                "96",
+                "--threads",
+                "2",
+                "-o",
+                path.to_str().unwrap(),
+            ],
+        );
+        assert!(
+            out.status.success(),
+            "{name}: {:?}\n{}",
+            out.status,
+            stderr(&out)
+        );
+        // The pixels, to the bit (the file's compressed bytes may differ: the compressor
+        // picks its own code path by CPU).
+        let image = image::open(&path).unwrap().into_rgba32f();
+        let bits: Vec<u32> = image.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect();
+        (bits, stderr(&out))
+    };
+    let (native, native_log) = render(None, "native.exr");
+    let (old, old_log) = render(Some(&qemu), "qemu64.exr");
+    let native_isa = rtis::accel::Isa::detect().name();
+    assert!(
+        native_log.contains(&format!("node test in {native_isa}")),
+        "{native_log}"
+    );
+    assert!(old_log.contains("node test in baseline"), "{old_log}");
+    assert!(native.len() > 4 * 96 * 70, "{} channels", native.len());
+    assert!(
+        native == old,
+        "the emulated older CPU rendered another image"
+    );
+    // Asked for an instruction set it lacks, the bench refuses by name.
+    let refused = rtis(
+        Some(&qemu),
+        &[
+            "bench",
+            "--section",
+            "meshes",
+            "--triangles",
+            "1000",
+            "--isa",
+            "avx2",
+        ],
+    );
+    assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+    assert!(
+        stderr(&refused).contains("--isa avx2: this CPU does not run it"),
+        "{}",
+        stderr(&refused)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
