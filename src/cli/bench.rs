@@ -45,7 +45,8 @@ pub struct BenchArgs {
     #[arg(long)]
     dump: Option<std::path::PathBuf>,
     /// Instruction set of the meshes section's BVH node test: the widest this CPU runs
-    /// (auto), or one named, to measure what it is worth. The answers are the same in each.
+    /// (auto), one named, or each this CPU runs (one row each, their passes taking turns), to
+    /// measure what it is worth. The answers are the same in each.
     #[arg(long, value_enum, default_value_t = IsaArg::Auto)]
     isa: IsaArg,
 }
@@ -59,18 +60,21 @@ pub enum IsaArg {
     Baseline,
     /// One eight-lane AVX2 register.
     Avx2,
+    /// Every one this CPU runs, baseline first.
+    Each,
 }
 
 impl IsaArg {
-    /// The instruction set meant, or an error if this CPU does not run it.
-    fn isa(self) -> Result<Isa, CliError> {
+    /// The instruction sets meant, or an error if this CPU does not run the one named.
+    fn isas(self) -> Result<Vec<Isa>, CliError> {
         let isa = match self {
-            IsaArg::Auto => return Ok(Isa::detect()),
+            IsaArg::Auto => return Ok(vec![Isa::detect()]),
+            IsaArg::Each => return Ok(Isa::all_available()),
             IsaArg::Baseline => Isa::Baseline,
             IsaArg::Avx2 => Isa::Avx2,
         };
         if isa.available() {
-            Ok(isa)
+            Ok(vec![isa])
         } else {
             Err(format!("--isa {}: this CPU does not run it", isa.name()).into())
         }
@@ -247,18 +251,37 @@ fn case(name: &str, scene: &RenderScene, runs: u32, json: bool) {
 }
 
 /// Mrays/s of `rays` run through `f` in parallel (chunks of 4096 rays).
-fn rate(rays: &[Ray], runs: u32, f: impl Fn(&Ray) -> bool + Sync) -> (f64, usize) {
+/// Mrays/s and hits of `query` over `rays` on the BVH in each of `isas`, each the median of
+/// `runs` passes. The instruction sets' passes take turns, so that the machine's drift falls
+/// on all of them.
+fn rates(
+    g: &mut Geometry,
+    isas: &[Isa],
+    rays: &[Ray],
+    runs: u32,
+    query: fn(&Geometry, &Ray) -> bool,
+) -> Vec<(f64, usize)> {
     use rayon::prelude::*;
-    let once = || {
-        let start = Instant::now();
-        let hits: usize = rays
-            .par_chunks(4096)
-            .map(|c| c.iter().filter(|r| f(r)).count())
-            .sum();
-        (start.elapsed().as_secs_f64(), hits)
-    };
-    let (seconds, hits) = median_of(runs, once);
-    (rays.len() as f64 / seconds / 1e6, hits)
+    let mut passes: Vec<Vec<(f64, usize)>> = vec![Vec::new(); isas.len()];
+    for _ in 0..runs.max(1) {
+        for (k, &isa) in isas.iter().enumerate() {
+            assert!(g.bvh.set_isa(isa), "checked by IsaArg::isas");
+            let g = &*g;
+            let start = Instant::now();
+            let hits: usize = rays
+                .par_chunks(4096)
+                .map(|c| c.iter().filter(|r| query(g, r)).count())
+                .sum();
+            passes[k].push((start.elapsed().as_secs_f64(), hits));
+        }
+    }
+    passes
+        .into_iter()
+        .map(|p| {
+            let (seconds, hits) = median(p);
+            (rays.len() as f64 / seconds / 1e6, hits)
+        })
+        .collect()
 }
 
 /// The median time of `runs` (at least 1) calls of `f`, which return a time and a result that
@@ -267,7 +290,11 @@ fn median_of<T: PartialEq + std::fmt::Debug>(
     runs: u32,
     mut f: impl FnMut() -> (f64, T),
 ) -> (f64, T) {
-    let mut results: Vec<(f64, T)> = (0..runs.max(1)).map(|_| f()).collect();
+    median((0..runs.max(1)).map(|_| f()).collect())
+}
+
+/// The result of median time among `results` (at least one), which must all agree.
+fn median<T: PartialEq + std::fmt::Debug>(mut results: Vec<(f64, T)>) -> (f64, T) {
     results.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mid = results.swap_remove(results.len() / 2);
     assert!(results.iter().all(|r| r.1 == mid.1), "runs disagree");
@@ -293,18 +320,15 @@ impl std::fmt::Debug for BuiltOnce {
 /// 1M triangles (a displaced sphere of radius 1 at the origin).
 fn meshes_section(
     json: bool,
-    isa: Isa,
+    isas: &[Isa],
     runs: u32,
     sizes: &[u32],
     dump: Option<&std::path::Path>,
 ) -> Result<(), CliError> {
     if !json {
+        println!("-- meshes: displaced sphere, 1M rays of each kind");
         println!(
-            "-- meshes: displaced sphere, 1M rays of each kind, node test in {}",
-            isa.name()
-        );
-        println!(
-            "{:>9} {:>9} {:>8} {:>9} {:>10} {:>10} {:>10} {:>12}",
+            "{:>9} {:>9} {:>8} {:>9} {:>10} {:>10} {:>10} {:>12} {:>9}",
             "triangles",
             "build s",
             "nodes",
@@ -312,7 +336,8 @@ fn meshes_section(
             "attr B/tri",
             "camera",
             "shadow",
-            "incoherent"
+            "incoherent",
+            "node test"
         );
     }
     let sizes = if sizes.is_empty() {
@@ -341,7 +366,6 @@ fn meshes_section(
             (start.elapsed().as_secs_f64(), BuiltOnce(g))
         });
         let mut g = g.0;
-        assert!(g.bvh.set_isa(isa), "checked by IsaArg::isa");
         let nodes = g.bvh.nodes.len();
         // The tree's nodes and its leaves' blocks of lanes.
         let bvh_bytes = (nodes * std::mem::size_of::<WideNode>()
@@ -358,7 +382,8 @@ fn meshes_section(
                 Ray::new(eye, (Vec3A::new(1.2 * x, 1.2 * y, 3.0)).normalize())
             })
             .collect();
-        let (cam_rate, cam_hits) = rate(&camera, runs, |r| g.intersect(r).is_some());
+        let closest = |g: &Geometry, r: &Ray| g.intersect(r).is_some();
+        let camera_rates = rates(&mut g, isas, &camera, runs, closest);
         // Shadow rays from the visible surface towards a light at (2, 3, -3).
         let light = Vec3A::new(2.0, 3.0, -3.0);
         let shadow: Vec<Ray> = camera
@@ -370,7 +395,7 @@ fn meshes_section(
                 Ray::spawn(&h, w, to.length() * 0.9999)
             })
             .collect();
-        let (shadow_rate, _) = rate(&shadow, runs, |r| g.occluded(r));
+        let shadow_rates = rates(&mut g, isas, &shadow, runs, |g, r| g.occluded(r));
         // Incoherent rays: random origins in the box [-2, 2]^3, random directions.
         let mut s = Sampler::new(1, 2, 3);
         let incoherent: Vec<Ray> = (0..1_000_000)
@@ -385,7 +410,7 @@ fn meshes_section(
                 Ray::new(o, d)
             })
             .collect();
-        let (inc_rate, inc_hits) = rate(&incoherent, runs, |r| g.intersect(r).is_some());
+        let incoherent_rates = rates(&mut g, isas, &incoherent, runs, closest);
         // What shading needs besides the vertices: each lane's material, normals and light
         // (and whole primitives for shapes outside the blocks: none here).
         let prim_bytes = (g.attrs.len() * std::mem::size_of::<Attrs>()
@@ -394,21 +419,26 @@ fn meshes_section(
         if let Some(dir) = dump {
             dump_work(dir, n, &mesh, &camera, &incoherent)?;
         }
-        let row = serde_json::json!({
-            "section": "meshes", "engine": "rtis", "isa": isa.name(), "triangles": count,
-            "build_s": build,
-            "nodes": nodes, "threads": rayon::current_num_threads(),
-            "bvh_bytes_per_triangle": bvh_bytes, "attribute_bytes_per_triangle": prim_bytes,
-            "bytes_per_triangle": bvh_bytes + prim_bytes,
-            "camera_mrays": cam_rate, "coherent_mrays": cam_rate, "shadow_mrays": shadow_rate,
-            "incoherent_mrays": inc_rate, "coherent_hits": cam_hits, "incoherent_hits": inc_hits,
-        });
-        emit(json, row, || {
-            format!(
-                "{count:>9} {build:>9.3} {nodes:>8} {bvh_bytes:>9.1} {prim_bytes:>10.1} \
-                 {cam_rate:>7.1} M/s {shadow_rate:>7.1} M/s {inc_rate:>9.1} M/s"
-            )
-        });
+        for (k, isa) in isas.iter().map(|i| i.name()).enumerate() {
+            let ((cam_rate, cam_hits), (shadow_rate, _), (inc_rate, inc_hits)) =
+                (camera_rates[k], shadow_rates[k], incoherent_rates[k]);
+            let row = serde_json::json!({
+                "section": "meshes", "engine": "rtis", "isa": isa, "triangles": count,
+                "build_s": build,
+                "nodes": nodes, "threads": rayon::current_num_threads(),
+                "bvh_bytes_per_triangle": bvh_bytes, "attribute_bytes_per_triangle": prim_bytes,
+                "bytes_per_triangle": bvh_bytes + prim_bytes,
+                "camera_mrays": cam_rate, "coherent_mrays": cam_rate, "shadow_mrays": shadow_rate,
+                "incoherent_mrays": inc_rate, "coherent_hits": cam_hits,
+                "incoherent_hits": inc_hits,
+            });
+            emit(json, row, || {
+                format!(
+                    "{count:>9} {build:>9.3} {nodes:>8} {bvh_bytes:>9.1} {prim_bytes:>10.1} \
+                     {cam_rate:>7.1} M/s {shadow_rate:>7.1} M/s {inc_rate:>9.1} M/s {isa:>9}"
+                )
+            });
+        }
     }
     Ok(())
 }
@@ -455,7 +485,7 @@ fn dump_work(
 /// Run `rtis bench`.
 pub fn run(a: BenchArgs) -> Result<(), CliError> {
     // Refused before any figure, whichever sections run.
-    let isa = a.isa.isa()?;
+    let isas = a.isa.isas()?;
     let threads = rayon::current_num_threads();
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     let head = serde_json::json!({
@@ -471,7 +501,7 @@ pub fn run(a: BenchArgs) -> Result<(), CliError> {
     });
     let wants = |s: Section| a.section == Section::All || a.section == s;
     if wants(Section::Meshes) {
-        meshes_section(a.json, isa, a.runs, &a.triangles, a.dump.as_deref())?;
+        meshes_section(a.json, &isas, a.runs, &a.triangles, a.dump.as_deref())?;
     }
     if wants(Section::Effects) {
         effects_section(&a.scenes, a.runs, a.shrink, a.json)?;
