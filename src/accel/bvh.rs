@@ -38,6 +38,9 @@ const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
 /// Cost of a node visit relative to one leaf test (SAH).
 const TRAVERSAL_COST: f32 = 1.0;
+// `build_node` keeps a leaf's worth of primitives a leaf without binning them, which holds
+// because no split can cost less than a one-block leaf: the traversal alone costs as much.
+const _: () = assert!(TRAVERSAL_COST >= 1.0);
 
 /// The SAH's cost of testing `n` primitives: the blocks of four they fill, each tested in one
 /// pass (Embree's SAH for its triangle4 leaves counts blocks the same way).
@@ -283,8 +286,8 @@ fn build_node(
     let extent = cbounds.max - cbounds.min;
     let axis = extent.max_position();
     // A leaf's worth of primitives stays a leaf without binning: any split costs at least
-    // the traversal (1) plus the children's non-negative share, so never less than the leaf
-    // (one block, cost 1), and `best_split` would say so after binning them.
+    // the traversal (`TRAVERSAL_COST`, at least 1) plus the children's non-negative share, so
+    // never less than the leaf (one block, cost 1).
     let split = if extent[axis] > 0.0 && depth < MEDIAN_DEPTH && order.len() > MAX_LEAF {
         best_split(order, &cbounds, axis, bounds.area())
     } else {
@@ -297,7 +300,8 @@ fn build_node(
             let mid = partition(order, |it| bin_of(it.centroid(axis), lo, scale) <= bin);
             (mid, Some((left, right)))
         }
-        // No split beats a leaf: keep a leaf if it is small enough, else split the middle.
+        // A leaf's worth, a flat centroid box, the depth limit, or every item in one bin:
+        // keep a leaf if it is small enough, else split the middle.
         None if order.len() <= MAX_LEAF && depth < MEDIAN_DEPTH => return,
         None => {
             let k = order.len() / 2;
@@ -409,8 +413,9 @@ fn fold_bounds(items: &[Item]) -> (Aabb, Aabb) {
     })
 }
 
-/// The bin after which to split along `axis`, with the item and centroid boxes of both sides,
-/// if splitting is cheaper than a leaf by the SAH.
+/// The bin after which to split more than a leaf's worth of items along `axis` at the least
+/// SAH cost, with the item and centroid boxes of both sides; `None` if every item falls in one
+/// bin. (A leaf's worth never gets here: see `build_node`.)
 #[allow(clippy::type_complexity)]
 fn best_split(
     order: &[Item],
@@ -458,12 +463,7 @@ fn best_split(
             best = (cost, Some((k, (acc.0, acc.1), rb)));
         }
     }
-    let leaf_cost = blocks(order.len());
-    if best.0 < leaf_cost || order.len() > MAX_LEAF {
-        best.1
-    } else {
-        None
-    }
+    best.1
 }
 
 /// Moves the elements for which `pred` holds to the front; returns how many there are.

@@ -250,21 +250,26 @@ fn case(name: &str, scene: &RenderScene, runs: u32, json: bool) {
     });
 }
 
-/// Mrays/s of `rays` run through `f` in parallel (chunks of 4096 rays).
-/// Mrays/s and hits of `query` over `rays` on the BVH in each of `isas`, each the median of
-/// `runs` passes. The instruction sets' passes take turns, so that the machine's drift falls
-/// on all of them.
+/// Mrays/s and hits of `query` over `rays` (in parallel, chunks of 4096 rays) on the BVH in
+/// each of `isas`, each the median of `runs` passes. The instruction sets' passes take turns,
+/// in reverse order every other round, so that the machine's drift falls on all of them; every
+/// pass must find the same hits.
 fn rates(
     g: &mut Geometry,
     isas: &[Isa],
     rays: &[Ray],
     runs: u32,
-    query: fn(&Geometry, &Ray) -> bool,
+    query: impl Fn(&Geometry, &Ray) -> bool + Sync + Copy,
 ) -> Vec<(f64, usize)> {
     use rayon::prelude::*;
     let mut passes: Vec<Vec<(f64, usize)>> = vec![Vec::new(); isas.len()];
-    for _ in 0..runs.max(1) {
-        for (k, &isa) in isas.iter().enumerate() {
+    for round in 0..runs.max(1) {
+        let mut order: Vec<usize> = (0..isas.len()).collect();
+        if round % 2 == 1 {
+            order.reverse();
+        }
+        for k in order {
+            let isa = isas[k];
             assert!(g.bvh.set_isa(isa), "checked by IsaArg::isas");
             let g = &*g;
             let start = Instant::now();
@@ -275,13 +280,18 @@ fn rates(
             passes[k].push((start.elapsed().as_secs_f64(), hits));
         }
     }
-    passes
+    let out: Vec<(f64, usize)> = passes
         .into_iter()
         .map(|p| {
             let (seconds, hits) = median(p);
             (rays.len() as f64 / seconds / 1e6, hits)
         })
-        .collect()
+        .collect();
+    assert!(
+        out.iter().all(|r| r.1 == out[0].1),
+        "the instruction sets found different hits"
+    );
+    out
 }
 
 /// The median time of `runs` (at least 1) calls of `f`, which return a time and a result that
@@ -328,7 +338,7 @@ fn meshes_section(
     if !json {
         println!("-- meshes: displaced sphere, 1M rays of each kind");
         println!(
-            "{:>9} {:>9} {:>8} {:>9} {:>10} {:>10} {:>10} {:>12} {:>9}",
+            "{:>9} {:>9} {:>8} {:>9} {:>10} {:>11} {:>11} {:>13} {:>9}",
             "triangles",
             "build s",
             "nodes",
