@@ -3,12 +3,18 @@
 //! BVH costs more than it saves. The arithmetic is the scalar tests' (`shape::Sphere`,
 //! `shape::Plane`), including their rule for a ray that starts on the surface, so a packet
 //! finds the hits the scalar code would (`tests/shapes.rs` checks that they agree).
+//!
+//! The same tests run the other way round: four rays in the lanes ([`RayLanes::gather`])
+//! against one primitive in all of them ([`SphereLanes::splat_lane`]), as a batch of rays
+//! needs. Each lane computes what the scalar test computes for its pair, so both layouts give
+//! the same bits.
 
 use crate::geometry::{Ray, gamma};
 use crate::shape::{Plane, Sphere};
 use glam::{BVec4A, Vec4};
 
-/// A ray splatted across four lanes.
+/// A ray splatted across four lanes ([`RayLanes::new`]), or four rays, one per lane
+/// ([`RayLanes::gather`]).
 #[derive(Clone, Copy)]
 pub struct RayLanes {
     o: [Vec4; 3],
@@ -30,6 +36,25 @@ impl RayLanes {
             d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
             plane_k: Vec4::splat(gamma(4) * a + ray.o_err),
             sphere_k: Vec4::splat(ray.o_err + gamma(1) * a),
+        }
+    }
+
+    /// Four rays, one per lane, with each lane's constants as [`RayLanes::new`] computes them.
+    #[inline(always)]
+    pub fn gather(rays: [&Ray; 4]) -> Self {
+        // Transpose: four `Vec3A`s (x, y, z, pad) into x, y, z lanes.
+        let t = |v: [glam::Vec3A; 4]| {
+            let [a, b, c, d] = v.map(|v| v.extend(0.0));
+            let m = glam::Mat4::from_cols(a, b, c, d).transpose();
+            [m.x_axis, m.y_axis, m.z_axis]
+        };
+        let a = Vec4::from_array(rays.map(|r| r.o.abs().max_element()));
+        let o_err = Vec4::from_array(rays.map(|r| r.o_err));
+        RayLanes {
+            o: t(rays.map(|r| r.o)),
+            d: t(rays.map(|r| r.d)),
+            plane_k: Vec4::splat(gamma(4)) * a + o_err,
+            sphere_k: o_err + Vec4::splat(gamma(1)) * a,
         }
     }
 }
@@ -85,10 +110,22 @@ impl SphereLanes {
         }
     }
 
-    /// Distances of each lane's hit in `(0, t_max]`, and which lanes hit (the scalar
+    /// Lane `i`'s sphere in all four lanes (an unused lane's padding, which never hits).
+    pub fn splat_lane(&self, i: usize) -> Self {
+        let s = |v: Vec4| Vec4::splat(v[i]);
+        SphereLanes {
+            c: self.c.map(s),
+            r: s(self.r),
+            r2: s(self.r2),
+            inv_r: s(self.inv_r),
+            c_err: s(self.c_err),
+        }
+    }
+
+    /// Distances of each lane's hit in `(0, tm]`, and which lanes hit (the scalar
     /// [`Sphere::intersect`], four at a time).
     #[inline(always)]
-    pub fn hit(&self, r: &RayLanes, t_max: f32) -> (Vec4, BVec4A) {
+    pub fn hit(&self, r: &RayLanes, tm: Vec4) -> (Vec4, BVec4A) {
         let f = [r.o[0] - self.c[0], r.o[1] - self.c[1], r.o[2] - self.c[2]];
         let b = -dot(f, r.d);
         let l = [f[0] + b * r.d[0], f[1] + b * r.d[1], f[2] + b * r.d[2]];
@@ -107,7 +144,6 @@ impl SphereLanes {
         let t0 = Vec4::select(first, a, q);
         let t1 = Vec4::select(first, q, a);
         let zero = Vec4::ZERO;
-        let tm = Vec4::splat(t_max);
         let ok0 = t0.cmpgt(zero) & t0.cmple(tm);
         let ok1 = t1.cmpgt(zero) & t1.cmple(tm);
         let mut t = Vec4::select(ok0, t0, t1);
@@ -142,9 +178,22 @@ impl PlaneLanes {
         }
     }
 
-    /// Distances and hit lanes (the scalar [`Plane::intersect`], four at a time).
+    /// Lane `i`'s plane in all four lanes (an unused lane's padding, which never hits).
+    pub fn splat_lane(&self, i: usize) -> Self {
+        let s = |v: Vec4| Vec4::splat(v[i]);
+        PlaneLanes {
+            n: self.n.map(s),
+            dist: s(self.dist),
+            n_abs_sum: s(self.n_abs_sum),
+            dist_err: s(self.dist_err),
+            side: s(self.side),
+        }
+    }
+
+    /// Distances of each lane's hit in `(0, t_max]`, and which lanes hit (the scalar
+    /// [`Plane::intersect`], four at a time).
     #[inline(always)]
-    pub fn hit(&self, r: &RayLanes, t_max: f32) -> (Vec4, BVec4A) {
+    pub fn hit(&self, r: &RayLanes, t_max: Vec4) -> (Vec4, BVec4A) {
         let denom = dot(self.n, r.d);
         let s = self.dist - dot(self.n, r.o);
         let band = self.n_abs_sum * r.plane_k + self.dist_err;
@@ -161,7 +210,7 @@ impl PlaneLanes {
             t = Vec4::select(leaving, t.max(Vec4::splat(f32::MIN_POSITIVE)), t);
             ok |= leaving;
         }
-        (t, ok & t.cmple(Vec4::splat(t_max)))
+        (t, ok & t.cmple(t_max))
     }
 }
 
@@ -172,9 +221,19 @@ pub struct Lanes<P> {
     pub packs: Vec<P>,
     /// `packs.len() * 4` prim indices; padding lanes repeat the last one (they never hit).
     pub prim: Vec<u32>,
+    /// The primitives packed (the lanes that are not padding).
+    pub count: usize,
 }
 
 impl<P> Lanes<P> {
+    /// Each primitive alone in all four lanes (`splat` gives a packet's lane), with its prim
+    /// index, in the order [`Lanes::closest`] tests them: for batches of rays in the lanes.
+    pub fn each(&self, splat: impl Fn(&P, usize) -> P) -> Vec<(u32, P)> {
+        (0..self.count)
+            .map(|k| (self.prim[k], splat(&self.packs[k / 4], k % 4)))
+            .collect()
+    }
+
     /// Closest hit over every packet, with the scalar loop's tie rule (a later lane at equal
     /// distance wins), updating `t_max` and `best`.
     #[inline(always)]
@@ -183,10 +242,10 @@ impl<P> Lanes<P> {
         r: &RayLanes,
         t_max: &mut f32,
         best: &mut Option<u32>,
-        hit: impl Fn(&P, &RayLanes, f32) -> (Vec4, BVec4A),
+        hit: impl Fn(&P, &RayLanes, Vec4) -> (Vec4, BVec4A),
     ) {
         for (k, p) in self.packs.iter().enumerate() {
-            let (t, ok) = hit(p, r, *t_max);
+            let (t, ok) = hit(p, r, Vec4::splat(*t_max));
             let mut mask = ok.bitmask();
             if mask == 0 {
                 continue;
@@ -209,8 +268,9 @@ impl<P> Lanes<P> {
         &self,
         r: &RayLanes,
         t_max: f32,
-        hit: impl Fn(&P, &RayLanes, f32) -> (Vec4, BVec4A),
+        hit: impl Fn(&P, &RayLanes, Vec4) -> (Vec4, BVec4A),
     ) -> bool {
+        let t_max = Vec4::splat(t_max);
         self.packs.iter().any(|p| hit(p, r, t_max).1.any())
     }
 }
@@ -223,6 +283,7 @@ where
     let mut out = Lanes {
         packs: Vec::new(),
         prim: Vec::new(),
+        count: items.len(),
     };
     for chunk in items.chunks(4) {
         let shapes: Vec<T> = chunk.iter().map(|(_, s)| *s).collect();

@@ -1,6 +1,7 @@
 //! Ray queries over the prepared geometry: packets of four planes and (in small scenes) four
 //! spheres tested with SSE, and a BVH over the remaining finite primitives.
 
+mod batch;
 pub mod block;
 mod bvh;
 pub mod lanes;
@@ -78,6 +79,12 @@ pub struct Geometry {
     pub spheres: Lanes<SphereLanes>,
     /// Infinite planes in packets of four.
     pub planes: Lanes<PlaneLanes>,
+    /// Each packed sphere alone in all four lanes, with its prim index, in the order of
+    /// `spheres`: what a batch of rays in the lanes is tested against
+    /// ([`Geometry::intersect_batch`]).
+    pub sphere_each: Vec<(u32, SphereLanes)>,
+    /// Each plane alone in all four lanes, with its prim index, in the order of `planes`.
+    pub plane_each: Vec<(u32, PlaneLanes)>,
     /// Vertex normals of smooth triangles, at their lane's index (empty if none is smooth).
     pub normals: Vec<[glam::Vec3A; 3]>,
     /// True if the BVH holds triangles: its rays then need the watertight test's shear
@@ -195,14 +202,18 @@ impl Geometry {
         let slots = attrs.len();
         let sphere_items = append(&mut others, slots, spheres);
         let plane_items = append(&mut others, slots, planes);
+        let spheres = lanes::pack(&sphere_items, SphereLanes::pack);
+        let planes = lanes::pack(&plane_items, PlaneLanes::pack);
         Geometry {
             others,
             in_bvh,
             bvh,
             blocks,
             attrs,
-            spheres: lanes::pack(&sphere_items, SphereLanes::pack),
-            planes: lanes::pack(&plane_items, PlaneLanes::pack),
+            sphere_each: spheres.each(SphereLanes::splat_lane),
+            plane_each: planes.each(PlaneLanes::splat_lane),
+            spheres,
+            planes,
             normals: lane_normals,
             has_triangles,
         }
@@ -332,16 +343,21 @@ impl Geometry {
             self.planes
                 .closest(lanes, &mut t_max, &mut best, PlaneLanes::hit);
         }
-        let prim = best?;
-        let s = self.prim(prim).shape.surface(ray, t_max);
-        Some(Hit {
-            t: t_max,
+        Some(self.hit_record(ray, best?, t_max))
+    }
+
+    /// The hit of `ray` on primitive `prim` at distance `t`.
+    #[inline]
+    fn hit_record(&self, ray: &Ray, prim: u32, t: f32) -> Hit {
+        let s = self.prim(prim).shape.surface(ray, t);
+        Hit {
+            t,
             p: s.p,
             n: s.n,
             err: s.err,
             err_along: s.err_along,
             prim,
-        })
+        }
     }
 
     /// True if anything blocks `ray` within `(0, ray.t_max]` (any-hit query for shadow rays).

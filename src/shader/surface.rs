@@ -6,7 +6,7 @@
 use super::Tracer;
 use crate::effects::Effects;
 use crate::geometry::{Hit, Origins, Ray};
-use crate::light::{AreaLight, Chosen, Light, NO_LIGHT, choose_by_importance};
+use crate::light::{AreaLight, Chosen, Incident, Light, NO_LIGHT, choose_by_importance};
 use crate::material::{Material, Model, Phong, reflect};
 use crate::sampling::{Sampling, hemisphere, power_heuristic};
 use crate::stats::RayKind;
@@ -105,22 +105,44 @@ pub fn point_lights(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
 /// One point light's term of Eq. 3: `L_i r(wi, wo) V`.
 #[inline]
 fn point_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light: &Light) -> Vec3A {
-    let Some(inc) = light.incident(si.hit.p) else {
+    let Some((inc, shadow)) = point_light_ray(si, light) else {
         return Vec3A::ZERO;
     };
-    if inc.wi.dot(si.n) <= 0.0 {
-        return Vec3A::ZERO;
-    }
-    // Shadow ray V^s: stop just short of the light, so that a surface the light sits on does
-    // not block it. No plane can block it when the light is in the planes' room.
-    let shadow = si.origins.ray(inc.wi, inc.dist * SHADOW_END);
     let visible = !tr.effects.shadows
         || match light.in_room() {
             true => tr.unoccluded_in_room(&shadow),
             false => tr.unoccluded(&shadow),
         };
+    point_light_term(tr.model, si, phong, &inc, visible)
+}
+
+/// A point light's incident light at `si` and its shadow ray `V^s`, or `None` if the light
+/// adds nothing there whatever the visibility (behind the surface, or at the point itself).
+///
+/// The shadow ray stops just short of the light, so that a surface the light sits on does not
+/// block it. No plane can block it when the light is in the planes' room
+/// ([`Light::in_room`]).
+#[inline]
+pub fn point_light_ray(si: &Interaction, light: &Light) -> Option<(Incident, Ray)> {
+    let inc = light.incident(si.hit.p)?;
+    if inc.wi.dot(si.n) <= 0.0 {
+        return None;
+    }
+    let shadow = si.origins.ray(inc.wi, inc.dist * SHADOW_END);
+    Some((inc, shadow))
+}
+
+/// `L_i r(wi, wo) V` for the incident light `inc` of [`point_light_ray`], seen or not.
+#[inline]
+pub fn point_light_term(
+    model: Model,
+    si: &Interaction,
+    phong: &Phong,
+    inc: &Incident,
+    visible: bool,
+) -> Vec3A {
     if visible {
-        inc.li * reflectance(tr.model, phong, inc.wi, si.wo, si.n)
+        inc.li * reflectance(model, phong, inc.wi, si.wo, si.n)
     } else {
         Vec3A::ZERO
     }

@@ -20,7 +20,12 @@
 //!
 //! No recursion: mirror and glass chains are loops carrying their tint (`follow_specular`), and
 //! the tree of two-direction rays below the first Phong hit is walked with an explicit stack of
-//! rays and throughputs (at most `D + 1` deep, `D` at most [`MAX_DEPTH`]).
+//! rays and throughputs (at most `D + 1` deep, `D` at most [`MAX_DEPTH`]). Where no hit draws
+//! random numbers, the trees of all `n` directions are traced together instead, one depth at a
+//! time ([`Order::Waves`]), so that the geometry answers their rays and shadow rays in SIMD
+//! batches; the sums keep the depth-first order, so the image is the same to the bit.
+
+mod waves;
 
 use super::Tracer;
 use super::surface::{ChainEnd, Interaction, direct_light, follow_specular, reflectance};
@@ -78,18 +83,72 @@ fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Ve
         // depth 1.
         let frame = Frame::from_normal(n);
         let mut sum = Vec3A::ZERO;
-        let mut stack = Vec::with_capacity(g.max_depth as usize + 1);
-        for _ in 0..g.samples {
-            let (u1, u2) = tr.sampler.next_2d();
-            let wj = frame.to_world(hemisphere::uniform(u1, u2));
-            let l_i = incident(tr, g, si.spawn(wj), &mut stack);
-            sum += l_i * reflectance(model, phong, wj, wo, n);
+        if waves::applies(tr, g) {
+            // The same directions and sums, the rays traced in waves.
+            let w: Vec<Vec3A> = (0..g.samples)
+                .map(|_| {
+                    let (u1, u2) = tr.sampler.next_2d();
+                    frame.to_world(hemisphere::uniform(u1, u2))
+                })
+                .collect();
+            let rays: Vec<Ray> = w.iter().map(|&wj| si.spawn(wj)).collect();
+            let l = incident_all(tr, g, &rays, Order::Waves);
+            for (l_i, wj) in l.into_iter().zip(w) {
+                sum += l_i * reflectance(model, phong, wj, wo, n);
+            }
+        } else {
+            // Light samples at the hits below draw random numbers: each direction's tree is
+            // walked before the next direction is drawn.
+            let mut stack = Vec::with_capacity(g.max_depth as usize + 1);
+            for _ in 0..g.samples {
+                let (u1, u2) = tr.sampler.next_2d();
+                let wj = frame.to_world(hemisphere::uniform(u1, u2));
+                let l_i = incident(tr, g, si.spawn(wj), &mut stack);
+                sum += l_i * reflectance(model, phong, wj, wo, n);
+            }
         }
         sum / (2.0 * PI * g.samples as f32)
     };
 
     // Eq. 1.
     l_dir + l_ind
+}
+
+/// The order in which the rays below the first Phong hit are traced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Order {
+    /// Each direction's tree depth first, one ray at a time: the reference.
+    DepthFirst,
+    /// All trees together, one depth at a time, rays in batches (`waves.rs`); the same bits
+    /// where [`Order::applies`].
+    Waves,
+}
+
+impl Order {
+    /// True if this order gives the depth-first walk's bits for `g` in `tr`'s scene: always for
+    /// the walk; for the waves, when no hit draws random numbers (no area-light samples) and
+    /// one direction's tree has at most 4095 nodes (`D <= 12`).
+    pub fn applies(self, tr: &Tracer, g: &Global) -> bool {
+        match self {
+            Order::DepthFirst => true,
+            Order::Waves => waves::applies(tr, g),
+        }
+    }
+}
+
+/// `L_i` along each of `rays` (indirect rays leaving the first Phong hit, traced at depth 1)
+/// in `order`, with no random numbers drawn between them. Where `order` applies, every order
+/// gives the same bits and counts the same rays (`tests/global_waves.rs` checks it).
+pub fn incident_all(tr: &mut Tracer, g: &Global, rays: &[Ray], order: Order) -> Vec<Vec3A> {
+    match order {
+        Order::DepthFirst => {
+            let mut stack = Vec::with_capacity(g.max_depth as usize + 1);
+            rays.iter()
+                .map(|r| incident(tr, g, *r, &mut stack))
+                .collect()
+        }
+        Order::Waves => waves::incident(tr, g, rays),
+    }
 }
 
 /// A ray still to be traced below the first Phong hit, with the weight `beta` its radiance

@@ -1,0 +1,187 @@
+//! Batched ray queries (`src/accel/batch.rs`): four rays in the SIMD lanes against one
+//! primitive at a time give what the one-ray queries give, to the bit, on random scenes of
+//! spheres and planes (and, through the BVH, triangles) at scales from 1e-3 to 1e5, for rays
+//! from anywhere and rays leaving a hit, where the error bands decide.
+
+use glam::Vec3A;
+use proptest::prelude::*;
+use rtis::accel::{Geometry, Prim};
+use rtis::geometry::{Hit, Ray};
+use rtis::shape::{Plane, Shape, Sphere, Triangle};
+
+fn unit() -> impl Strategy<Value = Vec3A> {
+    (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0)
+        .prop_filter("non-degenerate", |(x, y, z)| x * x + y * y + z * z > 1e-3)
+        .prop_map(|(x, y, z)| Vec3A::new(x, y, z).normalize())
+}
+
+fn point(s: f32) -> impl Strategy<Value = Vec3A> {
+    (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0).prop_map(move |(x, y, z)| Vec3A::new(x, y, z) * s)
+}
+
+/// A scene at scale `s`: up to 16 spheres (packed) and up to 9 planes; with `triangles`, a few
+/// triangles too, which put the scene in a BVH.
+fn scene(s: f32, triangles: bool) -> impl Strategy<Value = Vec<Prim>> {
+    let sphere = (point(s), 0.05f32..1.0)
+        .prop_map(move |(c, r)| Prim::flat(Shape::Sphere(Sphere { c, r: r * s })));
+    let plane =
+        (point(s), unit()).prop_map(|(p, n)| Prim::flat(Shape::Plane(Plane::through(p, n))));
+    let triangle = (point(s), point(s), point(s)).prop_filter_map("zero area", |(a, b, c)| {
+        Triangle::new(a, b, c).map(|t| Prim::flat(Shape::Triangle(t)))
+    });
+    let tris = if triangles { 1..6usize } else { 0..1usize };
+    (
+        prop::collection::vec(sphere, 0..17),
+        prop::collection::vec(plane, 0..10),
+        prop::collection::vec(triangle, tris),
+    )
+        .prop_map(|(mut a, b, c)| {
+            a.extend(b);
+            a.extend(c);
+            a
+        })
+}
+
+fn scale() -> impl Strategy<Value = f32> {
+    prop_oneof![Just(1e-3f32), Just(1.0), Just(1e3), Just(1e5)]
+}
+
+/// Rays from `origins` along `dirs`, each followed by a ray leaving its hit (if any) along the
+/// next direction, on either side; every third one a segment, as shadow rays are.
+fn rays(g: &Geometry, origins: &[Vec3A], dirs: &[Vec3A], s: f32) -> Vec<Ray> {
+    let mut out = Vec::new();
+    for (k, (&o, &d)) in origins.iter().zip(dirs).enumerate() {
+        let t_max = if k % 3 == 0 {
+            s * (k as f32 + 0.5) * 0.3
+        } else {
+            f32::INFINITY
+        };
+        let ray = Ray::segment(o, d, t_max);
+        out.push(ray);
+        if let Some(hit) = g.intersect(&Ray::new(o, d)) {
+            let w = dirs[(k + 1) % dirs.len()];
+            out.push(Ray::spawn(&hit, w, t_max));
+        }
+    }
+    out
+}
+
+fn bits(h: &Option<Hit>) -> Option<(u32, [u32; 7])> {
+    h.map(|h| {
+        let v = [h.t, h.p.x, h.p.y, h.p.z, h.n.x, h.err, h.err_along];
+        (h.prim, v.map(f32::to_bits))
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    /// The nearest hit of each ray of a batch is the one-ray query's, field for field.
+    #[test]
+    fn batched_nearest_hits_are_the_one_ray_hits(
+        (s, prims, origins, dirs, triangles) in (scale(), any::<bool>()).prop_flat_map(|(s, tri)| (
+            Just(s),
+            scene(s, tri),
+            prop::collection::vec(point(2.0 * s), 1..24),
+            prop::collection::vec(unit(), 24),
+            Just(tri),
+        ))
+    ) {
+        let g = Geometry::build(prims, Vec::new());
+        let rays = rays(&g, &origins, &dirs, s);
+        let mut hits = Vec::new();
+        g.intersect_batch(&rays, &mut hits);
+        prop_assert_eq!(hits.len(), rays.len());
+        for (k, (ray, hit)) in rays.iter().zip(&hits).enumerate() {
+            prop_assert_eq!(bits(hit), bits(&g.intersect(ray)), "ray {} of {} (triangles: {})", k, rays.len(), triangles);
+        }
+    }
+
+    /// Each shadow ray of a batch is blocked exactly when the one-ray query says so, with the
+    /// planes tested or skipped as each ray asks.
+    #[test]
+    fn batched_shadow_rays_are_the_one_ray_answers(
+        (s, prims, origins, dirs, planes) in (scale(), any::<bool>()).prop_flat_map(|(s, tri)| (
+            Just(s),
+            scene(s, tri),
+            prop::collection::vec(point(2.0 * s), 1..24),
+            prop::collection::vec(unit(), 24),
+            prop::collection::vec(any::<bool>(), 48),
+        ))
+    ) {
+        let g = Geometry::build(prims, Vec::new());
+        let rays = rays(&g, &origins, &dirs, s);
+        let planes = &planes[..rays.len()];
+        let mut blocked = Vec::new();
+        g.occluded_batch(&rays, planes, &mut blocked);
+        prop_assert_eq!(blocked.len(), rays.len());
+        for (k, ray) in rays.iter().enumerate() {
+            let one = if planes[k] { g.occluded(ray) } else { g.occluded_in_room(ray) };
+            prop_assert_eq!(blocked[k], one, "ray {} of {}", k, rays.len());
+        }
+    }
+}
+
+/// The batches cover every length, not only multiples of four, and an empty batch.
+#[test]
+fn batches_of_every_length() {
+    let prims = vec![
+        Prim::flat(Shape::Sphere(Sphere {
+            c: Vec3A::new(0.0, 0.0, 5.0),
+            r: 1.0,
+        })),
+        Prim::flat(Shape::Plane(Plane::through(
+            Vec3A::new(0.0, 0.0, 9.0),
+            Vec3A::Z,
+        ))),
+    ];
+    let g = Geometry::build(prims, Vec::new());
+    for n in 0..10 {
+        let rays: Vec<Ray> = (0..n)
+            .map(|k| {
+                Ray::new(
+                    Vec3A::ZERO,
+                    Vec3A::new(k as f32 * 0.1, 0.0, 1.0).normalize(),
+                )
+            })
+            .collect();
+        let (mut hits, mut blocked) = (Vec::new(), Vec::new());
+        g.intersect_batch(&rays, &mut hits);
+        g.occluded_batch(&rays, &vec![true; n], &mut blocked);
+        assert_eq!((hits.len(), blocked.len()), (n, n));
+        for (k, ray) in rays.iter().enumerate() {
+            assert_eq!(bits(&hits[k]), bits(&g.intersect(ray)));
+            assert_eq!(blocked[k], g.occluded(ray));
+        }
+    }
+}
+
+/// Two copies of a primitive meet a ray at the same distance: the later one wins, in a batch
+/// as in the one-ray query.
+#[test]
+fn equal_distances_go_to_the_later_primitive() {
+    let sphere = Shape::Sphere(Sphere {
+        c: Vec3A::new(0.0, 0.0, 5.0),
+        r: 1.0,
+    });
+    let plane = Shape::Plane(Plane::through(Vec3A::new(0.0, 0.0, 9.0), Vec3A::Z));
+    let g = Geometry::build(
+        [sphere, sphere, plane, plane].map(Prim::flat).to_vec(),
+        Vec::new(),
+    );
+    // Through the spheres, and past them onto the planes.
+    let rays: Vec<Ray> = [0.0, 0.1, 0.5, 0.9]
+        .iter()
+        .map(|&x| Ray::new(Vec3A::ZERO, Vec3A::new(x, 0.0, 1.0).normalize()))
+        .collect();
+    let mut hits = Vec::new();
+    g.intersect_batch(&rays, &mut hits);
+    let mut seen = std::collections::BTreeSet::new();
+    for (ray, hit) in rays.iter().zip(&hits) {
+        let one = g.intersect(ray);
+        assert_eq!(bits(hit), bits(&one));
+        seen.insert(one.expect("every ray hits").prim);
+    }
+    // One sphere and one plane took every hit: the later copy of each.
+    assert_eq!(seen.len(), 2, "{seen:?}");
+}

@@ -1,0 +1,180 @@
+//! The Global shader's two orders of tracing (`src/shader/global/waves.rs`): the trees of rays
+//! below a first hit traced in waves give the depth-first walk's `L_i` to the bit, and count
+//! the same rays, in every scene where the waves apply; and renders do not depend on which
+//! order ran.
+
+mod common;
+
+use common::{lights_out_of_room, scene, scenes_dir};
+use glam::Vec3A;
+use rtis::RenderScene;
+use rtis::geometry::Ray;
+use rtis::sampling::Sampler;
+use rtis::shader::global::{Order, incident_all};
+use rtis::shader::{Global, Shader};
+use rtis::stats::RayStats;
+
+/// The Global parameters of a scene.
+fn global(rs: &RenderScene) -> Global {
+    match rs.shader {
+        Shader::Global(g) => g,
+        other => panic!("not a Global scene: {other:?}"),
+    }
+}
+
+/// Rays as a first hit sends them: from random points in the course's box (inside the glass
+/// ball too), and from points on its surfaces found by tracing, where the error bands decide.
+fn rays(rs: &RenderScene, count: usize, seed: u64) -> Vec<Ray> {
+    let mut s = Sampler::new(seed, 0, 0);
+    let mut dir = || {
+        let (u1, u2) = s.next_2d();
+        let z = 1.0 - 2.0 * u1;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let phi = 2.0 * std::f32::consts::PI * u2;
+        Vec3A::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    let mut out = Vec::new();
+    let mut k = 0u32;
+    while out.len() < count {
+        k += 1;
+        // A point of the box in camera-relative coordinates (the camera is at z = -3).
+        let f = |i: u32| ((i as f32 * 0.618_034).fract() * 2.0 - 1.0) * 2.9;
+        let o = Vec3A::new(f(k), f(k * 7 + 1), f(k * 13 + 2) * 2.0 + 8.0);
+        let free = Ray::new(o, dir());
+        out.push(free);
+        // The same direction's hit, and a ray leaving it on the side it was met from.
+        if let Some(hit) = rs.geometry.intersect(&free) {
+            let w = dir();
+            let side = if w.dot(hit.n) * free.d.dot(hit.n) < 0.0 {
+                w
+            } else {
+                -w
+            };
+            out.push(Ray::spawn(&hit, side, f32::INFINITY));
+        }
+    }
+    out.truncate(count);
+    out
+}
+
+/// `L_i` of every ray in `order`, as bits, with the rays it counted.
+fn trace(rs: &RenderScene, g: &Global, rays: &[Ray], order: Order) -> (Vec<[u32; 3]>, RayStats) {
+    let mut stats = RayStats::default();
+    let mut tr = rs.tracer(Sampler::new(1, 2, 3), &mut stats);
+    assert!(order.applies(&tr, g), "{order:?} does not apply");
+    let l = incident_all(&mut tr, g, rays, order);
+    (
+        l.iter().map(|v| v.to_array().map(f32::to_bits)).collect(),
+        stats,
+    )
+}
+
+/// Both orders on `rs`: the same bits and the same counts.
+fn agree(name: &str, rs: &RenderScene) {
+    let g = global(rs);
+    let rays = rays(rs, 200, 11);
+    let (waves, waves_stats) = trace(rs, &g, &rays, Order::Waves);
+    let (walk, walk_stats) = trace(rs, &g, &rays, Order::DepthFirst);
+    for (k, (a, b)) in waves.iter().zip(&walk).enumerate() {
+        assert_eq!(a, b, "{name}: ray {k} ({:?}) differs", rays[k]);
+    }
+    assert_eq!(waves_stats, walk_stats, "{name}: ray counts differ");
+    assert!(
+        walk_stats.total() > 2 * rays.len() as u64,
+        "{name}: traced little"
+    );
+}
+
+/// The course's box under every depth from 1 to 6, with glass and mirror chains, and with
+/// each effect switched off in turn.
+#[test]
+fn waves_give_the_depth_first_bits_in_the_course_box() {
+    let cornell = scenes_dir().join("cornell.ron");
+    let cornell = cornell.to_str().unwrap();
+    for d in 1..=6 {
+        let text = format!(
+            "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: {d}, ambient: (0.3, 0.3, 0.3)))"
+        );
+        agree(&format!("D = {d}"), &rtis::extract(&scene(&text)));
+    }
+    for effect in [
+        "shadows",
+        "reflection",
+        "refraction",
+        "emission",
+        "indirect",
+        "ambient",
+        "background",
+    ] {
+        let text = format!(
+            "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)), effects: ({effect}: false))"
+        );
+        agree(&format!("{effect} off"), &rtis::extract(&scene(&text)));
+    }
+    // A sky that escaped chains see.
+    let text = format!(
+        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)), background: (0.5, 0.6, 0.7))"
+    );
+    agree("a sky", &rtis::extract(&scene(&text)));
+    // Ceiling panels with emission off: no hit samples them, and their rectangles are
+    // geometry like any other.
+    let area = scenes_dir().join("cornell-area.ron");
+    let text = format!(
+        "Scene(extends: {:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.1, 0.1, 0.1)), effects: (emission: false))",
+        area.to_str().unwrap()
+    );
+    agree("area lights switched off", &rtis::extract(&scene(&text)));
+    // Lights outside the room: their shadow rays test the planes too.
+    let text = format!(
+        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)))"
+    );
+    let mut rs = rtis::extract(&scene(&text));
+    lights_out_of_room(&mut rs);
+    agree("lights out of the room", &rs);
+}
+
+/// A mesh in a BVH (answered ray by ray inside the batches), and a Physical box.
+#[test]
+fn waves_give_the_depth_first_bits_with_a_bvh_and_the_physical_model() {
+    for (file, extra) in [
+        ("mesh.ron", ""),
+        ("cornell.ron", ", model: Physical"),
+        ("spheres.ron", ""),
+        ("triangles.ron", ""),
+    ] {
+        let path = scenes_dir().join(file);
+        let text = format!(
+            "Scene(extends: {:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.2, 0.2, 0.2)){extra})",
+            path.to_str().unwrap()
+        );
+        agree(file, &rtis::extract(&scene(&text)));
+    }
+}
+
+/// Where a hit samples area lights, the waves do not apply (their random numbers would be
+/// drawn in another order), and the shader walks depth first.
+#[test]
+fn waves_stand_aside_for_area_light_samples_and_deep_trees() {
+    let area = scenes_dir().join("cornell-area.ron");
+    let text = format!(
+        "Scene(extends: {:?}, shader: Global(samples: 4, max_depth: 2, ambient: (0.1, 0.1, 0.1), light_samples: 2))",
+        area.to_str().unwrap()
+    );
+    let rs = rtis::extract(&scene(&text));
+    let mut stats = RayStats::default();
+    let tr = rs.tracer(Sampler::new(1, 2, 3), &mut stats);
+    assert!(!Order::Waves.applies(&tr, &global(&rs)));
+    let cornell = scenes_dir().join("cornell.ron");
+    let text = format!(
+        "Scene(extends: {:?}, shader: Global(samples: 1, max_depth: 13, ambient: (0.1, 0.1, 0.1)))",
+        cornell.to_str().unwrap()
+    );
+    let rs = rtis::extract(&scene(&text));
+    let tr = rs.tracer(Sampler::new(1, 2, 3), &mut stats);
+    assert!(!Order::Waves.applies(&tr, &global(&rs)));
+    let g = Global {
+        max_depth: 12,
+        ..global(&rs)
+    };
+    assert!(Order::Waves.applies(&tr, &g));
+}
