@@ -67,18 +67,14 @@ impl Geometry {
     }
 
     /// Whether each ray of `rays` is blocked, as [`Geometry::occluded`] answers it, or as
-    /// [`Geometry::occluded_in_room`] does where `planes` holds false, into `blocked` (cleared
-    /// first, then one entry per ray).
-    pub fn occluded_batch(&self, rays: &[Ray], planes: &[bool], blocked: &mut Vec<bool>) {
-        assert_eq!(rays.len(), planes.len(), "one plane switch per ray");
+    /// [`Geometry::occluded_in_room`] does if not `planes`, into `blocked` (cleared first,
+    /// then one entry per ray).
+    pub fn occluded_batch(&self, rays: &[Ray], planes: bool, blocked: &mut Vec<bool>) {
         blocked.clear();
         if !self.all_packed() {
-            blocked.extend(rays.iter().zip(planes).map(|(r, &p)| {
-                if p {
-                    self.occluded(r)
-                } else {
-                    self.occluded_in_room(r)
-                }
+            blocked.extend(rays.iter().map(|r| match planes {
+                true => self.occluded(r),
+                false => self.occluded_in_room(r),
             }));
             return;
         }
@@ -90,12 +86,10 @@ impl Geometry {
             for (_, sphere) in &self.sphere_each {
                 hit |= sphere.hit(&lanes, t_max).1;
             }
-            let last = rays.len() - 1;
-            let test_planes = BVec4A::from_array([0, 1, 2, 3].map(|i| planes[(k + i).min(last)]));
-            // The planes only for the lanes that ask and are not blocked yet.
-            if (test_planes & !hit).any() {
+            // The planes only if asked, and while a lane is not blocked yet.
+            if planes && !hit.all() {
                 for (_, plane) in &self.plane_each {
-                    hit |= plane.hit(&lanes, t_max).1 & test_planes;
+                    hit |= plane.hit(&lanes, t_max).1;
                 }
             }
             let n = (rays.len() - k).min(4);

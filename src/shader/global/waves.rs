@@ -44,8 +44,6 @@ fn nodes_per_sample(g: &Global) -> usize {
 /// One ray of the tree and the mirror or glass chain it starts: what they add to `L_i`.
 #[derive(Clone, Copy)]
 struct Node {
-    /// What the chain's next ray is counted as.
-    kind: RayKind,
     /// Mirror and glass bounces so far.
     bounces: u32,
     /// The weight `beta` of the node's radiance in `L_i`.
@@ -65,7 +63,6 @@ impl Node {
     /// A node about to trace its first ray with weight `beta`.
     fn new(beta: Vec3A) -> Self {
         Node {
-            kind: RayKind::Indirect,
             bounces: 0,
             beta,
             tint: Vec3A::ONE,
@@ -89,7 +86,7 @@ struct Lit {
 }
 
 /// A point light's term at a hit before its shadow ray is answered: `L_i r(wi, wo)`, and the
-/// shadow ray's index ([`SEEN`] if none is traced).
+/// shadow ray's index among the light's ([`SEEN`] if none is traced).
 type Term = (Vec3A, u32);
 
 /// The index of a term whose light counts without a shadow ray (shadows off), or that adds
@@ -126,9 +123,9 @@ struct Scratch {
     hits: Vec<Option<Hit>>,
     lit: Vec<Lit>,
     terms: Vec<Term>,
-    shadow: Vec<Ray>,
-    planes: Vec<bool>,
-    blocked: Vec<bool>,
+    /// Each light's shadow rays, and whether each is blocked.
+    shadow: Vec<Vec<Ray>>,
+    blocked: Vec<Vec<bool>>,
     stack: Vec<u32>,
 }
 
@@ -177,6 +174,7 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
     for (i, r) in roots.iter().enumerate() {
         s.nodes.push(Node::new(Vec3A::ONE));
         s.children.push(i as u32, *r);
+        tr.stats.count(RayKind::Indirect);
     }
     for depth in 1..=g.max_depth {
         if s.children.rays.is_empty() {
@@ -186,19 +184,16 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         s.children.clear();
         s.lit.clear();
         s.terms.clear();
-        s.shadow.clear();
-        s.planes.clear();
+        s.shadow.resize_with(tr.lights.len(), Vec::new);
+        s.shadow.iter_mut().for_each(Vec::clear);
         // Each bounce of the mirror and glass chains in one batch, until every chain ends.
         while !s.now.rays.is_empty() {
-            for &i in &s.now.nodes {
-                tr.stats.count(s.nodes[i as usize].kind);
-            }
             tr.geometry.intersect_batch(&s.now.rays, &mut s.hits);
             s.bounced.clear();
             for k in 0..s.now.rays.len() {
-                let (i, ray) = (s.now.nodes[k], s.now.rays[k]);
+                let i = s.now.nodes[k];
                 match s.hits[k] {
-                    Some(hit) => shade(tr, g, s, depth, i, &ray, hit),
+                    Some(hit) => shade(tr, g, s, depth, k, hit),
                     None => {
                         let node = &mut s.nodes[i as usize];
                         node.rest = Some(node.beta * node.tint * tr.background);
@@ -214,8 +209,9 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
 /// Node `i`'s ray met `hit`: as [`crate::shader::surface::follow_specular`], a mirror or glass
 /// sends the chain on (into `s.bounced`); at a Phong surface, Eq. 3's light terms and shadow
 /// rays are queued and, below depth `D`, the two rays of task 2 (into `s.children`).
-fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, i: u32, ray: &Ray, hit: Hit) {
-    let si = Interaction::new(tr, ray, hit);
+fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit: Hit) {
+    let i = s.now.nodes[k];
+    let si = Interaction::new(tr, &s.now.rays[k], hit);
     let node = &mut s.nodes[i as usize];
     // The emitter a node's own ray hits is the direct light of the hit it left.
     if node.bounces > 0 {
@@ -227,8 +223,8 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, i: u32, ray: 
         }
         if let Some((next, tint, kind)) = specular_bounce(&si, tr.effects) {
             node.tint *= tint;
-            node.kind = kind;
             node.bounces += 1;
+            tr.stats.count(kind);
             s.bounced.push(i, next);
         }
         return;
@@ -238,15 +234,15 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, i: u32, ray: 
     // that reflects nothing has none (`point_lights`).
     let reflects = !phong.is_black();
     if reflects {
-        for light in tr.lights {
+        let lights = tr.lights;
+        for (light, rays) in lights.iter().zip(&mut s.shadow) {
             s.terms.push(match point_light_ray(&si, light) {
                 None => (Vec3A::ZERO, SEEN),
                 Some((inc, shadow)) => {
                     let term = point_light_term(tr.model, &si, &phong, &inc, true);
                     if tr.effects.shadows {
-                        s.shadow.push(shadow);
-                        s.planes.push(!light.in_room());
-                        (term, s.shadow.len() as u32 - 1)
+                        rays.push(shadow);
+                        (term, rays.len() as u32 - 1)
                     } else {
                         (term, SEEN)
                     }
@@ -273,6 +269,7 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, i: u32, ray: 
         let b = beta * reflectance(tr.model, &phong, w, wo, n) / (4.0 * PI);
         s.nodes.push(Node::new(b));
         s.children.push(first + k as u32, si.spawn(w));
+        tr.stats.count(RayKind::Indirect);
     }
 }
 
@@ -280,11 +277,14 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, i: u32, ray: 
 /// `direct_light` sums it (the lights' terms in order, then the area lights' zero), plus the
 /// ambient term at depth `D`.
 fn finish_direct_light(tr: &mut Tracer, s: &mut Scratch) {
-    for _ in 0..s.shadow.len() {
-        tr.stats.count(RayKind::Shadow);
+    // Light by light: rays towards one light from nearby hits run close together, so the
+    // lanes of a batch tend to agree, and all or none test the planes.
+    s.blocked.resize_with(s.shadow.len(), Vec::new);
+    for ((light, rays), blocked) in tr.lights.iter().zip(&s.shadow).zip(&mut s.blocked) {
+        tr.stats.shadow += rays.len() as u64;
+        tr.geometry
+            .occluded_batch(rays, !light.in_room(), blocked);
     }
-    tr.geometry
-        .occluded_batch(&s.shadow, &s.planes, &mut s.blocked);
     let lights = tr.lights.len();
     let mut at = 0;
     for lit in &s.lit {
@@ -296,8 +296,9 @@ fn finish_direct_light(tr: &mut Tracer, s: &mut Scratch) {
                 at += lights;
                 s.terms[at - lights..at]
                     .iter()
-                    .map(|&(term, k)| {
-                        let seen = k == SEEN || !s.blocked[k as usize];
+                    .zip(&s.blocked)
+                    .map(|(&(term, k), blocked)| {
+                        let seen = k == SEEN || !blocked[k as usize];
                         Vec3A::select(BVec3A::splat(seen), term, Vec3A::ZERO)
                     })
                     .sum()
