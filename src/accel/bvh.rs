@@ -61,7 +61,9 @@ struct Item {
     min: Vec3,
     prim: u32,
     max: Vec3,
-    _pad: u32,
+    /// The bin `best_split` put the item in at the node being split, which the partition
+    /// then reads instead of computing it again.
+    bin: u32,
 }
 
 impl Item {
@@ -114,7 +116,7 @@ impl Bvh {
                     min: b.min.into(),
                     prim: i as u32,
                     max: b.max.into(),
-                    _pad: 0,
+                    bin: 0,
                 }
             })
             .collect();
@@ -295,9 +297,8 @@ fn build_node(
     };
     let (mid, sides) = match split {
         Some((bin, left, right)) => {
-            let (lo, w) = (cbounds.min[axis], extent[axis]);
-            let scale = BINS as f32 / w;
-            let mid = partition(order, |it| bin_of(it.centroid(axis), lo, scale) <= bin);
+            // Each item's bin, as binning found it.
+            let mid = partition(order, |it| it.bin as usize <= bin);
             (mid, Some((left, right)))
         }
         // A leaf's worth, a flat centroid box, the depth limit, or every item in one bin:
@@ -415,10 +416,11 @@ fn fold_bounds(items: &[Item]) -> (Aabb, Aabb) {
 
 /// The bin after which to split more than a leaf's worth of items along `axis` at the least
 /// SAH cost, with the item and centroid boxes of both sides; `None` if every item falls in one
-/// bin. (A leaf's worth never gets here: see `build_node`.)
+/// bin. (A leaf's worth never gets here: see `build_node`.) Each item keeps its bin in
+/// `Item::bin` for the partition.
 #[allow(clippy::type_complexity)]
 fn best_split(
-    order: &[Item],
+    order: &mut [Item],
     cb: &Aabb,
     axis: usize,
     area: f32,
@@ -428,7 +430,9 @@ fn best_split(
     let mut bins = [(Aabb::EMPTY, Aabb::EMPTY, 0usize); BINS];
     for it in order {
         let ib = it.bounds();
-        let b = &mut bins[bin_of(it.centroid(axis), lo, scale)];
+        let bin = bin_of(it.centroid(axis), lo, scale);
+        it.bin = bin as u32;
+        let b = &mut bins[bin];
         b.0 = b.0.union(ib);
         b.1 = b.1.grow(ib.centroid());
         b.2 += 1;
