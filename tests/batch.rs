@@ -1,11 +1,12 @@
-//! Batched ray queries (`src/accel/batch.rs`): four rays in the SIMD lanes against one
-//! primitive at a time give what the one-ray queries give, to the bit, on random scenes of
-//! spheres and planes (and, through the BVH, triangles) at scales from 1e-3 to 1e5, for rays
-//! from anywhere and rays leaving a hit, where the error bands decide.
+//! Batched ray queries (`src/accel/batch.rs`): rays in the SIMD lanes (four with SSE, eight
+//! with AVX2) against one primitive at a time give what the one-ray queries give, to the bit,
+//! in every instruction set the CPU runs, on random scenes of spheres and planes (and, through
+//! the BVH, triangles) at scales from 1e-3 to 1e5, for rays from anywhere and rays leaving a
+//! hit, where the error bands decide.
 
 use glam::Vec3A;
 use proptest::prelude::*;
-use rtis::accel::{Geometry, Prim};
+use rtis::accel::{Geometry, Isa, Prim, require_all_isas};
 use rtis::geometry::{Hit, Ray};
 use rtis::shape::{Plane, Shape, Sphere, Triangle};
 
@@ -66,6 +67,15 @@ fn rays(g: &Geometry, origins: &[Vec3A], dirs: &[Vec3A], s: f32) -> Vec<Ray> {
     out
 }
 
+/// `g` with its queries in each instruction set this CPU runs.
+fn each_isa(mut g: Geometry) -> impl Iterator<Item = (Isa, Geometry)> {
+    require_all_isas();
+    Isa::all_available().into_iter().map(move |isa| {
+        assert!(g.bvh.set_isa(isa));
+        (isa, g.clone())
+    })
+}
+
 fn bits(h: &Option<Hit>) -> Option<(u32, [u32; 7])> {
     h.map(|h| {
         let v = [h.t, h.p.x, h.p.y, h.p.z, h.n.x, h.err, h.err_along];
@@ -89,11 +99,13 @@ proptest! {
     ) {
         let g = Geometry::build(prims, Vec::new());
         let rays = rays(&g, &origins, &dirs, s);
-        let mut hits = Vec::new();
-        g.intersect_batch(&rays, &mut hits);
-        prop_assert_eq!(hits.len(), rays.len());
-        for (k, (ray, hit)) in rays.iter().zip(&hits).enumerate() {
-            prop_assert_eq!(bits(hit), bits(&g.intersect(ray)), "ray {} of {} (triangles: {})", k, rays.len(), triangles);
+        for (isa, g) in each_isa(g) {
+            let mut hits = Vec::new();
+            g.intersect_batch(&rays, &mut hits);
+            prop_assert_eq!(hits.len(), rays.len());
+            for (k, (ray, hit)) in rays.iter().zip(&hits).enumerate() {
+                prop_assert_eq!(bits(hit), bits(&g.intersect(ray)), "{:?}: ray {} of {} (triangles: {})", isa, k, rays.len(), triangles);
+            }
         }
     }
 
@@ -111,12 +123,14 @@ proptest! {
     ) {
         let g = Geometry::build(prims, Vec::new());
         let rays = rays(&g, &origins, &dirs, s);
-        let mut blocked = Vec::new();
-        g.occluded_batch(&rays, planes, &mut blocked);
-        prop_assert_eq!(blocked.len(), rays.len());
-        for (k, ray) in rays.iter().enumerate() {
-            let one = if planes { g.occluded(ray) } else { g.occluded_in_room(ray) };
-            prop_assert_eq!(blocked[k], one, "ray {} of {}", k, rays.len());
+        for (isa, g) in each_isa(g) {
+            let mut blocked = Vec::new();
+            g.occluded_batch(&rays, planes, &mut blocked);
+            prop_assert_eq!(blocked.len(), rays.len());
+            for (k, ray) in rays.iter().enumerate() {
+                let one = if planes { g.occluded(ray) } else { g.occluded_in_room(ray) };
+                prop_assert_eq!(blocked[k], one, "{:?}: ray {} of {}", isa, k, rays.len());
+            }
         }
     }
 }
@@ -134,23 +148,24 @@ fn batches_of_every_length() {
             Vec3A::Z,
         ))),
     ];
-    let g = Geometry::build(prims, Vec::new());
-    for n in 0..10 {
-        let rays: Vec<Ray> = (0..n)
-            .map(|k| {
-                Ray::new(
-                    Vec3A::ZERO,
-                    Vec3A::new(k as f32 * 0.1, 0.0, 1.0).normalize(),
-                )
-            })
-            .collect();
-        let (mut hits, mut blocked) = (Vec::new(), Vec::new());
-        g.intersect_batch(&rays, &mut hits);
-        g.occluded_batch(&rays, true, &mut blocked);
-        assert_eq!((hits.len(), blocked.len()), (n, n));
-        for (k, ray) in rays.iter().enumerate() {
-            assert_eq!(bits(&hits[k]), bits(&g.intersect(ray)));
-            assert_eq!(blocked[k], g.occluded(ray));
+    for (_, g) in each_isa(Geometry::build(prims, Vec::new())) {
+        for n in 0..18 {
+            let rays: Vec<Ray> = (0..n)
+                .map(|k| {
+                    Ray::new(
+                        Vec3A::ZERO,
+                        Vec3A::new(k as f32 * 0.1, 0.0, 1.0).normalize(),
+                    )
+                })
+                .collect();
+            let (mut hits, mut blocked) = (Vec::new(), Vec::new());
+            g.intersect_batch(&rays, &mut hits);
+            g.occluded_batch(&rays, true, &mut blocked);
+            assert_eq!((hits.len(), blocked.len()), (n, n));
+            for (k, ray) in rays.iter().enumerate() {
+                assert_eq!(bits(&hits[k]), bits(&g.intersect(ray)));
+                assert_eq!(blocked[k], g.occluded(ray));
+            }
         }
     }
 }
@@ -169,18 +184,20 @@ fn equal_distances_go_to_the_later_primitive() {
         Vec::new(),
     );
     // Through the spheres, and past them onto the planes.
-    let rays: Vec<Ray> = [0.0, 0.1, 0.5, 0.9]
+    let rays: Vec<Ray> = [0.0, 0.1, 0.5, 0.9, 0.05, 0.7, 0.2, 0.3, 0.6]
         .iter()
         .map(|&x| Ray::new(Vec3A::ZERO, Vec3A::new(x, 0.0, 1.0).normalize()))
         .collect();
-    let mut hits = Vec::new();
-    g.intersect_batch(&rays, &mut hits);
-    let mut seen = std::collections::BTreeSet::new();
-    for (ray, hit) in rays.iter().zip(&hits) {
-        let one = g.intersect(ray);
-        assert_eq!(bits(hit), bits(&one));
-        seen.insert(one.expect("every ray hits").prim);
+    for (isa, g) in each_isa(g) {
+        let mut hits = Vec::new();
+        g.intersect_batch(&rays, &mut hits);
+        let mut seen = std::collections::BTreeSet::new();
+        for (ray, hit) in rays.iter().zip(&hits) {
+            let one = g.intersect(ray);
+            assert_eq!(bits(hit), bits(&one), "{isa:?}");
+            seen.insert(one.expect("every ray hits").prim);
+        }
+        // One sphere and one plane took every hit: the later copy of each.
+        assert_eq!(seen.len(), 2, "{isa:?}: {seen:?}");
     }
-    // One sphere and one plane took every hit: the later copy of each.
-    assert_eq!(seen.len(), 2, "{seen:?}");
 }

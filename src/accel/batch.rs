@@ -1,25 +1,39 @@
-//! Ray queries in batches: four rays in the SIMD lanes, tested against one primitive at a time.
+//! Ray queries in batches: a ray per SIMD lane, tested against one primitive at a time.
 //!
 //! A shader that holds many rays at once (the Global shader's tree of indirect rays, the shadow
 //! rays of all its hits) hands them over together. Where every primitive is packed (planes,
-//! and the spheres of small scenes), four rays fill the lanes and each primitive is splatted
-//! across them ([`Geometry::sphere_each`], [`Geometry::plane_each`]): no lane is padding, no
-//! closest-lane search runs per ray, and the ray's constants are computed once. Each lane runs
-//! the arithmetic the one-ray query runs for its pair, in the same order of primitives and with
-//! the same tie rule, so the answers are bit-identical to [`Geometry::intersect`] and
-//! [`Geometry::occluded`]. Scenes with a BVH answer ray by ray.
+//! and the spheres of small scenes), the rays fill the lanes (eight with AVX2, four with SSE)
+//! and each primitive is splatted across them ([`Geometry::sphere_each`],
+//! [`Geometry::plane_each`]): no lane is padding, no closest-lane search runs per ray, and the
+//! ray's constants are computed once. Each lane runs the arithmetic the one-ray query runs for
+//! its pair, in the same order of primitives and with the same tie rule, so the answers are
+//! bit-identical to [`Geometry::intersect`] and [`Geometry::occluded`] in every instruction
+//! set. Scenes with a BVH answer ray by ray.
+//!
+//! The instruction set is the BVH's ([`super::WideBvh::isa`]): AVX2 where the CPU has it. The
+//! AVX2 copies are `#[target_feature]` functions around the generic code, which has no
+//! closures, so every lane operation inlines into them.
 
 use super::Geometry;
 use super::lanes::RayLanes;
+use super::simd::{Floats, Isa};
 use crate::geometry::{Hit, Ray};
-use glam::{BVec4A, Vec4};
+use glam::Vec4;
 
-/// The four rays of a batch's chunk starting at `k` (the last ray repeated past the end; its
-/// answers are dropped).
+/// The `L::LANES` rays of a batch's chunk starting at `k` (the last ray repeated past the end;
+/// its answers are dropped), and their `t_max`.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
 #[inline(always)]
-fn chunk(rays: &[Ray], k: usize) -> [&Ray; 4] {
+unsafe fn chunk<L: Floats>(rays: &[Ray], k: usize) -> ([&Ray; 8], L) {
     let last = rays.len() - 1;
-    [0, 1, 2, 3].map(|i| &rays[(k + i).min(last)])
+    let mut eight = [&rays[last]; 8];
+    for (i, r) in eight.iter_mut().enumerate().take(L::LANES) {
+        *r = &rays[(k + i).min(last)];
+    }
+    // SAFETY: the caller vouches for the instruction set.
+    (eight, unsafe { L::from_array8(eight.map(|r| r.t_max)) })
 }
 
 impl Geometry {
@@ -37,32 +51,12 @@ impl Geometry {
             hits.extend(rays.iter().map(|r| self.intersect(r)));
             return;
         }
-        for k in (0..rays.len()).step_by(4) {
-            let four = chunk(rays, k);
-            let lanes = RayLanes::gather(four);
-            let mut t_max = Vec4::from_array(four.map(|r| r.t_max));
-            // Each lane's best primitive index, as the bits of a float lane (selects move bits
-            // unchanged), so that no lane takes a branch.
-            let mut best = Vec4::splat(f32::from_bits(u32::MAX));
-            // Spheres, then planes, as the one-ray query; a later primitive at equal distance
-            // wins. A lane's `ok` holds only hits within its current `t_max`.
-            let take = |id: u32, (t, ok): (Vec4, BVec4A), t_max: &mut Vec4, best: &mut Vec4| {
-                *t_max = Vec4::select(ok, t, *t_max);
-                *best = Vec4::select(ok, Vec4::splat(f32::from_bits(id)), *best);
-            };
-            for (id, sphere) in &self.sphere_each {
-                take(*id, sphere.hit(&lanes, t_max), &mut t_max, &mut best);
-            }
-            for (id, plane) in &self.plane_each {
-                take(*id, plane.hit(&lanes, t_max), &mut t_max, &mut best);
-            }
-            let (t, best) = (t_max.to_array(), best.to_array().map(f32::to_bits));
-            let n = (rays.len() - k).min(4);
-            hits.extend(
-                (0..n).map(|i| {
-                    (best[i] != u32::MAX).then(|| self.hit_record(four[i], best[i], t[i]))
-                }),
-            );
+        match self.bvh.isa() {
+            // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => unsafe { self.intersect_avx2(rays, hits) },
+            // SAFETY: `Vec4` runs on every CPU.
+            _ => unsafe { self.intersect_in::<Vec4>(rays, hits) },
         }
     }
 
@@ -78,23 +72,100 @@ impl Geometry {
             }));
             return;
         }
-        for k in (0..rays.len()).step_by(4) {
-            let four = chunk(rays, k);
-            let lanes = RayLanes::gather(four);
-            let t_max = Vec4::from_array(four.map(|r| r.t_max));
-            let mut hit = BVec4A::FALSE;
+        match self.bvh.isa() {
+            // SAFETY: as in `intersect_batch`.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => unsafe { self.occluded_avx2(rays, planes, blocked) },
+            // SAFETY: `Vec4` runs on every CPU.
+            _ => unsafe { self.occluded_in::<Vec4>(rays, planes, blocked) },
+        }
+    }
+
+    /// [`Geometry::intersect_batch`] in eight AVX2 lanes.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn intersect_avx2(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+        // SAFETY: this function runs only where AVX2 was found.
+        unsafe { self.intersect_in::<super::simd::avx2::F8>(rays, hits) }
+    }
+
+    /// [`Geometry::occluded_batch`] in eight AVX2 lanes.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn occluded_avx2(&self, rays: &[Ray], planes: bool, blocked: &mut Vec<bool>) {
+        // SAFETY: this function runs only where AVX2 was found.
+        unsafe { self.occluded_in::<super::simd::avx2::F8>(rays, planes, blocked) }
+    }
+
+    /// The nearest hits of `rays`, `L::LANES` at a time.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn intersect_in<L: Floats>(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+        for k in (0..rays.len()).step_by(L::LANES) {
+            // SAFETY: the caller vouches for the instruction set.
+            let (four, mut t_max) = unsafe { chunk::<L>(rays, k) };
+            let lanes = unsafe { RayLanes::<L>::gather(&four) };
+            // Each lane's best primitive index, as the bits of a float lane (selects move bits
+            // unchanged), so that no lane takes a branch.
+            let mut best = unsafe { L::splat(f32::from_bits(u32::MAX)) };
+            // Spheres, then planes, as the one-ray query; a later primitive at equal distance
+            // wins. A lane's `ok` holds only hits within its current `t_max`.
+            for (id, sphere) in &self.sphere_each {
+                let (t, ok) = unsafe { sphere.splat::<L>() }.hit(&lanes, t_max);
+                t_max = L::select(ok, t, t_max);
+                best = L::select(ok, unsafe { L::splat(f32::from_bits(*id)) }, best);
+            }
+            for (id, plane) in &self.plane_each {
+                let (t, ok) = unsafe { plane.splat::<L>() }.hit(&lanes, t_max);
+                t_max = L::select(ok, t, t_max);
+                best = L::select(ok, unsafe { L::splat(f32::from_bits(*id)) }, best);
+            }
+            let (mut t, mut b) = ([0.0f32; 8], [0.0f32; 8]);
+            t_max.write_to(&mut t);
+            best.write_to(&mut b);
+            for i in 0..(rays.len() - k).min(L::LANES) {
+                let prim = b[i].to_bits();
+                hits.push(match prim {
+                    u32::MAX => None,
+                    _ => Some(self.hit_record(four[i], prim, t[i])),
+                });
+            }
+        }
+    }
+
+    /// Whether `rays` are blocked, `L::LANES` at a time.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn occluded_in<L: Floats>(&self, rays: &[Ray], planes: bool, blocked: &mut Vec<bool>) {
+        for k in (0..rays.len()).step_by(L::LANES) {
+            // SAFETY: the caller vouches for the instruction set.
+            let (four, t_max) = unsafe { chunk::<L>(rays, k) };
+            let lanes = unsafe { RayLanes::<L>::gather(&four) };
+            // No lane blocked yet (nothing is below itself, NaN included).
+            let mut hit = t_max.cmplt(t_max);
             for (_, sphere) in &self.sphere_each {
-                hit |= sphere.hit(&lanes, t_max).1;
+                hit = hit | unsafe { sphere.splat::<L>() }.hit(&lanes, t_max).1;
             }
             // The planes only if asked, and while a lane is not blocked yet.
-            if planes && !hit.all() {
+            if planes && !L::all(hit) {
                 for (_, plane) in &self.plane_each {
-                    hit |= plane.hit(&lanes, t_max).1;
+                    hit = hit | unsafe { plane.splat::<L>() }.hit(&lanes, t_max).1;
                 }
             }
-            let n = (rays.len() - k).min(4);
-            let mask = hit.bitmask();
-            blocked.extend((0..n).map(|i| mask & (1 << i) != 0));
+            let mask = L::bitmask(hit);
+            for i in 0..(rays.len() - k).min(L::LANES) {
+                blocked.push(mask & (1 << i) != 0);
+            }
         }
     }
 }

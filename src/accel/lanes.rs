@@ -4,26 +4,27 @@
 //! `shape::Plane`), including their rule for a ray that starts on the surface, so a packet
 //! finds the hits the scalar code would (`tests/shapes.rs` checks that they agree).
 //!
-//! The same tests run the other way round: four rays in the lanes ([`RayLanes::gather`])
-//! against one primitive in all of them ([`SphereLanes::splat_lane`]), as a batch of rays
-//! needs. Each lane computes what the scalar test computes for its pair, so both layouts give
-//! the same bits.
+//! The same tests run the other way round: a ray per lane ([`RayLanes::gather`]) against one
+//! primitive in all of them ([`SphereLanes::splat`]), as a batch of rays needs, four lanes in
+//! SSE or eight in AVX2 (the tests are written once over [`Floats`]). Each lane computes what
+//! the scalar test computes for its pair, so every layout gives the same bits.
 
+use super::simd::Floats;
 use crate::geometry::{Ray, gamma};
 use crate::shape::{Plane, Sphere};
 use glam::{BVec4A, Vec4};
 
-/// A ray splatted across four lanes ([`RayLanes::new`]), or four rays, one per lane
-/// ([`RayLanes::gather`]).
+/// A ray splatted across four lanes ([`RayLanes::new`]), or one ray per lane
+/// ([`RayLanes::gather`]), in lanes of type `L`.
 #[derive(Clone, Copy)]
-pub struct RayLanes {
-    o: [Vec4; 3],
-    d: [Vec4; 3],
+pub struct RayLanes<L = Vec4> {
+    o: [L; 3],
+    d: [L; 3],
     /// The origin's share of a plane's band per unit of `sum |n_i|`:
     /// `gamma(4) max |o_i| + o_err`.
-    plane_k: Vec4,
+    plane_k: L,
     /// The error of `o` before the sphere's centre is subtracted: `o_err + gamma(1) max |o_i|`.
-    sphere_k: Vec4,
+    sphere_k: L,
 }
 
 impl RayLanes {
@@ -38,55 +39,65 @@ impl RayLanes {
             sphere_k: Vec4::splat(ray.o_err + gamma(1) * a),
         }
     }
+}
 
-    /// Four rays, one per lane, with each lane's constants as [`RayLanes::new`] computes them.
+impl<L: Floats> RayLanes<L> {
+    /// `L::LANES` rays, one per lane (the first of `rays`), with each lane's constants as
+    /// [`RayLanes::new`] computes them. (No closures that compute in lanes: this inlines into
+    /// code compiled for `L`'s instruction set.)
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    pub fn gather(rays: [&Ray; 4]) -> Self {
-        // Transpose: four `Vec3A`s (x, y, z, pad) into x, y, z lanes.
-        let t = |v: [glam::Vec3A; 4]| {
-            let [a, b, c, d] = v.map(|v| v.extend(0.0));
-            let m = glam::Mat4::from_cols(a, b, c, d).transpose();
-            [m.x_axis, m.y_axis, m.z_axis]
-        };
-        let a = Vec4::from_array(rays.map(|r| r.o.abs().max_element()));
-        let o_err = Vec4::from_array(rays.map(|r| r.o_err));
-        RayLanes {
-            o: t(rays.map(|r| r.o)),
-            d: t(rays.map(|r| r.d)),
-            plane_k: Vec4::splat(gamma(4)) * a + o_err,
-            sphere_k: o_err + Vec4::splat(gamma(1)) * a,
+    pub unsafe fn gather(rays: &[&Ray; 8]) -> Self {
+        // SAFETY: the caller vouches for the instruction set.
+        unsafe {
+            let o = L::transpose3(&rays.map(|r| &r.o));
+            let d = L::transpose3(&rays.map(|r| &r.d));
+            let o_err = L::from_array8(rays.map(|r| r.o_err));
+            // `max |o_i|` in glam's order (`Vec3A::max_element`): max(max(x, z), max(y, z)).
+            let [x, y, z] = [o[0].abs(), o[1].abs(), o[2].abs()];
+            let a = x.max(z).max(y.max(z));
+            RayLanes {
+                o,
+                d,
+                plane_k: L::splat(gamma(4)) * a + o_err,
+                sphere_k: o_err + L::splat(gamma(1)) * a,
+            }
         }
     }
 }
 
 #[inline(always)]
-fn dot(a: [Vec4; 3], b: [Vec4; 3]) -> Vec4 {
+fn dot<L: Floats>(a: [L; 3], b: [L; 3]) -> L {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Up to four spheres; unused lanes have `r2 = -1` and never hit.
+/// Up to four spheres in lanes of type `L`; unused lanes have `r2 = -1` and never hit. With
+/// `L = f32`, one sphere, to be splatted ([`SphereLanes::splat`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct SphereLanes {
-    c: [Vec4; 3],
-    r: Vec4,
-    r2: Vec4,
+pub struct SphereLanes<L = Vec4> {
+    c: [L; 3],
+    r: L,
+    r2: L,
     /// `1 / r` (0 in unused lanes).
-    inv_r: Vec4,
+    inv_r: L,
     /// `gamma(1) max |c_i|`: the rounding of `o - c` due to the centre.
-    c_err: Vec4,
+    c_err: L,
 }
 
-/// Up to four planes; unused lanes have a zero normal and never hit.
+/// Up to four planes in lanes of type `L`; unused lanes have a zero normal and never hit.
+/// With `L = f32`, one plane, to be splatted ([`PlaneLanes::splat`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct PlaneLanes {
-    n: [Vec4; 3],
-    dist: Vec4,
+pub struct PlaneLanes<L = Vec4> {
+    n: [L; 3],
+    dist: L,
     /// `sum |n_i|`.
-    n_abs_sum: Vec4,
+    n_abs_sum: L,
     /// `gamma(4) |dist|`.
-    dist_err: Vec4,
+    dist_err: L,
     /// [`Plane::side`] (0 in unused lanes).
-    side: Vec4,
+    side: L,
 }
 
 impl SphereLanes {
@@ -110,54 +121,79 @@ impl SphereLanes {
         }
     }
 
-    /// Lane `i`'s sphere in all four lanes (an unused lane's padding, which never hits).
-    pub fn splat_lane(&self, i: usize) -> Self {
-        let s = |v: Vec4| Vec4::splat(v[i]);
+    /// Lane `i`'s sphere (an unused lane's padding, which never hits).
+    pub fn lane(&self, i: usize) -> SphereLanes<f32> {
         SphereLanes {
-            c: self.c.map(s),
-            r: s(self.r),
-            r2: s(self.r2),
-            inv_r: s(self.inv_r),
-            c_err: s(self.c_err),
+            c: self.c.map(|v| v[i]),
+            r: self.r[i],
+            r2: self.r2[i],
+            inv_r: self.inv_r[i],
+            c_err: self.c_err[i],
         }
     }
+}
 
-    /// Distances of each lane's hit in `(0, tm]`, and which lanes hit (the scalar
-    /// [`Sphere::intersect`], four at a time).
+impl SphereLanes<f32> {
+    /// This sphere in every lane of `L`.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    pub fn hit(&self, r: &RayLanes, tm: Vec4) -> (Vec4, BVec4A) {
+    pub unsafe fn splat<L: Floats>(&self) -> SphereLanes<L> {
+        // SAFETY: the caller vouches for the instruction set.
+        unsafe {
+            SphereLanes {
+                c: [
+                    L::splat(self.c[0]),
+                    L::splat(self.c[1]),
+                    L::splat(self.c[2]),
+                ],
+                r: L::splat(self.r),
+                r2: L::splat(self.r2),
+                inv_r: L::splat(self.inv_r),
+                c_err: L::splat(self.c_err),
+            }
+        }
+    }
+}
+
+impl<L: Floats> SphereLanes<L> {
+    /// Distances of each lane's hit in `(0, tm]`, and which lanes hit (the scalar
+    /// [`Sphere::intersect`], a lane at a time).
+    #[inline(always)]
+    pub fn hit(&self, r: &RayLanes<L>, tm: L) -> (L, L::Mask) {
+        // SAFETY: `tm` is a value of `L`, so the CPU runs `L`'s instruction set.
+        let (zero, two, g5) = unsafe { (L::splat(0.0), L::splat(2.0), L::splat(gamma(5))) };
         let f = [r.o[0] - self.c[0], r.o[1] - self.c[1], r.o[2] - self.c[2]];
         let b = -dot(f, r.d);
         let l = [f[0] + b * r.d[0], f[1] + b * r.d[1], f[2] + b * r.d[2]];
         let disc = self.r2 - dot(l, l);
         // Most rays miss every sphere of a packet (a shadow ray in a room of a few spheres):
         // they skip the square root and division below, whose latency dominates the test.
-        let real = disc.cmpge(Vec4::ZERO);
-        if !real.any() {
-            return (Vec4::ZERO, real);
+        let real = disc.cmpge(zero);
+        if !L::any(real) {
+            return (zero, real);
         }
         let f2 = dot(f, f);
         let c = f2 - self.r2;
         let q = b + disc.sqrt().copysign(b);
         let a = c / q;
         let first = a.cmple(q);
-        let t0 = Vec4::select(first, a, q);
-        let t1 = Vec4::select(first, q, a);
-        let zero = Vec4::ZERO;
+        let t0 = L::select(first, a, q);
+        let t1 = L::select(first, q, a);
         let ok0 = t0.cmpgt(zero) & t0.cmple(tm);
         let ok1 = t1.cmpgt(zero) & t1.cmple(tm);
-        let mut t = Vec4::select(ok0, t0, t1);
+        let mut t = L::select(ok0, t0, t1);
         let mut ok = ok0 | ok1;
         // The scalar test's band: an origin on the sphere only meets the root away from zero.
         let e_f = r.sphere_k + self.c_err;
-        let band = Vec4::splat(gamma(5)) * (f2 + self.r2)
-            + Vec4::splat(2.0) * e_f * (f2 * self.inv_r + self.r);
+        let band = g5 * (f2 + self.r2) + two * e_f * (f2 * self.inv_r + self.r);
         let on = c.abs().cmple(band);
-        if on.any() {
+        if L::any(on) {
             let t_min = band / (f2.sqrt() + self.r);
-            let other = Vec4::select(t0.abs().cmple(t1.abs()), t1, t0);
+            let other = L::select(t0.abs().cmple(t1.abs()), t1, t0);
             let ok_on = other.cmpgt(t_min) & other.cmple(tm);
-            t = Vec4::select(on, other, t);
+            t = L::select(on, other, t);
             ok = (on & ok_on) | (!on & ok);
         }
         (t, real & q.cmpne(zero) & ok)
@@ -178,22 +214,49 @@ impl PlaneLanes {
         }
     }
 
-    /// Lane `i`'s plane in all four lanes (an unused lane's padding, which never hits).
-    pub fn splat_lane(&self, i: usize) -> Self {
-        let s = |v: Vec4| Vec4::splat(v[i]);
+    /// Lane `i`'s plane (an unused lane's padding, which never hits).
+    pub fn lane(&self, i: usize) -> PlaneLanes<f32> {
         PlaneLanes {
-            n: self.n.map(s),
-            dist: s(self.dist),
-            n_abs_sum: s(self.n_abs_sum),
-            dist_err: s(self.dist_err),
-            side: s(self.side),
+            n: self.n.map(|v| v[i]),
+            dist: self.dist[i],
+            n_abs_sum: self.n_abs_sum[i],
+            dist_err: self.dist_err[i],
+            side: self.side[i],
         }
     }
+}
 
-    /// Distances of each lane's hit in `(0, t_max]`, and which lanes hit (the scalar
-    /// [`Plane::intersect`], four at a time).
+impl PlaneLanes<f32> {
+    /// This plane in every lane of `L`.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    pub fn hit(&self, r: &RayLanes, t_max: Vec4) -> (Vec4, BVec4A) {
+    pub unsafe fn splat<L: Floats>(&self) -> PlaneLanes<L> {
+        // SAFETY: the caller vouches for the instruction set.
+        unsafe {
+            PlaneLanes {
+                n: [
+                    L::splat(self.n[0]),
+                    L::splat(self.n[1]),
+                    L::splat(self.n[2]),
+                ],
+                dist: L::splat(self.dist),
+                n_abs_sum: L::splat(self.n_abs_sum),
+                dist_err: L::splat(self.dist_err),
+                side: L::splat(self.side),
+            }
+        }
+    }
+}
+
+impl<L: Floats> PlaneLanes<L> {
+    /// Distances of each lane's hit in `(0, t_max]`, and which lanes hit (the scalar
+    /// [`Plane::intersect`], a lane at a time).
+    #[inline(always)]
+    pub fn hit(&self, r: &RayLanes<L>, t_max: L) -> (L, L::Mask) {
+        // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
+        let (zero, tiny) = unsafe { (L::splat(0.0), L::splat(f32::MIN_POSITIVE)) };
         let denom = dot(self.n, r.d);
         let s = self.dist - dot(self.n, r.o);
         let band = self.n_abs_sum * r.plane_k + self.dist_err;
@@ -202,13 +265,13 @@ impl PlaneLanes {
         // on the side `d` goes to).
         let within = s.abs().cmple(band);
         // Beyond the band: `s` on the side `d` goes to.
-        let mut ok = (s * denom).cmpgt(Vec4::ZERO) & !within;
+        let mut ok = (s * denom).cmpgt(zero) & !within;
         // Within it: only a ray leaving an oriented plane's side, met where it crosses or at
         // the smallest positive distance (rare: a ray from a crease heading out of the room).
-        let leaving = (self.side * denom).cmplt(Vec4::ZERO) & within;
-        if leaving.any() {
-            t = Vec4::select(leaving, t.max(Vec4::splat(f32::MIN_POSITIVE)), t);
-            ok |= leaving;
+        let leaving = (self.side * denom).cmplt(zero) & within;
+        if L::any(leaving) {
+            t = L::select(leaving, t.max(tiny), t);
+            ok = ok | leaving;
         }
         (t, ok & t.cmple(t_max))
     }
@@ -226,11 +289,11 @@ pub struct Lanes<P> {
 }
 
 impl<P> Lanes<P> {
-    /// Each primitive alone in all four lanes (`splat` gives a packet's lane), with its prim
-    /// index, in the order [`Lanes::closest`] tests them: for batches of rays in the lanes.
-    pub fn each(&self, splat: impl Fn(&P, usize) -> P) -> Vec<(u32, P)> {
+    /// Each primitive alone (`lane` reads it from its packet), with its prim index, in the
+    /// order [`Lanes::closest`] tests them: for batches of rays in the lanes.
+    pub fn each<Q>(&self, lane: impl Fn(&P, usize) -> Q) -> Vec<(u32, Q)> {
         (0..self.count)
-            .map(|k| (self.prim[k], splat(&self.packs[k / 4], k % 4)))
+            .map(|k| (self.prim[k], lane(&self.packs[k / 4], k % 4)))
             .collect()
     }
 

@@ -79,12 +79,11 @@ pub struct Geometry {
     pub spheres: Lanes<SphereLanes>,
     /// Infinite planes in packets of four.
     pub planes: Lanes<PlaneLanes>,
-    /// Each packed sphere alone in all four lanes, with its prim index, in the order of
-    /// `spheres`: what a batch of rays in the lanes is tested against
-    /// ([`Geometry::intersect_batch`]).
-    pub sphere_each: Vec<(u32, SphereLanes)>,
-    /// Each plane alone in all four lanes, with its prim index, in the order of `planes`.
-    pub plane_each: Vec<(u32, PlaneLanes)>,
+    /// Each packed sphere alone, with its prim index, in the order of `spheres`: what a batch
+    /// of rays in the lanes is tested against, splatted ([`Geometry::intersect_batch`]).
+    pub sphere_each: Vec<(u32, SphereLanes<f32>)>,
+    /// Each plane alone, with its prim index, in the order of `planes`.
+    pub plane_each: Vec<(u32, PlaneLanes<f32>)>,
     /// Vertex normals of smooth triangles, at their lane's index (empty if none is smooth).
     pub normals: Vec<[glam::Vec3A; 3]>,
     /// True if the BVH holds triangles: its rays then need the watertight test's shear
@@ -210,8 +209,8 @@ impl Geometry {
             bvh,
             blocks,
             attrs,
-            sphere_each: spheres.each(SphereLanes::splat_lane),
-            plane_each: planes.each(PlaneLanes::splat_lane),
+            sphere_each: spheres.each(SphereLanes::lane),
+            plane_each: planes.each(PlaneLanes::lane),
             spheres,
             planes,
             normals: lane_normals,

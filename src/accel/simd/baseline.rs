@@ -1,7 +1,93 @@
-//! [`Lanes8`] as two four-lane halves (`glam::Vec4`: SSE2 on x86-64, scalar elsewhere).
+//! [`Lanes8`] as two four-lane halves (`glam::Vec4`: SSE2 on x86-64, scalar elsewhere), and
+//! [`Floats`] as one `glam::Vec4`.
 
-use super::Lanes8;
-use glam::Vec4;
+use super::{Floats, Lanes8};
+use glam::{BVec4A, Vec4};
+
+// SAFETY: glam's `Vec4` runs on every CPU (SSE2 is in the x86-64 baseline).
+unsafe impl Floats for Vec4 {
+    const LANES: usize = 4;
+    type Mask = BVec4A;
+    #[inline(always)]
+    unsafe fn splat(x: f32) -> Self {
+        Vec4::splat(x)
+    }
+    #[inline(always)]
+    unsafe fn from_slice(x: &[f32]) -> Self {
+        Vec4::from_slice(x)
+    }
+    #[inline(always)]
+    unsafe fn from_array8(v: [f32; 8]) -> Self {
+        Vec4::new(v[0], v[1], v[2], v[3])
+    }
+    #[inline(always)]
+    unsafe fn transpose3(v: &[&glam::Vec3A; 8]) -> [Self; 3] {
+        let m = glam::Mat4::from_cols(
+            v[0].extend(0.0),
+            v[1].extend(0.0),
+            v[2].extend(0.0),
+            v[3].extend(0.0),
+        )
+        .transpose();
+        [m.x_axis, m.y_axis, m.z_axis]
+    }
+    #[inline(always)]
+    fn write_to(self, out: &mut [f32]) {
+        self.write_to_slice(out)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Vec4::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Vec4::abs(self)
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        Vec4::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn max(self, b: Self) -> Self {
+        Vec4::max(self, b)
+    }
+    #[inline(always)]
+    fn cmpge(self, b: Self) -> BVec4A {
+        Vec4::cmpge(self, b)
+    }
+    #[inline(always)]
+    fn cmple(self, b: Self) -> BVec4A {
+        Vec4::cmple(self, b)
+    }
+    #[inline(always)]
+    fn cmpgt(self, b: Self) -> BVec4A {
+        Vec4::cmpgt(self, b)
+    }
+    #[inline(always)]
+    fn cmplt(self, b: Self) -> BVec4A {
+        Vec4::cmplt(self, b)
+    }
+    #[inline(always)]
+    fn cmpne(self, b: Self) -> BVec4A {
+        Vec4::cmpne(self, b)
+    }
+    #[inline(always)]
+    fn select(m: BVec4A, a: Self, b: Self) -> Self {
+        Vec4::select(m, a, b)
+    }
+    #[inline(always)]
+    fn any(m: BVec4A) -> bool {
+        m.any()
+    }
+    #[inline(always)]
+    fn all(m: BVec4A) -> bool {
+        m.all()
+    }
+    #[inline(always)]
+    fn bitmask(m: BVec4A) -> u32 {
+        m.bitmask()
+    }
+}
 
 /// Eight lanes in two `Vec4`s, lanes 0 to 3 then 4 to 7.
 #[derive(Clone, Copy, Debug)]

@@ -97,6 +97,87 @@ pub trait Lanes8: Copy {
     unsafe fn ne_u32(x: &[u32; 8], v: u32) -> u32;
 }
 
+/// A vector of `f32` lanes with the operations of the sphere and plane tests
+/// (`accel::lanes`): four lanes in a `glam::Vec4` on every CPU, eight in an AVX2 register.
+///
+/// As for [`Lanes8`], every operation is IEEE single precision lane by lane, exactly as glam's
+/// `Vec4` computes it (negation and `copysign` as sign-bit operations, `max` as SSE's `maxps`,
+/// ordered comparisons except `cmpne`, which is true where either lane is NaN), so that a
+/// lane's answer does not depend on the vector it sits in. (Which NaN comes out of an
+/// operation on two NaNs is left open, by IEEE and by the compiler, which may swap the
+/// operands of a sum; every comparison treats all NaNs alike.)
+///
+/// # Safety
+/// Making a value from nothing (`splat`, `from_slice`) runs the set's instructions, so only
+/// callers that checked the CPU may do it; every other operation takes a value, whose existence
+/// shows that the check was made.
+pub unsafe trait Floats:
+    Copy
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+    + std::ops::Neg<Output = Self>
+{
+    /// How many lanes.
+    const LANES: usize;
+    /// One flag per lane, all bits set or clear.
+    type Mask: Copy
+        + std::ops::BitAnd<Output = Self::Mask>
+        + std::ops::BitOr<Output = Self::Mask>
+        + std::ops::Not<Output = Self::Mask>;
+    /// `x` in every lane.
+    ///
+    /// # Safety
+    /// The CPU must run the set.
+    unsafe fn splat(x: f32) -> Self;
+    /// The first [`Floats::LANES`] values of `x`, one per lane.
+    ///
+    /// # Safety
+    /// The CPU must run the set; `x` holds at least `LANES` values.
+    unsafe fn from_slice(x: &[f32]) -> Self;
+    /// The first `LANES` values of `v`, one per lane, from registers (no trip through memory,
+    /// which would stall the load behind the separate stores).
+    ///
+    /// # Safety
+    /// The CPU must run the set.
+    unsafe fn from_array8(v: [f32; 8]) -> Self;
+    /// The `x`, `y` and `z` of the first `LANES` vectors of `v`, lane `i` from `v[i]`: a
+    /// transposition by shuffles.
+    ///
+    /// # Safety
+    /// The CPU must run the set.
+    unsafe fn transpose3(v: &[&glam::Vec3A; 8]) -> [Self; 3];
+    /// The lanes, written to the first `LANES` values of `out`.
+    fn write_to(self, out: &mut [f32]);
+    /// Lane-wise square root.
+    fn sqrt(self) -> Self;
+    /// Lane-wise absolute value (the sign bit cleared).
+    fn abs(self) -> Self;
+    /// Lane-wise magnitude of `self` with the sign bit of `sign`.
+    fn copysign(self, sign: Self) -> Self;
+    /// Lane-wise maximum (`b` where either is NaN).
+    fn max(self, b: Self) -> Self;
+    /// Lanes where `self >= b`.
+    fn cmpge(self, b: Self) -> Self::Mask;
+    /// Lanes where `self <= b`.
+    fn cmple(self, b: Self) -> Self::Mask;
+    /// Lanes where `self > b`.
+    fn cmpgt(self, b: Self) -> Self::Mask;
+    /// Lanes where `self < b`.
+    fn cmplt(self, b: Self) -> Self::Mask;
+    /// Lanes where `self != b` (NaN in either included).
+    fn cmpne(self, b: Self) -> Self::Mask;
+    /// `a` where `m` is set, else `b`.
+    fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// True if any lane of `m` is set.
+    fn any(m: Self::Mask) -> bool;
+    /// True if every lane of `m` is set.
+    fn all(m: Self::Mask) -> bool;
+    /// The lanes of `m` as bits 0 to `LANES - 1`.
+    fn bitmask(m: Self::Mask) -> u32;
+}
+
 /// For tests that compare instruction sets: panics if the environment asks for all of them
 /// (`RTIS_REQUIRE_AVX2=1`, which `.ci/run` sets) and the CPU lacks one, so that a CI machine
 /// without AVX2 cannot pass by comparing the baseline with itself.
@@ -191,6 +272,133 @@ mod tests {
                     Avx2::ne_u32(&c, u32::MAX),
                     "{c:?}"
                 );
+            }
+        }
+    }
+
+    /// Every [`Floats`] operation gives the same bits in eight AVX2 lanes as in two `Vec4`
+    /// halves, on the same special values (NaN of both signs, signed zeros, infinities,
+    /// subnormals, equal operands), and the transposition and gathers put each value in its
+    /// lane.
+    #[test]
+    fn every_float_operation_agrees_bit_for_bit() {
+        use super::avx2::F8;
+        use glam::Vec4;
+        super::require_all_isas();
+        if !Isa::Avx2.available() {
+            eprintln!("no AVX2 here: nothing to compare");
+            return;
+        }
+        let specials = [
+            f32::NAN,
+            -f32::NAN,
+            0.0,
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            1.0,
+            -1.0,
+            1e-45,
+            f32::MAX,
+            -3.5,
+            2.0,
+        ];
+        let n = specials.len();
+        let lanes = |k: usize| -> [f32; 8] { std::array::from_fn(|i| specials[(k + 5 * i) % n]) };
+        // Bits, every NaN as one: which NaN an operation on two NaNs returns depends on the
+        // order of its operands, which IEEE leaves open and the compiler may swap.
+        let bits = |v: [f32; 8]| v.map(|x| if x.is_nan() { u32::MAX } else { x.to_bits() });
+        // SAFETY: AVX2 is present (checked above); `Vec4` runs everywhere.
+        unsafe {
+            let f8 = |v: F8| {
+                let mut out = [0.0; 8];
+                v.write_to(&mut out);
+                bits(out)
+            };
+            let v4 = |lo: Vec4, hi: Vec4| {
+                let mut out = [0.0; 8];
+                lo.write_to(&mut out[..4]);
+                hi.write_to(&mut out[4..]);
+                bits(out)
+            };
+            for a in 0..n {
+                for b in 0..n {
+                    let (x, y) = (lanes(a), lanes(b));
+                    let (xv, yv) = (F8::from_slice(&x), F8::from_slice(&y));
+                    let (xl, xh) = (Vec4::from_slice(&x[..4]), Vec4::from_slice(&x[4..]));
+                    let (yl, yh) = (Vec4::from_slice(&y[..4]), Vec4::from_slice(&y[4..]));
+                    // `$e` over `p` and `q`, in eight lanes and in two halves.
+                    macro_rules! same {
+                        (|$p:ident, $q:ident| $e:expr) => {{
+                            #[allow(unused_variables)]
+                            let eight = {
+                                let ($p, $q) = (xv, yv);
+                                $e
+                            };
+                            #[allow(unused_variables)]
+                            let (lo, hi) = (
+                                {
+                                    let ($p, $q) = (xl, yl);
+                                    $e
+                                },
+                                {
+                                    let ($p, $q) = (xh, yh);
+                                    $e
+                                },
+                            );
+                            assert_eq!(f8(eight), v4(lo, hi), "{x:?} {y:?}");
+                        }};
+                    }
+                    same!(|p, q| p + q);
+                    same!(|p, q| p - q);
+                    same!(|p, q| p * q);
+                    same!(|p, q| p / q);
+                    same!(|p, q| -p);
+                    same!(|p, q| Floats::sqrt(p));
+                    same!(|p, q| Floats::abs(p));
+                    same!(|p, q| Floats::copysign(p, q));
+                    same!(|p, q| Floats::max(p, q));
+                    let masks = |p: F8, q: F8| {
+                        [p.cmpge(q), p.cmple(q), p.cmpgt(q), p.cmplt(q), p.cmpne(q)]
+                            .map(F8::bitmask)
+                    };
+                    let masks4 = |p: Vec4, q: Vec4| {
+                        [p.cmpge(q), p.cmple(q), p.cmpgt(q), p.cmplt(q), p.cmpne(q)]
+                            .map(|m| m.bitmask())
+                    };
+                    let (lo, hi) = (masks4(xl, yl), masks4(xh, yh));
+                    let joined: [u32; 5] = std::array::from_fn(|i| lo[i] | hi[i] << 4);
+                    assert_eq!(masks(xv, yv), joined, "{x:?} {y:?}");
+                    let m = xv.cmplt(yv);
+                    let (ml, mh) = (xl.cmplt(yl), xh.cmplt(yh));
+                    assert_eq!(
+                        f8(F8::select(m, xv, yv)),
+                        v4(Vec4::select(ml, xl, yl), Vec4::select(mh, xh, yh))
+                    );
+                    assert_eq!(F8::any(m), ml.any() || mh.any());
+                    assert_eq!(F8::all(m), ml.all() && mh.all());
+                    assert_eq!(F8::bitmask(!m), (!ml).bitmask() | (!mh).bitmask() << 4);
+                    assert_eq!(
+                        F8::bitmask(m & xv.cmpne(yv)),
+                        (ml & xl.cmpne(yl)).bitmask() | (mh & xh.cmpne(yh)).bitmask() << 4
+                    );
+                    assert_eq!(
+                        F8::bitmask(m | xv.cmpne(yv)),
+                        (ml | xl.cmpne(yl)).bitmask() | (mh | xh.cmpne(yh)).bitmask() << 4
+                    );
+                    assert_eq!(f8(F8::from_array8(x)), bits(x));
+                    assert_eq!(f8(F8::splat(x[3])), bits([x[3]; 8]));
+                }
+            }
+            // The transposition: lane i holds vector i's coordinates.
+            let v: [glam::Vec3A; 8] =
+                std::array::from_fn(|i| glam::Vec3A::new(i as f32, 10.0 + i as f32, -(i as f32)));
+            let t = F8::transpose3(&std::array::from_fn(|i| &v[i]));
+            let t4 = Vec4::transpose3(&std::array::from_fn(|i| &v[i]));
+            for (axis, (lane8, lane4)) in t.iter().zip(&t4).enumerate() {
+                let want: [f32; 8] = std::array::from_fn(|i| v[i][axis]);
+                assert_eq!(f8(*lane8), bits(want));
+                assert_eq!(lane4.to_array(), want[..4]);
             }
         }
     }

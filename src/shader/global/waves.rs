@@ -282,8 +282,7 @@ fn finish_direct_light(tr: &mut Tracer, s: &mut Scratch) {
     s.blocked.resize_with(s.shadow.len(), Vec::new);
     for ((light, rays), blocked) in tr.lights.iter().zip(&s.shadow).zip(&mut s.blocked) {
         tr.stats.shadow += rays.len() as u64;
-        tr.geometry
-            .occluded_batch(rays, !light.in_room(), blocked);
+        tr.geometry.occluded_batch(rays, !light.in_room(), blocked);
     }
     let lights = tr.lights.len();
     let mut at = 0;
