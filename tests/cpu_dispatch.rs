@@ -2,8 +2,9 @@
 //! emulator as its baseline x86-64 CPU (`-cpu qemu64`: SSE2 and SSE3, no AVX, no SSE4, no
 //! POPCNT), which stops a process with SIGILL at its first instruction the CPU lacks. There
 //! the binary must pick the baseline node test, render a mesh scene (closest-hit and shadow
-//! queries through the BVH) to the same pixels, bit for bit, as the native run (AVX2 on a CI
-//! machine), and refuse `--isa avx2` with an error instead of crashing.
+//! queries through the BVH) and the course's box under the Global shader (batches of rays in
+//! SSE lanes instead of AVX2's) to the same pixels, bit for bit, as the native run (AVX2 on a
+//! CI machine), and refuse `--isa avx2` with an error instead of crashing.
 //!
 //! Needs `qemu-x86_64` (Debian's qemu-user), which `.ci/run` installs; without it the test
 //! says so and passes, unless `RTIS_REQUIRE_QEMU=1` (set by `.ci/run`) asks for it.
@@ -72,6 +73,25 @@ impl Drop for TempDir {
     }
 }
 
+/// The two renders of `scene` have the same pixels, bit for bit.
+fn same_pixels(scene: &str, native: &[u32], old: &[u32]) {
+    assert!(
+        native.len() > 4 * 96 * 70,
+        "{scene}: {} channels",
+        native.len()
+    );
+    assert_eq!(native.len(), old.len(), "{scene}");
+    if let Some(i) = (0..native.len()).find(|&i| native[i] != old[i]) {
+        let differ = native.iter().zip(old).filter(|(a, b)| a != b).count();
+        panic!(
+            "{scene}: the emulated older CPU rendered another image: {differ} channels differ, \
+             the first at {i} ({} against {})",
+            f32::from_bits(native[i]),
+            f32::from_bits(old[i])
+        );
+    }
+}
+
 #[test]
 fn an_older_cpu_renders_the_same_image_through_the_baseline_node_test() {
     // The native run must be the other instruction set where CI asks for it.
@@ -79,14 +99,14 @@ fn an_older_cpu_renders_the_same_image_through_the_baseline_node_test() {
     let Some(qemu) = qemu() else { return };
     let tmp = TempDir::new();
     let dir = &tmp.0;
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/mesh.ron");
-    let render = |emulated: Option<&Path>, name: &str| {
+    let render = |emulated: Option<&Path>, scene: &str, name: &str| {
+        let scene = format!("{}/scenes/{scene}", env!("CARGO_MANIFEST_DIR"));
         let path = dir.join(name);
         let out = rtis(
             emulated,
             &[
                 "render",
-                scene,
+                &scene,
                 "--width",
                 "96",
                 "--threads",
@@ -107,25 +127,19 @@ fn an_older_cpu_renders_the_same_image_through_the_baseline_node_test() {
         let bits: Vec<u32> = image.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect();
         (bits, stderr(&out))
     };
-    let (native, native_log) = render(None, "native.exr");
-    let (old, old_log) = render(Some(&qemu), "qemu64.exr");
+    let (native, native_log) = render(None, "mesh.ron", "native.exr");
+    let (old, old_log) = render(Some(&qemu), "mesh.ron", "qemu64.exr");
     let native_isa = rtis::accel::Isa::detect().name();
     assert!(
         native_log.contains(&format!("node test in {native_isa}")),
         "{native_log}"
     );
     assert!(old_log.contains("node test in baseline"), "{old_log}");
-    assert!(native.len() > 4 * 96 * 70, "{} channels", native.len());
-    assert_eq!(native.len(), old.len());
-    if let Some(i) = (0..native.len()).find(|&i| native[i] != old[i]) {
-        let differ = native.iter().zip(&old).filter(|(a, b)| a != b).count();
-        panic!(
-            "the emulated older CPU rendered another image: {differ} channels differ, the \
-             first at {i} ({} against {})",
-            f32::from_bits(native[i]),
-            f32::from_bits(old[i])
-        );
-    }
+    same_pixels("mesh.ron", &native, &old);
+    // No BVH: the Global shader's batches of rays, in four SSE lanes here.
+    let (native, _) = render(None, "cornell-two-bounce.ron", "box-native.exr");
+    let (old, _) = render(Some(&qemu), "cornell-two-bounce.ron", "box-qemu64.exr");
+    same_pixels("cornell-two-bounce.ron", &native, &old);
     // Asked for an instruction set it lacks, the bench refuses by name.
     let refused = rtis(
         Some(&qemu),

@@ -1,7 +1,6 @@
 //! The Global shader's two orders of tracing (`src/shader/global/waves.rs`): the trees of rays
 //! below a first hit traced in waves give the depth-first walk's `L_i` to the bit, and count
-//! the same rays, in every scene where the waves apply; and renders do not depend on which
-//! order ran.
+//! the same rays, in every scene where the waves apply; where they would not, they stand aside.
 
 mod common;
 
@@ -71,7 +70,12 @@ fn trace(rs: &RenderScene, g: &Global, rays: &[Ray], order: Order) -> (Vec<[u32;
 
 /// Both orders on `rs`: the same bits and the same counts.
 fn agree(name: &str, rs: &RenderScene) {
-    let g = global(rs);
+    agree_with(name, rs, &global(rs));
+}
+
+/// Both orders on `rs` with the shader's parameters `g`.
+fn agree_with(name: &str, rs: &RenderScene, g: &Global) {
+    let g = *g;
     let rays = rays(rs, 200, 11);
     let (waves, waves_stats) = trace(rs, &g, &rays, Order::Waves);
     let (walk, walk_stats) = trace(rs, &g, &rays, Order::DepthFirst);
@@ -91,11 +95,23 @@ fn agree(name: &str, rs: &RenderScene) {
 fn waves_give_the_depth_first_bits_in_the_course_box() {
     let cornell = scenes_dir().join("cornell.ron");
     let cornell = cornell.to_str().unwrap();
-    for d in 1..=6 {
+    for d in 1..=8 {
         let text = format!(
             "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: {d}, ambient: (0.3, 0.3, 0.3)))"
         );
         agree(&format!("D = {d}"), &rtis::extract(&scene(&text)));
+    }
+    // Mirror and glass chains cut short.
+    let text = format!(
+        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)))"
+    );
+    let rs = rtis::extract(&scene(&text));
+    for max_specular in [0, 1, 2] {
+        let g = Global {
+            max_specular,
+            ..global(&rs)
+        };
+        agree_with(&format!("max_specular {max_specular}"), &rs, &g);
     }
     for effect in [
         "shadows",
@@ -124,6 +140,30 @@ fn waves_give_the_depth_first_bits_in_the_course_box() {
         area.to_str().unwrap()
     );
     agree("area lights switched off", &rtis::extract(&scene(&text)));
+    // A ceiling panel that no hit samples (light_samples 0, which a scene file cannot ask
+    // for): chains through mirror and glass see it (each node's `le`, which must matter here).
+    let text = format!(
+        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.1, 0.1, 0.1)), \
+         entities: [(name: \"panel\", shape: Rectangle(corner: (-2.9, 2.99, -2.9), u: (5.8, 0, 0), v: (0, 0, 11.8)), \
+         emitter: Emitter(radiance: (1, 1, 1)))])"
+    );
+    let rs = rtis::extract(&scene(&text));
+    let g = Global {
+        light_samples: 0,
+        ..global(&rs)
+    };
+    let mut dark = rs.clone();
+    dark.set_effects(rtis::effects::Effects {
+        emission: false,
+        ..rs.effects
+    });
+    let rays = rays(&rs, 200, 11);
+    assert_ne!(
+        trace(&rs, &g, &rays, Order::DepthFirst).0,
+        trace(&dark, &g, &rays, Order::DepthFirst).0,
+        "the panel is never seen"
+    );
+    agree_with("unsampled area lights", &rs, &g);
     // Lights outside the room: their shadow rays test the planes too.
     let text = format!(
         "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)))"
@@ -151,30 +191,47 @@ fn waves_give_the_depth_first_bits_with_a_bvh_and_the_physical_model() {
     }
 }
 
-/// Where a hit samples area lights, the waves do not apply (their random numbers would be
-/// drawn in another order), and the shader walks depth first.
+/// Where the waves would not give the walk's bits or would outgrow their memory bounds, they
+/// stand aside: area-light samples (their random numbers would be drawn in another order),
+/// D = 0 (no tree), D > 8, and more than 64 point lights.
 #[test]
-fn waves_stand_aside_for_area_light_samples_and_deep_trees() {
+fn waves_stand_aside_where_they_would_not_give_the_same_bits_or_fit() {
+    let applies = |rs: &RenderScene, g: &Global| {
+        let mut stats = RayStats::default();
+        let tr = rs.tracer(Sampler::new(1, 2, 3), &mut stats);
+        Order::Waves.applies(&tr, g)
+    };
     let area = scenes_dir().join("cornell-area.ron");
     let text = format!(
         "Scene(extends: {:?}, shader: Global(samples: 4, max_depth: 2, ambient: (0.1, 0.1, 0.1), light_samples: 2))",
         area.to_str().unwrap()
     );
     let rs = rtis::extract(&scene(&text));
-    let mut stats = RayStats::default();
-    let tr = rs.tracer(Sampler::new(1, 2, 3), &mut stats);
-    assert!(!Order::Waves.applies(&tr, &global(&rs)));
+    assert!(!applies(&rs, &global(&rs)));
     let cornell = scenes_dir().join("cornell.ron");
     let text = format!(
-        "Scene(extends: {:?}, shader: Global(samples: 1, max_depth: 13, ambient: (0.1, 0.1, 0.1)))",
+        "Scene(extends: {:?}, shader: Global(samples: 1, max_depth: 9, ambient: (0.1, 0.1, 0.1)))",
         cornell.to_str().unwrap()
     );
     let rs = rtis::extract(&scene(&text));
-    let tr = rs.tracer(Sampler::new(1, 2, 3), &mut stats);
-    assert!(!Order::Waves.applies(&tr, &global(&rs)));
-    let g = Global {
-        max_depth: 12,
-        ..global(&rs)
-    };
-    assert!(Order::Waves.applies(&tr, &g));
+    let g = global(&rs);
+    assert!(!applies(&rs, &g));
+    assert!(applies(&rs, &Global { max_depth: 8, ..g }));
+    assert!(!applies(&rs, &Global { max_depth: 0, ..g }));
+    // 65 point lights.
+    let lights: String = (0..65)
+        .map(|k| {
+            format!(
+                "(light: Point(position: ({}, 2, 3), intensity: (1, 1, 1))),",
+                -2.0 + k as f64 * 0.05
+            )
+        })
+        .collect();
+    let text = format!(
+        "Scene(extends: {:?}, shader: Global(samples: 1, max_depth: 2, ambient: (0.1, 0.1, 0.1)), entities: [{lights}])",
+        cornell.to_str().unwrap()
+    );
+    let rs = rtis::extract(&scene(&text));
+    assert_eq!(rs.lights.len(), 68);
+    assert!(!applies(&rs, &global(&rs)));
 }

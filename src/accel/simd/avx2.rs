@@ -1,10 +1,12 @@
 //! [`Lanes8`] and [`Floats`] in one AVX2 register.
 //!
-//! Every method is unsafe: its caller must have found AVX2 ([`super::Isa::available`]). The
-//! methods are `#[inline(always)]` without a target feature of their own, so that they and the
-//! intrinsics in them inline into the wide BVH's AVX2 traversals (which enable AVX2); a closure
-//! between the two would be compiled without it and keep every intrinsic a call, so the node
-//! test has none.
+//! Every [`Lanes8`] method, and every [`Floats`] constructor, is unsafe: its caller must have
+//! found AVX2 ([`super::Isa::available`]); the other [`Floats`] operations take a value, which
+//! exists only where that was done. The methods are `#[inline(always)]` without a target
+//! feature of their own, so that they and the intrinsics in them inline into the AVX2 copies
+//! of the BVH traversals and of the batched queries (which enable AVX2); a closure between the
+//! two would be compiled without it and keep every intrinsic a call, so the node test and the
+//! lane tests have none.
 
 use super::{Floats, Lanes8};
 use std::arch::x86_64::*;
@@ -80,7 +82,8 @@ pub struct F8(__m256);
 pub struct M8(__m256);
 
 // SAFETY (of the `unsafe` blocks from here on): an `F8` or `M8` exists, so AVX2 was found (the
-// only constructors are `Floats::splat` and `Floats::from_slice`, unsafe, and the operations
+// only constructors are the unsafe `Floats::splat`, `from_slice`, `from_array8` and
+// `transpose3`, and the operations
 // below, which take a value). The intrinsics only compute on registers, except the marked
 // loads and stores.
 macro_rules! binary {
@@ -125,7 +128,8 @@ impl F8 {
     }
 }
 
-// SAFETY: `splat` and `from_slice` are the only constructors and are unsafe, with AVX2 as the
+// SAFETY: `splat`, `from_slice`, `from_array8` and `transpose3` are the only constructors and
+// are unsafe, with AVX2 as the
 // caller's duty; see above for the rest.
 unsafe impl Floats for F8 {
     const LANES: usize = 8;

@@ -1,8 +1,10 @@
-//! Eight float lanes for the wide BVH's node test, in the instruction set the CPU has: the
-//! closed set [`Isa`], one file per variant, chosen at run time.
+//! Float lanes in the instruction set the CPU has: the closed set [`Isa`], one file per
+//! variant, chosen at run time. [`Lanes8`] serves the wide BVH's node test (eight lanes in
+//! both sets); [`Floats`] serves the sphere and plane tests of batched rays (four lanes in
+//! SSE, eight in AVX2).
 //!
 //! Every variant computes the same IEEE operations lane by lane (no fused multiply-add), so
-//! the traversal's answers are bit-identical whichever runs; only the speed differs. The
+//! the queries' answers are bit-identical whichever runs; only the speed differs. The
 //! build targets baseline x86-64, so a binary runs on any x86-64 CPU and takes AVX2 where
 //! [`Isa::detect`] finds it, as Embree's ISA dispatch does.
 
@@ -108,7 +110,8 @@ pub trait Lanes8: Copy {
 /// operands of a sum; every comparison treats all NaNs alike.)
 ///
 /// # Safety
-/// Making a value from nothing (`splat`, `from_slice`) runs the set's instructions, so only
+/// Making a value from nothing (`splat`, `from_slice`, `from_array8`, `transpose3`) runs the
+/// set's instructions, so only
 /// callers that checked the CPU may do it; every other operation takes a value, whose existence
 /// shows that the check was made.
 pub unsafe trait Floats:

@@ -84,17 +84,25 @@ fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Ve
         let frame = Frame::from_normal(n);
         let mut sum = Vec3A::ZERO;
         if waves::applies(tr, g) {
-            // The same directions and sums, the rays traced in waves.
-            let w: Vec<Vec3A> = (0..g.samples)
-                .map(|_| {
+            // The same directions, drawn in order, and the same sums; each group's rays
+            // traced together in waves.
+            let group = waves::group(g);
+            let (mut w, mut rays) = (Vec::with_capacity(group), Vec::with_capacity(group));
+            let mut left = g.samples as usize;
+            while left > 0 {
+                let k = left.min(group);
+                left -= k;
+                w.clear();
+                w.extend((0..k).map(|_| {
                     let (u1, u2) = tr.sampler.next_2d();
                     frame.to_world(hemisphere::uniform(u1, u2))
-                })
-                .collect();
-            let rays: Vec<Ray> = w.iter().map(|&wj| si.spawn(wj)).collect();
-            let l = incident_all(tr, g, &rays, Order::Waves);
-            for (l_i, wj) in l.into_iter().zip(w) {
-                sum += l_i * reflectance(model, phong, wj, wo, n);
+                }));
+                rays.clear();
+                rays.extend(w.iter().map(|&wj| si.spawn(wj)));
+                let l = incident_all(tr, g, &rays, Order::Waves);
+                for (l_i, &wj) in l.iter().zip(&w) {
+                    sum += *l_i * reflectance(model, phong, wj, wo, n);
+                }
             }
         } else {
             // Light samples at the hits below draw random numbers: each direction's tree is
@@ -126,8 +134,8 @@ pub enum Order {
 
 impl Order {
     /// True if this order gives the depth-first walk's bits for `g` in `tr`'s scene: always for
-    /// the walk; for the waves, when no hit draws random numbers (no area-light samples) and
-    /// one direction's tree has at most 4095 nodes (`D <= 12`).
+    /// the walk; for the waves, when `D >= 1`, no hit draws random numbers (no area-light
+    /// samples), `D <= 8` and there are at most 64 point lights (their memory bounds).
     pub fn applies(self, tr: &Tracer, g: &Global) -> bool {
         match self {
             Order::DepthFirst => true,
@@ -140,6 +148,7 @@ impl Order {
 /// in `order`, with no random numbers drawn between them. Where `order` applies, every order
 /// gives the same bits and counts the same rays (`tests/global_waves.rs` checks it).
 pub fn incident_all(tr: &mut Tracer, g: &Global, rays: &[Ray], order: Order) -> Vec<Vec3A> {
+    debug_assert!(order.applies(tr, g), "{order:?} does not apply");
     match order {
         Order::DepthFirst => {
             let mut stack = Vec::with_capacity(g.max_depth as usize + 1);

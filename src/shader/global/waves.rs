@@ -1,6 +1,7 @@
 //! The rays below the first Phong hit traced in waves: every ray of one depth together, then
-//! every shadow ray of their hits together, so that the geometry answers them in batches with
-//! four rays in the SIMD lanes ([`crate::accel::Geometry::intersect_batch`]).
+//! every shadow ray of their hits together, light by light, so that the geometry answers them
+//! in batches with a ray per SIMD lane, eight with AVX2
+//! ([`crate::accel::Geometry::intersect_batch`]).
 //!
 //! The result is the depth-first walk's ([`super::incident`]) to the bit. Each node of the tree
 //! (one traced ray and the mirror or glass chain behind it) keeps the terms that walk would add
@@ -21,19 +22,30 @@ use crate::stats::RayKind;
 use glam::{BVec3A, Vec3A};
 use std::f32::consts::PI;
 
-/// The largest tree of one sample traced in waves: `2^D - 1` nodes, so up to `D = 12`. Deeper
+/// The largest tree of one sample traced in waves: `2^D - 1` nodes, so up to `D = 8`. Deeper
 /// trees are walked depth first, which needs memory for only `D + 1` rays.
-pub const MAX_NODES: usize = 4095;
+pub const MAX_NODES: usize = 255;
+
+/// The most point lights the waves take: a wave holds a shadow ray per light and hit, up to
+/// `64 * 128` of them at `D = 8`, about a megabyte. More lights are walked depth first.
+pub const MAX_LIGHTS: usize = 64;
 
 /// Samples are traced in groups of about this many nodes: enough rays for full batches, few
-/// enough that a group's nodes stay in the first-level cache.
+/// enough that a group's buffers stay small (about 20 KB of nodes).
 const GROUP_NODES: usize = 64;
 
-/// True if the waves give the depth-first walk's result: no hit draws random numbers (no
-/// area-light samples), and one sample's tree fits in [`MAX_NODES`].
+/// True if the waves give the depth-first walk's result, and fit their memory bounds: there is
+/// a tree to trace (`D >= 1`), no hit draws random numbers (no area-light samples), one
+/// sample's tree has at most [`MAX_NODES`] nodes, and there are at most [`MAX_LIGHTS`] point
+/// lights.
 pub fn applies(tr: &Tracer, g: &Global) -> bool {
     let draws = tr.effects.emission && !tr.emitters.is_empty() && g.light_samples > 0;
-    !draws && nodes_per_sample(g) <= MAX_NODES
+    g.max_depth >= 1 && !draws && nodes_per_sample(g) <= MAX_NODES && tr.lights.len() <= MAX_LIGHTS
+}
+
+/// How many samples' trees are traced together: about [`GROUP_NODES`] nodes' worth.
+pub fn group(g: &Global) -> usize {
+    (GROUP_NODES / nodes_per_sample(g).max(1)).max(1)
 }
 
 /// Nodes of one sample's full tree: `2^D - 1`.
@@ -52,8 +64,9 @@ struct Node {
     tint: Vec3A,
     /// Light the chain's surfaces emit towards the node, weighted by `tint`.
     le: Vec3A,
-    /// What the node adds after `beta le`: the background it escapes to, or the direct light
-    /// of its Phong hit (with the ambient term at depth `D`); `None` if it is absorbed.
+    /// What the node adds to `L_i` after `beta le`: `beta` times the background it escapes
+    /// to, or times its Phong hit's direct light (Eq. 3), plus the ambient term at depth `D`
+    /// (Eq. 2); `None` if it is absorbed.
     rest: Option<Vec3A>,
     /// Index of its first child (the normal's ray; the reflection's follows), if it has two.
     children: Option<u32>,
@@ -138,10 +151,8 @@ pub fn incident(tr: &mut Tracer, g: &Global, rays: &[Ray]) -> Vec<Vec3A> {
         static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::default();
     }
     SCRATCH.with_borrow_mut(|s| {
-        // Samples in groups of about `GROUP_NODES` nodes.
-        let group = (GROUP_NODES / nodes_per_sample(g)).max(1);
         let mut out = Vec::with_capacity(rays.len());
-        for chunk in rays.chunks(group) {
+        for chunk in rays.chunks(group(g)) {
             trace_tree(tr, g, chunk, s);
             out.extend((0..chunk.len()).map(|root| sum_tree(s, root as u32)));
         }
@@ -152,6 +163,7 @@ pub fn incident(tr: &mut Tracer, g: &Global, rays: &[Ray]) -> Vec<Vec3A> {
 /// The depth-first sum of the tree at `root`: a node, its normal's subtree, its reflection's.
 fn sum_tree(s: &mut Scratch, root: u32) -> Vec3A {
     let mut l = Vec3A::ZERO;
+    s.stack.clear();
     s.stack.push(root);
     while let Some(i) = s.stack.pop() {
         let node = &s.nodes[i as usize];
