@@ -193,7 +193,8 @@ pub fn require_all_isas() {
     }
 }
 
-#[cfg(all(test, target_arch = "x86_64"))]
+#[cfg(test)]
+#[cfg(target_arch = "x86_64")]
 mod tests {
     use super::avx2::Avx2;
     use super::baseline::Halves;
