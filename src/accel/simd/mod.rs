@@ -200,31 +200,43 @@ mod tests {
     use super::baseline::Halves;
     use super::*;
 
+    /// The values where implementations differ if they differ at all: NaN of both signs,
+    /// zeros of both signs, infinities, a subnormal, the largest float and plain numbers.
+    const SPECIALS: [f32; 12] = [
+        f32::NAN,
+        -f32::NAN,
+        0.0,
+        -0.0,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        1.0,
+        -1.0,
+        1e-45,
+        f32::MAX,
+        -3.5,
+        2.0,
+    ];
+
+    /// True if this CPU has AVX2 to compare with the baseline; false (saying so) if not, which
+    /// fails instead where `RTIS_REQUIRE_AVX2=1`.
+    fn avx2_to_compare() -> bool {
+        super::require_all_isas();
+        let present = Isa::Avx2.available();
+        if !present {
+            eprintln!("no AVX2 here: nothing to compare");
+        }
+        present
+    }
+
     /// Every lane operation gives the same bits in both instruction sets, on the values where
     /// implementations differ if they differ at all: NaN in either operand, zeros of both
     /// signs, infinities, equal operands, subnormals and bytes at both ends.
     #[test]
     fn every_lane_operation_agrees_bit_for_bit() {
-        super::require_all_isas();
-        if !Isa::Avx2.available() {
-            eprintln!("no AVX2 here: nothing to compare");
+        if !avx2_to_compare() {
             return;
         }
-        let specials = [
-            f32::NAN,
-            -f32::NAN,
-            0.0,
-            -0.0,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            1.0,
-            -1.0,
-            1e-45,
-            f32::MAX,
-            -3.5,
-            2.0,
-        ];
-        let n = specials.len();
+        let (specials, n) = (SPECIALS, SPECIALS.len());
         let lanes = |k: usize| -> [f32; 8] { std::array::from_fn(|i| specials[(k + 3 * i) % n]) };
         let bits = |v: [f32; 8]| v.map(f32::to_bits);
         for a in 0..n {
@@ -288,26 +300,10 @@ mod tests {
     fn every_float_operation_agrees_bit_for_bit() {
         use super::avx2::F8;
         use glam::Vec4;
-        super::require_all_isas();
-        if !Isa::Avx2.available() {
-            eprintln!("no AVX2 here: nothing to compare");
+        if !avx2_to_compare() {
             return;
         }
-        let specials = [
-            f32::NAN,
-            -f32::NAN,
-            0.0,
-            -0.0,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            1.0,
-            -1.0,
-            1e-45,
-            f32::MAX,
-            -3.5,
-            2.0,
-        ];
-        let n = specials.len();
+        let (specials, n) = (SPECIALS, SPECIALS.len());
         let lanes = |k: usize| -> [f32; 8] { std::array::from_fn(|i| specials[(k + 5 * i) % n]) };
         // Bits, every NaN as one: which NaN an operation on two NaNs returns depends on the
         // order of its operands, which IEEE leaves open and the compiler may swap.
