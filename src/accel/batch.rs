@@ -103,6 +103,67 @@ impl Geometry {
         unsafe { self.occluded_in::<super::simd::avx2::F8>(rays, planes, blocked) }
     }
 
+    /// Which of the segments in the lanes are blocked, as [`Geometry::occluded`] answers each
+    /// (or [`Geometry::occluded_in_room`] if not `planes`): from origins `o` (with errors
+    /// `o_err`) along unit directions `d` to `t_max`. Only the lanes of `live` are asked; the
+    /// others answer false. For a shader that builds its rays in lanes (no gathering).
+    #[inline(always)]
+    pub fn occluded_lanes<L: Floats>(
+        &self,
+        o: [L; 3],
+        d: [L; 3],
+        o_err: L,
+        t_max: L,
+        planes: bool,
+        live: L::Mask,
+    ) -> L::Mask {
+        if !self.all_packed() {
+            // Ray by ray through the BVH.
+            let (mut v, mut lane) = ([[0.0f32; 8]; 8], [0.0f32; 8]);
+            for (k, x) in [o[0], o[1], o[2], d[0], d[1], d[2], o_err, t_max]
+                .into_iter()
+                .enumerate()
+            {
+                x.write_to(&mut v[k]);
+            }
+            let live = L::bitmask(live);
+            for (i, blocked) in lane.iter_mut().enumerate().take(L::LANES) {
+                if live & (1 << i) == 0 {
+                    continue;
+                }
+                let ray = Ray {
+                    o_err: v[6][i],
+                    ..Ray::bare(
+                        glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
+                        glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
+                        v[7][i],
+                    )
+                };
+                let hit = if planes {
+                    self.occluded(&ray)
+                } else {
+                    self.occluded_in_room(&ray)
+                };
+                *blocked = if hit { 1.0 } else { 0.0 };
+            }
+            // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
+            return unsafe { L::from_array8(lane).cmpne(L::splat(0.0)) };
+        }
+        let lanes = RayLanes::from_parts(o, d, o_err);
+        // No lane blocked yet (nothing is below itself, NaN included).
+        let mut hit = t_max.cmplt(t_max);
+        for (_, sphere) in &self.sphere_each {
+            // SAFETY: as above.
+            hit = hit | unsafe { sphere.splat::<L>() }.hit(&lanes, t_max).1;
+        }
+        if planes && !L::all(hit) {
+            for (_, plane) in &self.plane_each {
+                hit = hit | unsafe { plane.splat::<L>() }.hit(&lanes, t_max).1;
+            }
+        }
+        hit & live
+    }
+
     /// The nearest hits of `rays`, `L::LANES` at a time.
     ///
     /// # Safety

@@ -54,16 +54,24 @@ impl<L: Floats> RayLanes<L> {
         unsafe {
             let o = L::transpose3(&rays.map(|r| &r.o));
             let d = L::transpose3(&rays.map(|r| &r.d));
-            let o_err = L::from_array8(rays.map(|r| r.o_err));
-            // `max |o_i|` in glam's order (`Vec3A::max_element`): max(max(x, z), max(y, z)).
-            let [x, y, z] = [o[0].abs(), o[1].abs(), o[2].abs()];
-            let a = x.max(z).max(y.max(z));
-            RayLanes {
-                o,
-                d,
-                plane_k: L::splat(gamma(4)) * a + o_err,
-                sphere_k: o_err + L::splat(gamma(1)) * a,
-            }
+            RayLanes::from_parts(o, d, L::from_array8(rays.map(|r| r.o_err)))
+        }
+    }
+
+    /// Rays from origins `o` along `d` with origin errors `o_err`, one per lane, with each
+    /// lane's constants as [`RayLanes::new`] computes them.
+    #[inline(always)]
+    pub fn from_parts(o: [L; 3], d: [L; 3], o_err: L) -> Self {
+        // `max |o_i|` in glam's order (`Vec3A::max_element`): max(max(x, z), max(y, z)).
+        let [x, y, z] = [o[0].abs(), o[1].abs(), o[2].abs()];
+        let a = x.max(z).max(y.max(z));
+        // SAFETY: `o_err` is a value of `L`, so the CPU runs `L`'s instruction set.
+        let (g4, g1) = unsafe { (L::splat(gamma(4)), L::splat(gamma(1))) };
+        RayLanes {
+            o,
+            d,
+            plane_k: g4 * a + o_err,
+            sphere_k: o_err + g1 * a,
         }
     }
 }

@@ -11,7 +11,9 @@ pub mod wide;
 
 pub use bvh::{Bvh, Node};
 pub use prim::{FLAT, Prim};
-pub use simd::{Isa, require_all_isas};
+#[cfg(target_arch = "x86_64")]
+pub use simd::avx2::F8;
+pub use simd::{Floats, Isa, require_all_isas};
 pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::{Hit, Ray};

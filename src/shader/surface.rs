@@ -292,7 +292,7 @@ pub fn brdf_pdf(phong: &Phong, wo: Vec3A, n: Vec3A, wi: Vec3A, sampling: Samplin
 }
 
 /// Shadow rays end at this fraction of the distance to the light.
-const SHADOW_END: f32 = 1.0 - 1e-4;
+pub const SHADOW_END: f32 = 1.0 - 1e-4;
 
 /// The one ray a mirror or glass surface sends on, its tint, and its kind, in the course's
 /// model; `None` for Phong, and for an effect that is off (the surface is then black).

@@ -102,10 +102,10 @@ pub trait Lanes8: Copy {
 /// A vector of `f32` lanes with the operations of the sphere and plane tests
 /// (`accel::lanes`): four lanes in a `glam::Vec4` on every CPU, eight in an AVX2 register.
 ///
-/// As for [`Lanes8`], every operation is IEEE single precision lane by lane, exactly as glam's
-/// `Vec4` computes it (negation and `copysign` as sign-bit operations, `max` as SSE's `maxps`,
-/// ordered comparisons except `cmpne`, which is true where either lane is NaN), so that a
-/// lane's answer does not depend on the vector it sits in. (Which NaN comes out of an
+/// As for the node test's lanes, every operation is IEEE single precision lane by lane,
+/// exactly as glam's `Vec4` computes it (negation and `copysign` as sign-bit operations, `max`
+/// as SSE's `maxps`, ordered comparisons except `cmpne`, which is true where either lane is
+/// NaN), so that a lane's answer does not depend on the vector it sits in. (Which NaN comes out of an
 /// operation on two NaNs is left open, by IEEE and by the compiler, which may swap the
 /// operands of a sum; every comparison treats all NaNs alike.)
 ///

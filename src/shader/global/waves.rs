@@ -12,14 +12,14 @@
 //! ([`applies`]).
 
 use super::Global;
+use crate::accel::{Floats, Isa};
 use crate::geometry::{Hit, Ray};
-use crate::material::{Material, reflect};
+use crate::light::Light;
+use crate::material::{Material, Model, Phong, reflect};
 use crate::shader::Tracer;
-use crate::shader::surface::{
-    Interaction, emitted, point_light_ray, point_light_term, reflectance, specular_bounce,
-};
+use crate::shader::surface::{Interaction, SHADOW_END, emitted, reflectance, specular_bounce};
 use crate::stats::RayKind;
-use glam::{BVec3A, Vec3A};
+use glam::Vec3A;
 use std::f32::consts::PI;
 
 /// The largest tree of one sample traced in waves: `2^D - 1` nodes, so up to `D = 8`. Deeper
@@ -86,7 +86,7 @@ impl Node {
     }
 }
 
-/// A node whose chain ended at a Phong surface, waiting for its shadow rays.
+/// A node whose chain ended at a Phong surface, waiting for its direct light.
 struct Lit {
     /// The node.
     node: u32,
@@ -94,17 +94,18 @@ struct Lit {
     beta: Vec3A,
     /// The ambient term `a_t kd` at depth `D` (Eq. 2), else `None`.
     ambient: Option<Vec3A>,
-    /// False for a surface that reflects nothing: it has no light terms.
-    reflects: bool,
+    /// The point lights' sum of Eq. 3 (zero for a surface that reflects nothing, which has no
+    /// light terms), once [`light_sums`] has run.
+    point: Vec3A,
 }
 
-/// A point light's term at a hit before its shadow ray is answered: `L_i r(wi, wo)`, and the
-/// shadow ray's index among the light's ([`SEEN`] if none is traced).
-type Term = (Vec3A, u32);
-
-/// The index of a term whose light counts without a shadow ray (shadows off), or that adds
-/// nothing whatever the visibility.
-const SEEN: u32 = u32::MAX;
+/// A Phong hit that reflects light, waiting for its point lights' terms, and its [`Lit`].
+struct End {
+    si: Interaction,
+    phong: Phong,
+    /// Index of its [`Lit`] in the wave.
+    lit: u32,
+}
 
 /// Rays waiting to be traced, with their nodes.
 #[derive(Default)]
@@ -135,10 +136,7 @@ struct Scratch {
     children: Rays,
     hits: Vec<Option<Hit>>,
     lit: Vec<Lit>,
-    terms: Vec<Term>,
-    /// Each light's shadow rays, and whether each is blocked.
-    shadow: Vec<Vec<Ray>>,
-    blocked: Vec<Vec<bool>>,
+    ends: Vec<End>,
     stack: Vec<u32>,
 }
 
@@ -195,9 +193,7 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         std::mem::swap(&mut s.now, &mut s.children);
         s.children.clear();
         s.lit.clear();
-        s.terms.clear();
-        s.shadow.resize_with(tr.lights.len(), Vec::new);
-        s.shadow.iter_mut().for_each(Vec::clear);
+        s.ends.clear();
         // Each bounce of the mirror and glass chains in one batch, until every chain ends.
         while !s.now.rays.is_empty() {
             tr.geometry.intersect_batch(&s.now.rays, &mut s.hits);
@@ -214,7 +210,8 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
             }
             std::mem::swap(&mut s.now, &mut s.bounced);
         }
-        finish_direct_light(tr, s);
+        light_sums(tr, s);
+        finish_direct_light(s);
     }
 }
 
@@ -242,25 +239,14 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
         return;
     };
     let beta = node.beta * node.tint;
-    // Eq. 3: each point light's term, its shadow ray answered in the wave's batch. A surface
-    // that reflects nothing has none (`point_lights`).
-    let reflects = !phong.is_black();
-    if reflects {
-        let lights = tr.lights;
-        for (light, rays) in lights.iter().zip(&mut s.shadow) {
-            s.terms.push(match point_light_ray(&si, light) {
-                None => (Vec3A::ZERO, SEEN),
-                Some((inc, shadow)) => {
-                    let term = point_light_term(tr.model, &si, &phong, &inc, true);
-                    if tr.effects.shadows {
-                        rays.push(shadow);
-                        (term, rays.len() as u32 - 1)
-                    } else {
-                        (term, SEEN)
-                    }
-                }
-            });
-        }
+    // Eq. 3 waits for the wave's light pass ([`light_sums`]). A surface that reflects nothing
+    // has no light terms (`point_lights`).
+    if !phong.is_black() {
+        s.ends.push(End {
+            si,
+            phong,
+            lit: s.lit.len() as u32,
+        });
     }
     // Eq. 2 at depth D ends the path; above it, task 2: Eq. 4 with the directions fixed to
     // the normal w_n and the reflection w_r, weighted by 1 / (4 pi).
@@ -269,7 +255,7 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
         node: i,
         beta,
         ambient: end.then(|| g.ambient * phong.kd),
-        reflects,
+        point: Vec3A::ZERO,
     });
     if end {
         return;
@@ -285,41 +271,181 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
     }
 }
 
-/// Answer the wave's shadow rays in one batch and set each Phong node's `rest`: Eq. 3 as
-/// `direct_light` sums it (the lights' terms in order, then the area lights' zero), plus the
-/// ambient term at depth `D`.
-fn finish_direct_light(tr: &mut Tracer, s: &mut Scratch) {
-    // Light by light: rays towards one light from nearby hits run close together, so the
-    // lanes of a batch tend to agree, and all or none test the planes.
-    s.blocked.resize_with(s.shadow.len(), Vec::new);
-    for ((light, rays), blocked) in tr.lights.iter().zip(&s.shadow).zip(&mut s.blocked) {
-        tr.stats.shadow += rays.len() as u64;
-        tr.geometry.occluded_batch(rays, !light.in_room(), blocked);
-    }
-    let lights = tr.lights.len();
-    let mut at = 0;
+/// Set each Phong node's `rest`: Eq. 3 as `direct_light` sums it (the point lights' sum, then
+/// the area lights' zero), plus the ambient term at depth `D`.
+fn finish_direct_light(s: &mut Scratch) {
     for lit in &s.lit {
-        // `point_lights`: nothing for a surface that reflects nothing, else the lights'
-        // terms in order, each seen or not.
-        let point = match lit.reflects {
-            false => Vec3A::ZERO,
-            true => {
-                at += lights;
-                s.terms[at - lights..at]
-                    .iter()
-                    .zip(&s.blocked)
-                    .map(|(&(term, k), blocked)| {
-                        let seen = k == SEEN || !blocked[k as usize];
-                        Vec3A::select(BVec3A::splat(seen), term, Vec3A::ZERO)
-                    })
-                    .sum()
-            }
-        };
         // `area_lights` adds an exact zero here: no hit samples them ([`applies`]).
-        let l_dir = point + Vec3A::ZERO;
+        let l_dir = lit.point + Vec3A::ZERO;
         s.nodes[lit.node as usize].rest = Some(match lit.ambient {
             Some(ambient) => lit.beta * (l_dir + ambient),
             None => lit.beta * l_dir,
         });
+    }
+}
+
+/// Eq. 3's point-light sum at every hit of `s.ends`, into its [`Lit`]: the hits in SIMD lanes
+/// (eight with AVX2), each light's terms and shadow rays computed and answered lane by lane,
+/// added in the lights' order as `point_lights` adds them.
+fn light_sums(tr: &mut Tracer, s: &mut Scratch) {
+    match tr.geometry.bvh.isa() {
+        // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { light_sums_avx2(tr, s) },
+        // SAFETY: `Vec4` runs on every CPU.
+        _ => unsafe { light_sums_in::<glam::Vec4>(tr, s) },
+    }
+}
+
+/// [`light_sums`] in eight AVX2 lanes.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn light_sums_avx2(tr: &mut Tracer, s: &mut Scratch) {
+    // SAFETY: this function runs only where AVX2 was found.
+    unsafe { light_sums_in::<crate::accel::F8>(tr, s) }
+}
+
+/// `(x + y) + z` of the products: glam's `Vec3A::dot`, lane by lane.
+#[inline(always)]
+fn dot<L: Floats>(a: [L; 3], b: [L; 3]) -> L {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// [`light_sums`] with the hits `L::LANES` at a time. No closures that compute in lanes, so
+/// that this inlines whole into the AVX2 copy.
+///
+/// Each lane computes what `point_light_ray` and `point_light_term` compute for its hit:
+/// `wi = (x - p) / |x - p|`, `L_i = I / d^2`, no term where `d^2` is 0 or not finite or
+/// `wi.n <= 0`, the shadow ray from the origin on `wi`'s side to `SHADOW_END` of the distance,
+/// and `L_i r(wi, wo)`, in lanes for the course's diffuse reflectance `kd (wi.n)` and by the
+/// scalar `reflectance` for any other (a specular lobe, the Physical model). The lanes' sums
+/// add an exact zero where the walk adds `ZERO`; a sum that starts at `+0` and adds no
+/// negative term is never `-0`, so that zero changes no bit.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
+    let (lights, model, shadows) = (tr.lights, tr.model, tr.effects.shadows);
+    // SAFETY: the caller vouches for the instruction set.
+    let (zero, inf, end) =
+        unsafe { (L::splat(0.0), L::splat(f32::INFINITY), L::splat(SHADOW_END)) };
+    for k in (0..s.ends.len()).step_by(L::LANES) {
+        let last = s.ends.len() - 1;
+        let mut e = [&s.ends[last]; 8];
+        for (i, slot) in e.iter_mut().enumerate().take(L::LANES) {
+            *slot = &s.ends[(k + i).min(last)];
+        }
+        let count = (s.ends.len() - k).min(L::LANES);
+        // The hits in lanes.
+        let (p, n, ng, front, back, kd, o_err, diffuse) = unsafe {
+            let mut diffuse = [0.0f32; 8];
+            for (d, end) in diffuse.iter_mut().zip(&e) {
+                let lambert = model == Model::Course && end.phong.ks == Vec3A::ZERO;
+                *d = if lambert { 1.0 } else { 0.0 };
+            }
+            (
+                L::transpose3(&e.map(|e| &e.si.hit.p)),
+                L::transpose3(&e.map(|e| &e.si.n)),
+                L::transpose3(&e.map(|e| &e.si.origins.n)),
+                L::transpose3(&e.map(|e| &e.si.origins.front)),
+                L::transpose3(&e.map(|e| &e.si.origins.back)),
+                L::transpose3(&e.map(|e| &e.phong.kd)),
+                L::from_array8(e.map(|e| e.si.origins.o_err)),
+                L::from_array8(diffuse).cmpne(zero),
+            )
+        };
+        let mut sum = [zero; 3];
+        for light in lights {
+            let Light::Point(pl) = light;
+            let (x, intensity) = (pl.position, pl.intensity);
+            // `PointLight::toward` and `incident`.
+            let to = unsafe {
+                [
+                    L::splat(x.x) - p[0],
+                    L::splat(x.y) - p[1],
+                    L::splat(x.z) - p[2],
+                ]
+            };
+            let d2 = dot(to, to);
+            let dist = d2.sqrt();
+            let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
+            let li = unsafe {
+                [
+                    L::splat(intensity.x) / d2,
+                    L::splat(intensity.y) / d2,
+                    L::splat(intensity.z) / d2,
+                ]
+            };
+            // `point_light_ray`: a term unless `d^2` is 0 or not finite, or `wi.n <= 0`.
+            let cos = dot(wi, n);
+            let valid = d2.cmpne(zero) & d2.cmplt(inf) & !cos.cmple(zero);
+            // `Origins::ray`: the side `wi` leaves by.
+            let on_front = dot(ng, wi).cmpge(zero);
+            let o = [
+                L::select(on_front, front[0], back[0]),
+                L::select(on_front, front[1], back[1]),
+                L::select(on_front, front[2], back[2]),
+            ];
+            let seen = if shadows {
+                tr.stats.shadow += u64::from((L::bitmask(valid) & ((1 << count) - 1)).count_ones());
+                let planes = !light.in_room();
+                let blocked = tr
+                    .geometry
+                    .occluded_lanes(o, wi, o_err, dist * end, planes, valid);
+                valid & !blocked
+            } else {
+                valid
+            };
+            // `point_light_term`: `L_i r(wi, wo)`; the course's diffuse `r = kd max(wi.n, 0)`
+            // in lanes, any other by the scalar reflectance.
+            let cos_i = cos.max(zero);
+            let mut term = [
+                li[0] * (kd[0] * cos_i),
+                li[1] * (kd[1] * cos_i),
+                li[2] * (kd[2] * cos_i),
+            ];
+            if !L::all(diffuse) {
+                let mut v = [[0.0f32; 8]; 9];
+                for (c, x) in [
+                    term[0], term[1], term[2], wi[0], wi[1], wi[2], li[0], li[1], li[2],
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    x.write_to(&mut v[c]);
+                }
+                let lambert = L::bitmask(diffuse);
+                for (i, end) in e.iter().enumerate().take(count) {
+                    if lambert & (1 << i) != 0 {
+                        continue;
+                    }
+                    let w = Vec3A::new(v[3][i], v[4][i], v[5][i]);
+                    let l = Vec3A::new(v[6][i], v[7][i], v[8][i]);
+                    let t = l * reflectance(model, &end.phong, w, end.si.wo, end.si.n);
+                    (v[0][i], v[1][i], v[2][i]) = (t.x, t.y, t.z);
+                }
+                term = unsafe {
+                    [
+                        L::from_array8(v[0]),
+                        L::from_array8(v[1]),
+                        L::from_array8(v[2]),
+                    ]
+                };
+            }
+            for c in 0..3 {
+                sum[c] = sum[c] + L::select(seen, term[c], zero);
+            }
+        }
+        let mut out = [[0.0f32; 8]; 3];
+        for c in 0..3 {
+            sum[c].write_to(&mut out[c]);
+        }
+        for (i, end) in e.iter().enumerate().take(count) {
+            s.lit[end.lit as usize].point = Vec3A::new(out[0][i], out[1][i], out[2][i]);
+        }
     }
 }
