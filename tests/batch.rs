@@ -223,3 +223,106 @@ fn equal_distances_go_to_the_later_primitive() {
         assert_eq!(seen, want, "{isa:?}");
     }
 }
+
+/// Shadow rays built in lanes (`Geometry::occluded_lanes`, as the Global shader's light pass
+/// builds them): each live lane answers as the one-ray query does, the others answer false,
+/// in each instruction set, with and without the planes, also for zero and NaN directions.
+#[test]
+fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
+    use rtis::accel::Floats;
+    let prims = vec![
+        Prim::flat(Shape::Sphere(Sphere {
+            c: Vec3A::new(0.0, 0.0, 5.0),
+            r: 1.0,
+        })),
+        Prim::flat(Shape::Sphere(Sphere {
+            c: Vec3A::new(2.0, 1.0, 4.0),
+            r: 0.5,
+        })),
+        Prim::flat(Shape::Plane(
+            Plane::through(Vec3A::new(0.0, 0.0, 9.0), -Vec3A::Z).oriented(1.0),
+        )),
+    ];
+    let rays: Vec<Ray> = (0..8)
+        .map(|k| {
+            let d = match k {
+                6 => Vec3A::ZERO,
+                7 => Vec3A::NAN,
+                _ => Vec3A::new(k as f32 * 0.12 - 0.3, 0.05 * k as f32, 1.0).normalize(),
+            };
+            Ray {
+                o_err: 1e-6 * k as f32,
+                ..Ray::segment(Vec3A::new(0.1, 0.0, 0.0), d, 4.0 + k as f32)
+            }
+        })
+        .collect();
+    let lane = |f: fn(&Ray) -> f32| -> [f32; 8] { std::array::from_fn(|i| f(&rays[i])) };
+    let parts = [
+        lane(|r| r.o.x),
+        lane(|r| r.o.y),
+        lane(|r| r.o.z),
+        lane(|r| r.d.x),
+        lane(|r| r.d.y),
+        lane(|r| r.d.z),
+        lane(|r| r.o_err),
+        lane(|r| r.t_max),
+    ];
+    for (_, g) in each_isa(Geometry::build(prims.clone(), Vec::new())) {
+        for planes in [false, true] {
+            let one: Vec<bool> = rays
+                .iter()
+                .map(|r| {
+                    if planes {
+                        g.occluded(r)
+                    } else {
+                        g.occluded_in_room(r)
+                    }
+                })
+                .collect();
+            assert!(one.iter().any(|&b| b) && one.iter().any(|&b| !b), "{one:?}");
+            // Four SSE lanes: rays 0 to 3, then 4 to 7; lanes 1 and 2 not live.
+            for half in [0, 4] {
+                let v = |k: usize| glam::Vec4::from_slice(&parts[k][half..half + 4]);
+                let live = glam::BVec4A::new(true, false, false, true);
+                let m = g.occluded_lanes(
+                    [v(0), v(1), v(2)],
+                    [v(3), v(4), v(5)],
+                    v(6),
+                    v(7),
+                    planes,
+                    live,
+                );
+                let want: u32 = (0..4)
+                    .filter(|&i| i != 1 && i != 2 && one[half + i])
+                    .map(|i| 1 << i)
+                    .sum();
+                assert_eq!(
+                    <glam::Vec4 as Floats>::bitmask(m),
+                    want,
+                    "SSE, rays {half}.., planes {planes}"
+                );
+            }
+            #[cfg(target_arch = "x86_64")]
+            if rtis::accel::Isa::Avx2.available() {
+                use rtis::accel::F8;
+                // SAFETY: AVX2 is present (checked just above).
+                let v = |k: usize| unsafe { F8::from_array8(parts[k]) };
+                let live = unsafe { F8::from_array8([1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0]) }
+                    .cmpne(unsafe { F8::splat(0.0) });
+                let m = g.occluded_lanes(
+                    [v(0), v(1), v(2)],
+                    [v(3), v(4), v(5)],
+                    v(6),
+                    v(7),
+                    planes,
+                    live,
+                );
+                let want: u32 = (0..8)
+                    .filter(|&i| i != 1 && i != 4 && one[i])
+                    .map(|i| 1 << i)
+                    .sum();
+                assert_eq!(F8::bitmask(m), want, "AVX2, planes {planes}");
+            }
+        }
+    }
+}

@@ -73,8 +73,19 @@ fn agree(name: &str, rs: &RenderScene) {
     agree_with(name, rs, &global(rs));
 }
 
-/// Both orders on `rs` with the shader's parameters `g`.
+/// Both orders on `rs` with the shader's parameters `g`, in every instruction set this CPU
+/// runs (the waves' batches and light pass run in it).
 fn agree_with(name: &str, rs: &RenderScene, g: &Global) {
+    rtis::accel::require_all_isas();
+    for isa in rtis::accel::Isa::all_available() {
+        let mut rs = rs.clone();
+        assert!(rs.geometry.bvh.set_isa(isa));
+        agree_in(&format!("{name} ({})", isa.name()), &rs, g);
+    }
+}
+
+/// Both orders on `rs` with the shader's parameters `g`.
+fn agree_in(name: &str, rs: &RenderScene, g: &Global) {
     let g = *g;
     let rays = rays(rs, 200, 11);
     let (waves, waves_stats) = trace(rs, &g, &rays, Order::Waves);

@@ -1,7 +1,8 @@
 //! Ray queries in batches: a ray per SIMD lane, tested against one primitive at a time.
 //!
-//! A shader that holds many rays at once (the Global shader's tree of indirect rays, the shadow
-//! rays of all its hits) hands them over together. Where every primitive is packed (planes,
+//! A shader that holds many rays at once (the Global shader's tree of indirect rays) hands
+//! them over together, or builds them in lanes itself (the shadow rays of its hits,
+//! [`Geometry::occluded_lanes`]). Where every primitive is packed (planes,
 //! and the spheres of small scenes), the rays fill the lanes (eight with AVX2, four with SSE)
 //! and each primitive is splatted across them ([`Geometry::sphere_each`],
 //! [`Geometry::plane_each`]): no lane is padding, no closest-lane search runs per ray, and the
@@ -156,7 +157,8 @@ impl Geometry {
             // SAFETY: as above.
             hit = hit | unsafe { sphere.splat::<L>() }.hit(&lanes, t_max).1;
         }
-        if planes && !L::all(hit) {
+        // The planes only if asked, and while a live lane is not blocked yet.
+        if planes && !L::all(hit | !live) {
             for (_, plane) in &self.plane_each {
                 hit = hit | unsafe { plane.splat::<L>() }.hit(&lanes, t_max).1;
             }
@@ -211,18 +213,16 @@ impl Geometry {
         for k in (0..rays.len()).step_by(L::LANES) {
             // SAFETY: the caller vouches for the instruction set.
             let (four, t_max) = unsafe { chunk::<L>(rays, k) };
-            let lanes = unsafe { RayLanes::<L>::gather(&four) };
-            // No lane blocked yet (nothing is below itself, NaN included).
-            let mut hit = t_max.cmplt(t_max);
-            for (_, sphere) in &self.sphere_each {
-                hit = hit | unsafe { sphere.splat::<L>() }.hit(&lanes, t_max).1;
-            }
-            // The planes only if asked, and while a lane is not blocked yet.
-            if planes && !L::all(hit) {
-                for (_, plane) in &self.plane_each {
-                    hit = hit | unsafe { plane.splat::<L>() }.hit(&lanes, t_max).1;
-                }
-            }
+            let (o, d, o_err) = unsafe {
+                (
+                    L::transpose3(&four.map(|r| &r.o)),
+                    L::transpose3(&four.map(|r| &r.d)),
+                    L::from_array8(four.map(|r| r.o_err)),
+                )
+            };
+            // Every lane asks (nothing is below itself: all clear, then all set).
+            let all = !t_max.cmplt(t_max);
+            let hit = self.occluded_lanes(o, d, o_err, t_max, planes, all);
             let mask = L::bitmask(hit);
             for i in 0..(rays.len() - k).min(L::LANES) {
                 blocked.push(mask & (1 << i) != 0);

@@ -1,7 +1,7 @@
-//! The rays below the first Phong hit traced in waves: every ray of one depth together, then
-//! every shadow ray of their hits together, light by light, so that the geometry answers them
-//! in batches with a ray per SIMD lane, eight with AVX2
-//! ([`crate::accel::Geometry::intersect_batch`]).
+//! The rays below the first Phong hit traced in waves: every ray of one depth together, so
+//! that the geometry answers them in batches with a ray per SIMD lane, eight with AVX2
+//! ([`crate::accel::Geometry::intersect_batch`]); then the direct light of all their hits
+//! together, with a hit per lane, light by light, shadow rays included ([`light_sums`]).
 //!
 //! The result is the depth-first walk's ([`super::incident`]) to the bit. Each node of the tree
 //! (one traced ray and the mirror or glass chain behind it) keeps the terms that walk would add
@@ -26,8 +26,8 @@ use std::f32::consts::PI;
 /// trees are walked depth first, which needs memory for only `D + 1` rays.
 pub const MAX_NODES: usize = 255;
 
-/// The most point lights the waves take: a wave holds a shadow ray per light and hit, up to
-/// `64 * 128` of them at `D = 8`, about a megabyte. More lights are walked depth first.
+/// The most point lights the waves take. The light pass keeps nothing per light, so this bounds
+/// only the work a wave holds back before its first sum; more lights are walked depth first.
 pub const MAX_LIGHTS: usize = 64;
 
 /// Samples are traced in groups of about this many nodes: enough rays for full batches, few
@@ -216,8 +216,9 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
 }
 
 /// Node `i`'s ray met `hit`: as [`crate::shader::surface::follow_specular`], a mirror or glass
-/// sends the chain on (into `s.bounced`); at a Phong surface, Eq. 3's light terms and shadow
-/// rays are queued and, below depth `D`, the two rays of task 2 (into `s.children`).
+/// sends the chain on (into `s.bounced`); a Phong hit is queued for the wave's light pass
+/// (into `s.ends`, if it reflects light) and, below depth `D`, sends the two rays of task 2
+/// (into `s.children`).
 fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit: Hit) {
     let i = s.now.nodes[k];
     let si = Interaction::new(tr, &s.now.rays[k], hit);
@@ -322,8 +323,7 @@ fn dot<L: Floats>(a: [L; 3], b: [L; 3]) -> L {
 /// `wi.n <= 0`, the shadow ray from the origin on `wi`'s side to `SHADOW_END` of the distance,
 /// and `L_i r(wi, wo)`, in lanes for the course's diffuse reflectance `kd (wi.n)` and by the
 /// scalar `reflectance` for any other (a specular lobe, the Physical model). The lanes' sums
-/// add an exact zero where the walk adds `ZERO`; a sum that starts at `+0` and adds no
-/// negative term is never `-0`, so that zero changes no bit.
+/// add `+0` where the walk adds `ZERO` for a light that adds nothing, as it does.
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.
@@ -340,6 +340,12 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
             *slot = &s.ends[(k + i).min(last)];
         }
         let count = (s.ends.len() - k).min(L::LANES);
+        // The lanes that hold a hit (the rest repeat the last one): only they trace.
+        let mut filled = [0.0f32; 8];
+        for f in filled.iter_mut().take(count) {
+            *f = 1.0;
+        }
+        let filled = unsafe { L::from_array8(filled) }.cmpne(zero);
         // The hits in lanes.
         let (p, n, ng, front, back, kd, o_err, diffuse) = unsafe {
             let mut diffuse = [0.0f32; 8];
@@ -358,6 +364,7 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
                 L::from_array8(diffuse).cmpne(zero),
             )
         };
+        let (all_diffuse, lambert) = (L::all(diffuse), L::bitmask(diffuse));
         let mut sum = [zero; 3];
         for light in lights {
             let Light::Point(pl) = light;
@@ -382,7 +389,7 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
             };
             // `point_light_ray`: a term unless `d^2` is 0 or not finite, or `wi.n <= 0`.
             let cos = dot(wi, n);
-            let valid = d2.cmpne(zero) & d2.cmplt(inf) & !cos.cmple(zero);
+            let valid = d2.cmpne(zero) & d2.cmplt(inf) & !cos.cmple(zero) & filled;
             // `Origins::ray`: the side `wi` leaves by.
             let on_front = dot(ng, wi).cmpge(zero);
             let o = [
@@ -391,8 +398,8 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
                 L::select(on_front, front[2], back[2]),
             ];
             let seen = if shadows {
-                tr.stats.shadow += u64::from((L::bitmask(valid) & ((1 << count) - 1)).count_ones());
-                let planes = !light.in_room();
+                tr.stats.shadow += u64::from(L::bitmask(valid).count_ones());
+                let planes = !pl.in_room;
                 let blocked = tr
                     .geometry
                     .occluded_lanes(o, wi, o_err, dist * end, planes, valid);
@@ -401,14 +408,15 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
                 valid
             };
             // `point_light_term`: `L_i r(wi, wo)`; the course's diffuse `r = kd max(wi.n, 0)`
-            // in lanes, any other by the scalar reflectance.
-            let cos_i = cos.max(zero);
+            // in lanes, any other by the scalar reflectance. `max(wi.n, 0)` as a select: `cos`
+            // where it is positive, else +0, as `f32::max` gives it on every target (NaN: 0).
+            let cos_i = L::select(cos.cmpgt(zero), cos, zero);
             let mut term = [
                 li[0] * (kd[0] * cos_i),
                 li[1] * (kd[1] * cos_i),
                 li[2] * (kd[2] * cos_i),
             ];
-            if !L::all(diffuse) {
+            if !all_diffuse {
                 let mut v = [[0.0f32; 8]; 9];
                 for (c, x) in [
                     term[0], term[1], term[2], wi[0], wi[1], wi[2], li[0], li[1], li[2],
@@ -418,7 +426,6 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
                 {
                     x.write_to(&mut v[c]);
                 }
-                let lambert = L::bitmask(diffuse);
                 for (i, end) in e.iter().enumerate().take(count) {
                     if lambert & (1 << i) != 0 {
                         continue;
