@@ -30,9 +30,9 @@ pub const MAX_NODES: usize = 255;
 /// only the work a wave holds back before its first sum; more lights are walked depth first.
 pub const MAX_LIGHTS: usize = 64;
 
-/// Samples are traced in groups of about this many nodes: enough rays for full batches, few
-/// enough that a group's buffers stay small (about 20 KB of nodes).
-const GROUP_NODES: usize = 64;
+/// Samples are traced in groups of at most about this many nodes: enough hits to fill the
+/// lanes of each wave, few enough that a group's buffers stay small (about 25 KB of nodes).
+const GROUP_NODES: usize = 256;
 
 /// True if the waves give the depth-first walk's result, and fit their memory bounds: there is
 /// a tree to trace (`D >= 1`), no hit draws random numbers (no area-light samples), one
@@ -43,9 +43,14 @@ pub fn applies(tr: &Tracer, g: &Global) -> bool {
     g.max_depth >= 1 && !draws && nodes_per_sample(g) <= MAX_NODES && tr.lights.len() <= MAX_LIGHTS
 }
 
-/// How many samples' trees are traced together: about [`GROUP_NODES`] nodes' worth.
+/// How many samples' trees are traced together: the `n` samples split into as few groups of
+/// at most [`GROUP_NODES`] nodes as they fit in (one sample at least), of equal size but the
+/// last, so that no group is left with a few samples' worth of rays.
 pub fn group(g: &Global) -> usize {
-    (GROUP_NODES / nodes_per_sample(g).max(1)).max(1)
+    let n = (g.samples as usize).max(1);
+    let per = nodes_per_sample(g).max(1);
+    let groups = (n * per).div_ceil(GROUP_NODES).max(1);
+    n.div_ceil(groups)
 }
 
 /// Nodes of one sample's full tree: `2^D - 1`.
