@@ -106,7 +106,9 @@ struct Lit {
 
 /// A Phong hit that reflects light, waiting for its point lights' terms, and its [`Lit`].
 struct End {
+    /// The hit.
     si: Interaction,
+    /// Its material.
     phong: Phong,
     /// Index of its [`Lit`] in the wave.
     lit: u32,
