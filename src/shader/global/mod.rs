@@ -105,8 +105,9 @@ fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Ve
                 }
             }
         } else {
-            // Light samples at the hits below draw random numbers: each direction's tree is
-            // walked before the next direction is drawn.
+            // Where the waves do not apply (light samples at the hits below draw random
+            // numbers, or the tree or the lights exceed their bounds), each direction's tree
+            // is walked before the next direction is drawn.
             let mut stack = Vec::with_capacity(g.max_depth as usize + 1);
             for _ in 0..g.samples {
                 let (u1, u2) = tr.sampler.next_2d();
