@@ -5,8 +5,9 @@
 //! [`Geometry::occluded_lanes`]). Where every primitive is packed (planes,
 //! and the spheres of small scenes), the rays fill the lanes (eight with AVX2, four with SSE)
 //! and each primitive is splatted across them ([`Geometry::sphere_each`],
-//! [`Geometry::plane_each`]): no lane is padding, no closest-lane search runs per ray, and the
-//! ray's constants are computed once. Each lane runs the arithmetic the one-ray query runs for
+//! [`Geometry::plane_each`]): no lane holds a padding primitive (only a batch's last chunk
+//! may repeat its last ray), no closest-lane search runs per ray, and each ray's constants are
+//! computed once. Each lane runs the arithmetic the one-ray query runs for
 //! its pair, in the same order of primitives and with the same tie rule, so the answers are
 //! bit-identical to [`Geometry::intersect`] and [`Geometry::occluded`] in every instruction
 //! set. Scenes with a BVH answer ray by ray.
