@@ -229,7 +229,6 @@ fn equal_distances_go_to_the_later_primitive() {
 /// in each instruction set, with and without the planes, also for zero and NaN directions.
 #[test]
 fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
-    use rtis::accel::Floats;
     let prims = vec![
         Prim::flat(Shape::Sphere(Sphere {
             c: Vec3A::new(0.0, 0.0, 5.0),
@@ -281,48 +280,59 @@ fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
                 .collect();
             assert!(one.iter().any(|&b| b) && one.iter().any(|&b| !b), "{one:?}");
             // Four SSE lanes: rays 0 to 3, then 4 to 7; lanes 1 and 2 not live.
-            for half in [0, 4] {
-                let v = |k: usize| glam::Vec4::from_slice(&parts[k][half..half + 4]);
-                let live = glam::BVec4A::new(true, false, false, true);
-                let m = g.occluded_lanes(
-                    [v(0), v(1), v(2)],
-                    [v(3), v(4), v(5)],
-                    v(6),
-                    v(7),
-                    planes,
-                    live,
-                );
-                let want: u32 = (0..4)
-                    .filter(|&i| i != 1 && i != 2 && one[half + i])
-                    .map(|i| 1 << i)
-                    .sum();
-                assert_eq!(
-                    <glam::Vec4 as Floats>::bitmask(m),
-                    want,
-                    "SSE, rays {half}.., planes {planes}"
-                );
+            for first in [0, 4] {
+                // SAFETY: `Vec4` runs on every CPU.
+                unsafe { in_lanes::<glam::Vec4>(&g, &parts, first, 0b1001, planes, &one) };
             }
+            // Eight AVX2 lanes; lanes 1 and 4 not live.
             #[cfg(target_arch = "x86_64")]
             if rtis::accel::Isa::Avx2.available() {
-                use rtis::accel::F8;
                 // SAFETY: AVX2 is present (checked just above).
-                let v = |k: usize| unsafe { F8::from_array8(parts[k]) };
-                let live = unsafe { F8::from_array8([1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0]) }
-                    .cmpne(unsafe { F8::splat(0.0) });
-                let m = g.occluded_lanes(
-                    [v(0), v(1), v(2)],
-                    [v(3), v(4), v(5)],
-                    v(6),
-                    v(7),
-                    planes,
-                    live,
-                );
-                let want: u32 = (0..8)
-                    .filter(|&i| i != 1 && i != 4 && one[i])
-                    .map(|i| 1 << i)
-                    .sum();
-                assert_eq!(F8::bitmask(m), want, "AVX2, planes {planes}");
+                unsafe { in_lanes::<rtis::accel::F8>(&g, &parts, 0, 0b1110_1101, planes, &one) };
             }
         }
     }
+}
+
+/// `occluded_lanes` on rays `first..first + L::LANES` of `parts` (their origin, direction,
+/// origin error and `t_max`, a row each) with the lanes of `live` asked: the live lanes answer
+/// as the one-ray queries (`one`), the others false.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+unsafe fn in_lanes<L: rtis::accel::Floats>(
+    g: &Geometry,
+    parts: &[[f32; 8]; 8],
+    first: usize,
+    live: u32,
+    planes: bool,
+    one: &[bool],
+) {
+    let v = |k: usize| {
+        let mut row = [0.0; 8];
+        row[..L::LANES].copy_from_slice(&parts[k][first..first + L::LANES]);
+        // SAFETY: the caller vouches for the instruction set.
+        unsafe { L::from_array8(row) }
+    };
+    let flags: [f32; 8] = std::array::from_fn(|i| (live >> i & 1) as f32);
+    // SAFETY: as above.
+    let live_mask = unsafe { L::from_array8(flags).cmpne(L::splat(0.0)) };
+    let m = g.occluded_lanes(
+        [v(0), v(1), v(2)],
+        [v(3), v(4), v(5)],
+        v(6),
+        v(7),
+        planes,
+        live_mask,
+    );
+    let want: u32 = (0..L::LANES)
+        .filter(|&i| live >> i & 1 == 1 && one[first + i])
+        .map(|i| 1 << i)
+        .sum();
+    assert_eq!(
+        L::bitmask(m),
+        want,
+        "{} lanes from ray {first}, planes {planes}",
+        L::LANES
+    );
 }

@@ -75,7 +75,7 @@ impl Item {
         }
     }
     /// The centroid's coordinate on `axis`. Read through arrays: glam's `Vec3` index is a
-    /// `match`, three compares per read, and the build reads this twice per item and level.
+    /// `match`, three compares per read, and binning reads this once per item and level.
     #[inline]
     fn centroid(&self, axis: usize) -> f32 {
         let (min, max): (&[f32; 3], &[f32; 3]) = (self.min.as_ref(), self.max.as_ref());

@@ -76,8 +76,10 @@ impl<L: Floats> RayLanes<L> {
     }
 }
 
+/// The dot product of two vectors held a coordinate per lane vector: `(x x' + y y') + z z'`
+/// lane by lane, glam's `Vec3A::dot` order.
 #[inline(always)]
-fn dot<L: Floats>(a: [L; 3], b: [L; 3]) -> L {
+pub fn dot<L: Floats>(a: [L; 3], b: [L; 3]) -> L {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 

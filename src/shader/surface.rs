@@ -123,7 +123,7 @@ fn point_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light: &Light) 
 /// block it. No plane can block it when the light is in the planes' room
 /// ([`Light::in_room`]).
 #[inline]
-pub fn point_light_ray(si: &Interaction, light: &Light) -> Option<(Incident, Ray)> {
+fn point_light_ray(si: &Interaction, light: &Light) -> Option<(Incident, Ray)> {
     let inc = light.incident(si.hit.p)?;
     if inc.wi.dot(si.n) <= 0.0 {
         return None;
@@ -134,7 +134,7 @@ pub fn point_light_ray(si: &Interaction, light: &Light) -> Option<(Incident, Ray
 
 /// `L_i r(wi, wo) V` for the incident light `inc` of [`point_light_ray`], seen or not.
 #[inline]
-pub fn point_light_term(
+fn point_light_term(
     model: Model,
     si: &Interaction,
     phong: &Phong,

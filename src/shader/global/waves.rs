@@ -12,6 +12,7 @@
 //! ([`applies`]).
 
 use super::Global;
+use crate::accel::lanes::dot;
 use crate::accel::{Floats, Isa};
 use crate::geometry::{Hit, Ray};
 use crate::light::Light;
@@ -314,12 +315,6 @@ fn light_sums(tr: &mut Tracer, s: &mut Scratch) {
 unsafe fn light_sums_avx2(tr: &mut Tracer, s: &mut Scratch) {
     // SAFETY: this function runs only where AVX2 was found.
     unsafe { light_sums_in::<crate::accel::F8>(tr, s) }
-}
-
-/// `(x + y) + z` of the products: glam's `Vec3A::dot`, lane by lane.
-#[inline(always)]
-fn dot<L: Floats>(a: [L; 3], b: [L; 3]) -> L {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// [`light_sums`] with the hits `L::LANES` at a time. No closures that compute in lanes, so
