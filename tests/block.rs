@@ -37,7 +37,8 @@ fn block_of(prims: &[Prim]) -> (Block, Vec<Prim>) {
         .filter(|p| lane_triangle(p).is_none())
         .copied()
         .collect();
-    (Block::new(prims, 0), others)
+    let leaf: Vec<&Prim> = prims.iter().collect();
+    (Block::new(&leaf, 0), others)
 }
 
 /// A block gives back each triangle with the same vertices and normal, to the bit (the

@@ -34,7 +34,7 @@ pub struct Block {
 impl Block {
     /// The block of the primitives `leaf` (1 to 4), whose non-triangles the caller stores, in
     /// order, from index `other` on.
-    pub fn new(leaf: &[Prim], other: usize) -> Block {
+    pub fn new(leaf: &[&Prim], other: usize) -> Block {
         assert!(
             (1..=4).contains(&leaf.len()),
             "a block holds 1 to 4 primitives"

@@ -97,26 +97,34 @@ impl Geometry {
     /// Sort the primitives into packets and a BVH; `normals` holds the vertex normals that
     /// smooth primitives refer to.
     pub fn build(prims: Vec<Prim>, normals: Vec<[glam::Vec3A; 3]>) -> Self {
-        let n_spheres = prims
-            .iter()
-            .filter(|p| p.shape.kind() == ShapeKind::Sphere)
-            .count();
+        // What leaves the BVH, counted in parallel: planes, and spheres in small scenes.
+        let (n_spheres, n_planes) = prims
+            .par_iter()
+            .map(|p| match p.shape.kind() {
+                ShapeKind::Sphere => (1, 0),
+                ShapeKind::Plane => (0, 1),
+                _ => (0, 0),
+            })
+            .reduce(|| (0usize, 0usize), |a, b| (a.0 + b.0, a.1 + b.1));
         let pack_spheres = n_spheres <= PACKED_SPHERES;
-        // One pass: planes to their packets, spheres to theirs in small scenes, the rest to
-        // the BVH. The packets keep each shape with its primitive, so no kind is lost.
+        // One pass if any leaves: planes to their packets, spheres to theirs in small scenes,
+        // the rest to the BVH. The packets keep each shape with its primitive, so no kind is
+        // lost. (A mesh leaves its primitives where they are.)
         let (mut planes, mut spheres) = (Vec::new(), Vec::new());
         let mut for_bvh = prims;
-        for_bvh.retain(|p| match p.shape {
-            Shape::Plane(pl) => {
-                planes.push((*p, pl));
-                false
-            }
-            Shape::Sphere(s) if pack_spheres => {
-                spheres.push((*p, s));
-                false
-            }
-            _ => true,
-        });
+        if n_planes > 0 || (pack_spheres && n_spheres > 0) {
+            for_bvh.retain(|p| match p.shape {
+                Shape::Plane(pl) => {
+                    planes.push((*p, pl));
+                    false
+                }
+                Shape::Sphere(s) if pack_spheres => {
+                    spheres.push((*p, s));
+                    false
+                }
+                _ => true,
+            });
+        }
         let has_triangles = for_bvh
             .iter()
             .any(|p| p.shape.kind() == ShapeKind::Triangle);
@@ -126,10 +134,12 @@ impl Geometry {
         // are most of the work).
         let (bvh, ranges) = WideBvh::collapse(&binary);
         drop(binary);
+        // A leaf's primitives, by reference (no copies of the 96-byte primitives); lanes
+        // past `count` repeat the first.
         let leaf = |(first, count): (usize, usize)| {
-            let mut leaf = [for_bvh[order[first] as usize]; 4];
+            let mut leaf = [&for_bvh[order[first] as usize]; 4];
             for (k, p) in leaf.iter_mut().enumerate().take(count) {
-                *p = for_bvh[order[first + k] as usize];
+                *p = &for_bvh[order[first + k] as usize];
             }
             (leaf, count)
         };
@@ -143,7 +153,7 @@ impl Geometry {
                 let block = Block::new(&leaf[..count], 0);
                 let attrs = [0, 1, 2, 3].map(|k| match in_lane(&block, k) {
                     true => {
-                        let p = &leaf[k];
+                        let p = leaf[k];
                         assert!(p.material < SMOOTH, "at most 2^31 materials");
                         let smooth = if p.smooth == FLAT { 0 } else { SMOOTH };
                         Attrs {
@@ -156,7 +166,8 @@ impl Geometry {
                 (block, attrs)
             })
             .unzip();
-        let attrs: Vec<Attrs> = lanes.into_iter().flatten().collect();
+        // The lanes' attributes in block order, in place (no copy).
+        let attrs: Vec<Attrs> = lanes.into_flattened();
         // The primitives of scalar lanes, kept whole in `others` in leaf order; each block
         // notes where its own start.
         let mut others: Vec<Prim> = Vec::new();
