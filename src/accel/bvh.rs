@@ -433,6 +433,28 @@ fn fold_bounds(items: &[Item]) -> (Aabb, Aabb) {
     })
 }
 
+/// Nodes over more items than this bin them in parallel.
+const PARALLEL_BINNING_MIN: usize = 1 << 16;
+
+/// Per bin: the box of the items, the box of their centroids, and their count.
+type Bins = [(Aabb, Aabb, usize); BINS];
+
+/// The bins of `items` along `axis`, the first from `lo`, `scale` bins per unit; each item
+/// keeps its bin in `Item::bin`.
+fn bin_items(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
+    let mut bins = [(Aabb::EMPTY, Aabb::EMPTY, 0usize); BINS];
+    for it in items {
+        let ib = it.bounds();
+        let bin = bin_of(it.centroid(axis), lo, scale);
+        it.bin = bin as u32;
+        let b = &mut bins[bin];
+        b.0 = b.0.union(ib);
+        b.1 = b.1.grow(ib.centroid());
+        b.2 += 1;
+    }
+    bins
+}
+
 /// The bin after which to split more than a leaf's worth of items along `axis` at the least
 /// SAH cost, with the item and centroid boxes of both sides; `None` if every item falls in one
 /// bin. (A leaf's worth never gets here: see `build_node`.) Each item keeps its bin in
@@ -445,17 +467,24 @@ fn best_split(
     area: f32,
 ) -> Option<(usize, (Aabb, Aabb), (Aabb, Aabb))> {
     let (lo, scale) = (cb.min[axis], BINS as f32 / (cb.max[axis] - cb.min[axis]));
-    // Per bin: item box, centroid box, count.
-    let mut bins = [(Aabb::EMPTY, Aabb::EMPTY, 0usize); BINS];
-    for it in order {
-        let ib = it.bounds();
-        let bin = bin_of(it.centroid(axis), lo, scale);
-        it.bin = bin as u32;
-        let b = &mut bins[bin];
-        b.0 = b.0.union(ib);
-        b.1 = b.1.grow(ib.centroid());
-        b.2 += 1;
-    }
+    let fill = |items: &mut [Item]| bin_items(items, axis, lo, scale);
+    // Near the root, in parallel by chunks: the unions and counts are exact, so the merged
+    // bins are the ones a single pass fills.
+    let bins = if order.len() > PARALLEL_BINNING_MIN {
+        order
+            .par_chunks_mut(PARALLEL_BINNING_MIN / 4)
+            .map(fill)
+            .reduce(
+                || [(Aabb::EMPTY, Aabb::EMPTY, 0); BINS],
+                |a, b| {
+                    std::array::from_fn(|k| {
+                        (a[k].0.union(b[k].0), a[k].1.union(b[k].1), a[k].2 + b[k].2)
+                    })
+                },
+            )
+    } else {
+        fill(order)
+    };
     // Sweep from the right for every right side, then from the left.
     let mut right = [((Aabb::EMPTY, Aabb::EMPTY), 0usize); BINS];
     let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
