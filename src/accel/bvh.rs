@@ -455,6 +455,22 @@ fn bin_items(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
     bins
 }
 
+/// [`bin_items`], in parallel by chunks for a node over more than [`PARALLEL_BINNING_MIN`]
+/// items: the unions and counts are exact, so the merged bins are the ones one pass fills.
+fn bins_of(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
+    let fill = |items: &mut [Item]| bin_items(items, axis, lo, scale);
+    if items.len() <= PARALLEL_BINNING_MIN {
+        return fill(items);
+    }
+    let merge = |a: Bins, b: Bins| -> Bins {
+        std::array::from_fn(|k| (a[k].0.union(b[k].0), a[k].1.union(b[k].1), a[k].2 + b[k].2))
+    };
+    items
+        .par_chunks_mut(PARALLEL_BINNING_MIN / 4)
+        .map(fill)
+        .reduce(|| [(Aabb::EMPTY, Aabb::EMPTY, 0); BINS], merge)
+}
+
 /// The bin after which to split more than a leaf's worth of items along `axis` at the least
 /// SAH cost, with the item and centroid boxes of both sides; `None` if every item falls in one
 /// bin. (A leaf's worth never gets here: see `build_node`.) Each item keeps its bin in
@@ -467,24 +483,7 @@ fn best_split(
     area: f32,
 ) -> Option<(usize, (Aabb, Aabb), (Aabb, Aabb))> {
     let (lo, scale) = (cb.min[axis], BINS as f32 / (cb.max[axis] - cb.min[axis]));
-    let fill = |items: &mut [Item]| bin_items(items, axis, lo, scale);
-    // Near the root, in parallel by chunks: the unions and counts are exact, so the merged
-    // bins are the ones a single pass fills.
-    let bins = if order.len() > PARALLEL_BINNING_MIN {
-        order
-            .par_chunks_mut(PARALLEL_BINNING_MIN / 4)
-            .map(fill)
-            .reduce(
-                || [(Aabb::EMPTY, Aabb::EMPTY, 0); BINS],
-                |a, b| {
-                    std::array::from_fn(|k| {
-                        (a[k].0.union(b[k].0), a[k].1.union(b[k].1), a[k].2 + b[k].2)
-                    })
-                },
-            )
-    } else {
-        fill(order)
-    };
+    let bins = bins_of(order, axis, lo, scale);
     // Sweep from the right for every right side, then from the left.
     let mut right = [((Aabb::EMPTY, Aabb::EMPTY), 0usize); BINS];
     let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
@@ -540,6 +539,40 @@ fn partition(v: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::displaced_sphere;
+
+    /// Binning by chunks in parallel fills the bins one pass fills, to the bit, and gives each
+    /// item the same bin.
+    #[test]
+    fn parallel_binning_equals_one_pass() {
+        let mesh = displaced_sphere(3 * PARALLEL_BINNING_MIN, Vec3::ZERO, 1.0, 0.05);
+        let prims = Prim::flat_triangles(&mesh);
+        let mut items: Vec<Item> = prims
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let b = p.shape.bounds().unwrap();
+                Item {
+                    min: b.min.into(),
+                    prim: i as u32,
+                    max: b.max.into(),
+                    bin: 0,
+                }
+            })
+            .collect();
+        assert!(items.len() > PARALLEL_BINNING_MIN);
+        let mut again = items.clone();
+        let (parallel, one) = (
+            bins_of(&mut items, 1, -1.0, 7.5),
+            bin_items(&mut again, 1, -1.0, 7.5),
+        );
+        assert_eq!(format!("{parallel:?}"), format!("{one:?}"));
+        assert!(items.iter().zip(&again).all(|(a, b)| a.bin == b.bin));
+        assert!(
+            one.iter().filter(|b| b.2 > 0).count() == BINS,
+            "every bin filled"
+        );
+    }
 
     /// The fast bin index equals the saturating conversion it replaces on every kind of value:
     /// NaN, infinities, signed zeros, negatives, bin edges and their neighbours, and a sweep.
