@@ -135,8 +135,15 @@ impl Geometry {
         let (bvh, ranges) = WideBvh::collapse(&binary);
         drop(binary);
         // A leaf's primitives, by reference (no copies of the 96-byte primitives); lanes
-        // past `count` repeat the first.
+        // past `count` repeat the first. The leaves come in the order of `order`, whose
+        // primitives lie scattered: each leaf asks for those `AHEAD` places further on, so
+        // that their cache misses overlap with this leaf's work.
+        const AHEAD: usize = 32;
         let leaf = |(first, count): (usize, usize)| {
+            for k in first..first + count {
+                let ahead = order[(k + AHEAD).min(order.len() - 1)] as usize;
+                wide::prefetch(&for_bvh[ahead]);
+            }
             let mut leaf = [&for_bvh[order[first] as usize]; 4];
             for (k, p) in leaf.iter_mut().enumerate().take(count) {
                 *p = &for_bvh[order[first + k] as usize];
