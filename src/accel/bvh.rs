@@ -484,36 +484,33 @@ fn best_split(
 ) -> Option<(usize, (Aabb, Aabb), (Aabb, Aabb))> {
     let (lo, scale) = (cb.min[axis], BINS as f32 / (cb.max[axis] - cb.min[axis]));
     let bins = bins_of(order, axis, lo, scale);
-    // Sweep from the right for every right side, then from the left.
+    // The bins that hold items, in order. An empty bin changes no union and no count, and
+    // the split after it has the same sides as the split after the last full bin before it
+    // (whose cost is the same operations on the same boxes), or an empty left side: skipping
+    // empty bins finds the same split, and small nodes leave most bins empty.
+    let mut full = [0usize; BINS];
+    let mut m = 0;
+    for (k, bin) in bins.iter().enumerate() {
+        if bin.2 > 0 {
+            full[m] = k;
+            m += 1;
+        }
+    }
+    // Sweep from the right for every right side (`right[i]`: the full bins from the `i`th
+    // on), then from the left over the splits after each full bin but the last.
     let mut right = [((Aabb::EMPTY, Aabb::EMPTY), 0usize); BINS];
     let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
-    for k in (1..BINS).rev() {
-        acc = (
-            acc.0.union(bins[k].0),
-            acc.1.union(bins[k].1),
-            acc.2 + bins[k].2,
-        );
-        right[k] = ((acc.0, acc.1), acc.2);
+    for i in (1..m).rev() {
+        let b = &bins[full[i]];
+        acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
+        right[i] = ((acc.0, acc.1), acc.2);
     }
     let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
     let mut best: (f32, Option<(usize, (Aabb, Aabb), (Aabb, Aabb))>) = (f32::INFINITY, None);
-    for k in 0..BINS - 1 {
-        // After an empty bin, the split is the one after the last bin that holds items
-        // (their sides hold the same items), whose cost was found already (the same
-        // operations on the same boxes); or its left side is empty. Small nodes leave most
-        // bins empty, so this skips most of their candidates.
-        if bins[k].2 == 0 {
-            continue;
-        }
-        acc = (
-            acc.0.union(bins[k].0),
-            acc.1.union(bins[k].1),
-            acc.2 + bins[k].2,
-        );
-        let (rb, rc) = right[k + 1];
-        if rc == 0 {
-            continue;
-        }
+    for i in 0..m.saturating_sub(1) {
+        let (k, b) = (full[i], &bins[full[i]]);
+        acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
+        let (rb, rc) = right[i + 1];
         let cost = TRAVERSAL_COST
             + (acc.0.area() * blocks(acc.2) + rb.0.area() * blocks(rc))
                 / area.max(f32::MIN_POSITIVE);
