@@ -68,6 +68,20 @@ struct Item {
 }
 
 impl Item {
+    /// The item of primitive `p`, the `i`th (bounded).
+    fn new((i, p): (usize, &Prim)) -> Item {
+        let b = p
+            .shape
+            .bounds()
+            .expect("only bounded primitives go in the BVH");
+        Item {
+            min: b.min.into(),
+            prim: i as u32,
+            max: b.max.into(),
+            bin: 0,
+        }
+    }
+
     /// Its box.
     #[inline]
     fn bounds(&self) -> Aabb {
@@ -123,22 +137,7 @@ impl Bvh {
         if prims.is_empty() {
             return (Vec::new(), Vec::new());
         }
-        let mut items: Vec<Item> = prims
-            .par_iter()
-            .enumerate()
-            .map(|(i, p)| {
-                let b = p
-                    .shape
-                    .bounds()
-                    .expect("only bounded primitives go in the BVH");
-                Item {
-                    min: b.min.into(),
-                    prim: i as u32,
-                    max: b.max.into(),
-                    bin: 0,
-                }
-            })
-            .collect();
+        let mut items: Vec<Item> = prims.par_iter().enumerate().map(Item::new).collect();
         let mut sparse = zeroed_nodes(2 * prims.len() - 1);
         let bounds = items.par_chunks(PARALLEL_MIN).map(fold_bounds).reduce(
             || (Aabb::EMPTY, Aabb::EMPTY),
@@ -544,19 +543,7 @@ mod tests {
     fn parallel_binning_equals_one_pass() {
         let mesh = displaced_sphere(3 * PARALLEL_BINNING_MIN, Vec3::ZERO, 1.0, 0.05);
         let prims = Prim::flat_triangles(&mesh);
-        let mut items: Vec<Item> = prims
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
-                let b = p.shape.bounds().unwrap();
-                Item {
-                    min: b.min.into(),
-                    prim: i as u32,
-                    max: b.max.into(),
-                    bin: 0,
-                }
-            })
-            .collect();
+        let mut items: Vec<Item> = prims.iter().enumerate().map(Item::new).collect();
         assert!(items.len() > PARALLEL_BINNING_MIN);
         let mut again = items.clone();
         let (parallel, one) = (

@@ -129,6 +129,25 @@ unsafe fn quantize4(
     inv: f32,
 ) -> ([i32; 4], [i32; 4]) {
     use std::arch::x86_64::*;
+    /// Step the lanes where `moves` holds (its mask is -1 there) one grid line up (or down),
+    /// until it holds in none.
+    #[inline(always)]
+    fn walk(mut q: __m128i, up: bool, moves: impl Fn(__m128i) -> __m128i) -> __m128i {
+        // SAFETY: SSE2 is in the x86-64 baseline; these only compute on registers.
+        unsafe {
+            loop {
+                let m = moves(q);
+                if _mm_movemask_epi8(m) == 0 {
+                    return q;
+                }
+                q = if up {
+                    _mm_sub_epi32(q, m)
+                } else {
+                    _mm_add_epi32(q, m)
+                };
+            }
+        }
+    }
     // SAFETY: the caller's; the loads read four floats from slices of four.
     unsafe {
         let (lo, hi) = (_mm_loadu_ps(lo.as_ptr()), _mm_loadu_ps(hi.as_ptr()));
@@ -141,52 +160,26 @@ unsafe fn quantize4(
             let x = _mm_mul_ps(_mm_sub_ps(v, o), inv);
             _mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_set1_ps(255.0))
         };
-        // Each loop adds the lanes' masks (-1 where a lane steps) until no lane steps.
-        let mut ql = _mm_cvttps_epi32(estimate(lo));
-        loop {
-            let down = _mm_and_si128(
-                _mm_cmpgt_epi32(ql, zero),
-                _mm_castps_si128(_mm_cmpgt_ps(decode(ql), lo)),
-            );
-            if _mm_movemask_epi8(down) == 0 {
-                break;
-            }
-            ql = _mm_add_epi32(ql, down);
-        }
-        loop {
-            let up = _mm_and_si128(
-                _mm_cmplt_epi32(ql, top),
-                _mm_castps_si128(_mm_cmple_ps(decode(_mm_add_epi32(ql, one)), lo)),
-            );
-            if _mm_movemask_epi8(up) == 0 {
-                break;
-            }
-            ql = _mm_sub_epi32(ql, up);
-        }
+        let (is, holds) = (_mm_castps_si128, _mm_and_si128);
+        let ql = _mm_cvttps_epi32(estimate(lo));
+        let ql = walk(ql, false, |q| {
+            holds(_mm_cmpgt_epi32(q, zero), is(_mm_cmpgt_ps(decode(q), lo)))
+        });
+        let ql = walk(ql, true, |q| {
+            let next = decode(_mm_add_epi32(q, one));
+            holds(_mm_cmplt_epi32(q, top), is(_mm_cmple_ps(next, lo)))
+        });
         // `x as u8`, plus one where that is below `x`.
         let x = estimate(hi);
         let t = _mm_cvttps_epi32(x);
-        let mut qh = _mm_sub_epi32(t, _mm_castps_si128(_mm_cmplt_ps(_mm_cvtepi32_ps(t), x)));
-        loop {
-            let up = _mm_and_si128(
-                _mm_cmplt_epi32(qh, top),
-                _mm_castps_si128(_mm_cmplt_ps(decode(qh), hi)),
-            );
-            if _mm_movemask_epi8(up) == 0 {
-                break;
-            }
-            qh = _mm_sub_epi32(qh, up);
-        }
-        loop {
-            let down = _mm_and_si128(
-                _mm_cmpgt_epi32(qh, zero),
-                _mm_castps_si128(_mm_cmpge_ps(decode(_mm_sub_epi32(qh, one)), hi)),
-            );
-            if _mm_movemask_epi8(down) == 0 {
-                break;
-            }
-            qh = _mm_add_epi32(qh, down);
-        }
+        let qh = _mm_sub_epi32(t, is(_mm_cmplt_ps(_mm_cvtepi32_ps(t), x)));
+        let qh = walk(qh, true, |q| {
+            holds(_mm_cmplt_epi32(q, top), is(_mm_cmplt_ps(decode(q), hi)))
+        });
+        let qh = walk(qh, false, |q| {
+            let before = decode(_mm_sub_epi32(q, one));
+            holds(_mm_cmpgt_epi32(q, zero), is(_mm_cmpge_ps(before, hi)))
+        });
         let (mut l, mut h) = ([0i32; 4], [0i32; 4]);
         _mm_storeu_si128(l.as_mut_ptr() as *mut __m128i, ql);
         _mm_storeu_si128(h.as_mut_ptr() as *mut __m128i, qh);
