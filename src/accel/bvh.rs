@@ -67,6 +67,9 @@ struct Item {
     bin: u32,
 }
 
+// The layout `Item::bounds` loads.
+const _: () = assert!(std::mem::size_of::<Item>() == 32 && std::mem::align_of::<Item>() == 16);
+
 impl Item {
     /// The item of primitive `p`, the `i`th (bounded).
     fn new((i, p): (usize, &Prim)) -> Item {
@@ -88,10 +91,11 @@ impl Item {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::{__m128, _mm_and_ps, _mm_castsi128_ps, _mm_set_epi32};
-            // SAFETY: `Item` is `repr(C)` and 16-byte aligned, so bytes 0..16 (`min`, `prim`)
-            // and 16..32 (`max`, `bin`) are two aligned `__m128`s; the fourth lane, an
-            // integer, is cleared to 0.0 as `Vec3A` keeps it (its bits as a float could be
-            // subnormal, which slows arithmetic). SSE2 is in the x86-64 baseline.
+            // SAFETY: `Item` is `repr(C)`, 32 bytes and 16-byte aligned (checked below), so
+            // bytes 0..16 (`min`, `prim`) and 16..32 (`max`, `bin`) are two aligned `__m128`s.
+            // The fourth lane holds an integer, which glam's `Vec3A` ignores; it is cleared to
+            // 0.0 so that no arithmetic meets its bits as a float (they can be subnormal,
+            // which is slow). SSE2 is in the x86-64 baseline.
             unsafe {
                 let corners = &*(self as *const Item as *const [__m128; 2]);
                 let xyz = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
@@ -438,6 +442,10 @@ const PARALLEL_BINNING_MIN: usize = 1 << 16;
 /// Per bin: the box of the items, the box of their centroids, and their count.
 type Bins = [(Aabb, Aabb, usize); BINS];
 
+/// A split the SAH chose: the bin after which it falls, then the item and centroid boxes of
+/// the left side and of the right side.
+type Chosen = (usize, (Aabb, Aabb), (Aabb, Aabb));
+
 /// The bins of `items` along `axis`, the first from `lo`, `scale` bins per unit; each item
 /// keeps its bin in `Item::bin`.
 fn bin_items(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
@@ -455,7 +463,10 @@ fn bin_items(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
 }
 
 /// [`bin_items`], in parallel by chunks for a node over more than [`PARALLEL_BINNING_MIN`]
-/// items: the unions and counts are exact, so the merged bins are the ones one pass fills.
+/// items, merged in order: the counts are sums, and on NaN-free boxes (scenes hold finite
+/// values, and `Triangle::new` refuses the rest) the minima and maxima of the chunks' minima
+/// and maxima are those of one pass, to the bit (of equal values, `minps` and `maxps` keep
+/// the later, in either order of work), so the merged bins are the ones one pass fills.
 fn bins_of(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
     let fill = |items: &mut [Item]| bin_items(items, axis, lo, scale);
     if items.len() <= PARALLEL_BINNING_MIN {
@@ -464,6 +475,8 @@ fn bins_of(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
     let merge = |a: Bins, b: Bins| -> Bins {
         std::array::from_fn(|k| (a[k].0.union(b[k].0), a[k].1.union(b[k].1), a[k].2 + b[k].2))
     };
+    // At least four chunks per node binned in parallel: enough to share among the threads,
+    // few enough that merging costs nothing.
     items
         .par_chunks_mut(PARALLEL_BINNING_MIN / 4)
         .map(fill)
@@ -474,19 +487,20 @@ fn bins_of(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
 /// SAH cost, with the item and centroid boxes of both sides; `None` if every item falls in one
 /// bin. (A leaf's worth never gets here: see `build_node`.) Each item keeps its bin in
 /// `Item::bin` for the partition.
-#[allow(clippy::type_complexity)]
-fn best_split(
-    order: &mut [Item],
-    cb: &Aabb,
-    axis: usize,
-    area: f32,
-) -> Option<(usize, (Aabb, Aabb), (Aabb, Aabb))> {
+fn best_split(order: &mut [Item], cb: &Aabb, axis: usize, area: f32) -> Option<Chosen> {
     let (lo, scale) = (cb.min[axis], BINS as f32 / (cb.max[axis] - cb.min[axis]));
-    let bins = bins_of(order, axis, lo, scale);
-    // The bins that hold items, in order. An empty bin changes no union and no count, and
-    // the split after it has the same sides as the split after the last full bin before it
-    // (whose cost is the same operations on the same boxes), or an empty left side: skipping
-    // empty bins finds the same split, and small nodes leave most bins empty.
+    sweep(&bins_of(order, axis, lo, scale), area)
+}
+
+/// The SAH's choice among the splits between `bins` of a node whose box has surface `area`:
+/// the bin after which to split, and the item and centroid boxes of both sides; `None` if
+/// every item falls in one bin. Of equal costs the first is kept.
+fn sweep(bins: &Bins, area: f32) -> Option<Chosen> {
+    // The bins that hold items, in order. On NaN-free boxes an empty bin changes no union and
+    // no count, and the split after it has the same sides as the split after the last full
+    // bin before it (whose cost is the same operations on the same boxes, kept as the first
+    // of equal costs), or an empty left side: skipping empty bins finds the same split, and
+    // small nodes leave most bins empty.
     let mut full = [0usize; BINS];
     let mut m = 0;
     for (k, bin) in bins.iter().enumerate() {
@@ -505,7 +519,7 @@ fn best_split(
         right[i] = ((acc.0, acc.1), acc.2);
     }
     let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
-    let mut best: (f32, Option<(usize, (Aabb, Aabb), (Aabb, Aabb))>) = (f32::INFINITY, None);
+    let mut best: (f32, Option<Chosen>) = (f32::INFINITY, None);
     for i in 0..m.saturating_sub(1) {
         let (k, b) = (full[i], &bins[full[i]]);
         acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
@@ -536,25 +550,128 @@ fn partition(v: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
 mod tests {
     use super::*;
     use crate::mesh::displaced_sphere;
+    use glam::Vec3A;
 
-    /// Binning by chunks in parallel fills the bins one pass fills, to the bit, and gives each
-    /// item the same bin.
+    /// A box's bits, to compare boxes exactly (signed zeros apart).
+    fn bits(b: &Aabb) -> [u32; 6] {
+        let (lo, hi) = (b.min.to_array(), b.max.to_array());
+        [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]].map(f32::to_bits)
+    }
+
+    /// Bins' boxes and counts as bits.
+    fn bin_bits(bins: &Bins) -> Vec<([u32; 6], [u32; 6], usize)> {
+        bins.iter().map(|b| (bits(&b.0), bits(&b.1), b.2)).collect()
+    }
+
+    /// Binning by chunks in parallel fills the bins one pass fills, to the bit (signed zeros
+    /// included, where the order of the minima and maxima decides which comes out), and gives
+    /// each item the same bin.
     #[test]
     fn parallel_binning_equals_one_pass() {
         let mesh = displaced_sphere(3 * PARALLEL_BINNING_MIN, Vec3::ZERO, 1.0, 0.05);
         let prims = Prim::flat_triangles(&mesh);
         let mut items: Vec<Item> = prims.iter().enumerate().map(Item::new).collect();
         assert!(items.len() > PARALLEL_BINNING_MIN);
+        // Every item's smallest x and largest z a zero, of either sign by turns: each bin's
+        // box then has zeros there, whose signs depend on the order of the unions.
+        for (k, it) in items.iter_mut().enumerate() {
+            let zero = if k % 3 == 0 { -0.0 } else { 0.0 };
+            (it.min.x, it.max.z) = (zero, -zero);
+        }
         let mut again = items.clone();
         let (parallel, one) = (
             bins_of(&mut items, 1, -1.0, 7.5),
             bin_items(&mut again, 1, -1.0, 7.5),
         );
-        assert_eq!(format!("{parallel:?}"), format!("{one:?}"));
+        assert_eq!(bin_bits(&parallel), bin_bits(&one));
         assert!(items.iter().zip(&again).all(|(a, b)| a.bin == b.bin));
         assert!(
             one.iter().filter(|b| b.2 > 0).count() == BINS,
             "every bin filled"
+        );
+    }
+
+    /// The SAH sweep as it was before it skipped empty bins: every split after bins 0 to
+    /// 14 with two non-empty sides costed in turn.
+    fn sweep_every_bin(bins: &Bins, area: f32) -> Option<Chosen> {
+        let mut right = [((Aabb::EMPTY, Aabb::EMPTY), 0usize); BINS];
+        let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
+        for k in (1..BINS).rev() {
+            let b = &bins[k];
+            acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
+            right[k] = ((acc.0, acc.1), acc.2);
+        }
+        let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
+        let mut best = (f32::INFINITY, None);
+        for k in 0..BINS - 1 {
+            let b = &bins[k];
+            acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
+            let (rb, rc) = right[k + 1];
+            if acc.2 == 0 || rc == 0 {
+                continue;
+            }
+            let cost = TRAVERSAL_COST
+                + (acc.0.area() * blocks(acc.2) + rb.0.area() * blocks(rc))
+                    / area.max(f32::MIN_POSITIVE);
+            if cost < best.0 {
+                best = (cost, Some((k, (acc.0, acc.1), rb)));
+            }
+        }
+        best.1
+    }
+
+    /// The sweep over the full bins chooses what the sweep over every bin chooses, to the
+    /// bit: on bins mostly empty (as in small nodes), drawn from a few boxes and counts so
+    /// that equal costs are common (the first is kept), with signed zeros among the corners.
+    #[test]
+    fn sweeping_full_bins_equals_sweeping_every_bin() {
+        let mut s = crate::sampling::Sampler::new(9, 0, 0);
+        let corner = |s: &mut crate::sampling::Sampler| {
+            let pick = [0.0, -0.0, 0.25, 1.0, 2.5][(s.next_f32() * 5.0) as usize % 5];
+            if s.next_f32() < 0.5 {
+                pick
+            } else {
+                s.next_f32() * 4.0 - 2.0
+            }
+        };
+        let (mut ties, mut splits) = (0, 0);
+        for case in 0..20_000 {
+            let empty = [0.3, 0.6, 0.9][case % 3];
+            let bins: Bins = std::array::from_fn(|_| {
+                if s.next_f32() < empty {
+                    return (Aabb::EMPTY, Aabb::EMPTY, 0);
+                }
+                let a = Vec3A::new(corner(&mut s), corner(&mut s), corner(&mut s));
+                let b = Vec3A::new(corner(&mut s), corner(&mut s), corner(&mut s));
+                let bounds = Aabb::EMPTY.grow(a).grow(b);
+                let count = 1 + (s.next_f32() * 9.0) as usize;
+                (bounds, Aabb::EMPTY.grow(bounds.centroid()), count)
+            });
+            let area = bins.iter().fold(Aabb::EMPTY, |a, b| a.union(b.0)).area();
+            let show = |c: Option<Chosen>| {
+                c.map(|(k, l, r)| (k, bits(&l.0), bits(&l.1), bits(&r.0), bits(&r.1)))
+            };
+            let (new, old) = (sweep(&bins, area), sweep_every_bin(&bins, area));
+            assert_eq!(show(new), show(old), "case {case}");
+            splits += new.is_some() as usize;
+            // A later split of the same cost as the one kept.
+            let costs: Vec<f32> = (0..BINS - 1)
+                .filter_map(|k| {
+                    let (l, r) = bins.split_at(k + 1);
+                    let side = |b: &[(Aabb, Aabb, usize)]| {
+                        b.iter()
+                            .fold((Aabb::EMPTY, 0), |(a, n), b| (a.union(b.0), n + b.2))
+                    };
+                    let ((la, ln), (ra, rn)) = (side(l), side(r));
+                    (ln > 0 && rn > 0).then(|| la.area() * blocks(ln) + ra.area() * blocks(rn))
+                })
+                .collect();
+            let least = costs.iter().copied().fold(f32::INFINITY, f32::min);
+            ties += (costs.iter().filter(|&&c| c == least).count() > 1) as usize;
+        }
+        assert!(
+            splits > 10_000 && ties > 500,
+            "{splits} splits, {ties} with tied costs"
         );
     }
 

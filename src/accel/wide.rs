@@ -84,7 +84,7 @@ fn quantize(lo: f32, hi: f32, origin: f32, step: f32, inv_step: f32) -> (u8, u8)
 /// [`quantize`] of the intervals `lo[k]..hi[k]` for `k < n` on one grid, the others left 0:
 /// with SSE2, four intervals per pass, each lane taking the steps `quantize` takes (the same
 /// operations, the corrections repeated while any lane needs one), so the grid coordinates are
-/// the same; a node's eight children cost about what one of them costs alone.
+/// the same; a node's eight children cost about what two of them cost one by one.
 fn quantize_all(
     lo: &[f32; WIDTH],
     hi: &[f32; WIDTH],
@@ -101,9 +101,9 @@ fn quantize_all(
         if k >= n {
             break;
         }
-        // SAFETY: SSE2 is in the x86-64 baseline; these intrinsics only compute on registers
-        // and on the local arrays they are given.
-        let (l, h) = unsafe { quantize4(&lo[k..k + 4], &hi[k..k + 4], origin, step, inv_step) };
+        let four = |v: &[f32; WIDTH]| -> [f32; 4] { std::array::from_fn(|j| v[k + j]) };
+        // SAFETY: SSE2 is in the x86-64 baseline.
+        let (l, h) = unsafe { quantize4(&four(lo), &four(hi), origin, step, inv_step) };
         for j in k..n.min(k + 4) {
             (ql[j], qh[j]) = (l[j - k] as u8, h[j - k] as u8);
         }
@@ -112,18 +112,26 @@ fn quantize_all(
     for k in 0..n {
         (ql[k], qh[k]) = quantize(lo[k], hi[k], origin, step, inv_step);
     }
+    // What `quantize` asserts: each decoded interval contains its box.
+    for k in 0..n {
+        let decode = |q: u8| origin + q as f32 * step;
+        debug_assert!(
+            decode(ql[k]) <= lo[k] && decode(qh[k]) >= hi[k],
+            "box outside its grid"
+        );
+    }
     (ql, qh)
 }
 
 /// [`quantize`] in the four SSE lanes (see [`quantize_all`]); the grid coordinates as `i32`.
 ///
 /// # Safety
-/// Needs SSE2 (the x86-64 baseline); `lo` and `hi` hold four values each.
+/// Needs SSE2 (the x86-64 baseline).
 #[cfg(target_arch = "x86_64")]
 #[inline]
 unsafe fn quantize4(
-    lo: &[f32],
-    hi: &[f32],
+    lo: &[f32; 4],
+    hi: &[f32; 4],
     origin: f32,
     step: f32,
     inv: f32,
@@ -148,7 +156,7 @@ unsafe fn quantize4(
             }
         }
     }
-    // SAFETY: the caller's; the loads read four floats from slices of four.
+    // SAFETY: the caller's; the loads read the four floats of each array.
     unsafe {
         let (lo, hi) = (_mm_loadu_ps(lo.as_ptr()), _mm_loadu_ps(hi.as_ptr()));
         let (o, s, inv) = (_mm_set1_ps(origin), _mm_set1_ps(step), _mm_set1_ps(inv));
@@ -851,9 +859,49 @@ mod tests {
 
     /// The eight-lane quantisation gives each of the first `n` intervals what `quantize`
     /// gives it alone, and 0 in the other slots: on grids of every scale and offset, intervals
-    /// on grid lines and between them, a step of 0, and extents whose reciprocal overflows.
+    /// on grid lines and between them, a step of 0, a step whose reciprocal overflows, and
+    /// (below) intervals at the grid's two ends, signed zeros, and grids spanning all floats.
+    /// (Boxes outside their grid, or NaN, never reach it: a node's grid spans its children.)
     #[test]
     fn quantising_eight_at_once_equals_one_by_one() {
+        let agree = |lo: [f32; WIDTH], hi: [f32; WIDTH], origin: f32, step: f32| {
+            let (ql, qh) = quantize_all(&lo, &hi, WIDTH, (origin, step, 1.0 / step));
+            for k in 0..WIDTH {
+                let expect = quantize(lo[k], hi[k], origin, step, 1.0 / step);
+                assert_eq!((ql[k], qh[k]), expect, "{origin} + q {step}: {lo:?} {hi:?}");
+            }
+        };
+        for (origin, top) in [
+            (0.0f32, 1.0f32),
+            (-0.0, 3.0),
+            (-f32::MAX, f32::MAX),
+            (-1e30, 1e38),
+        ] {
+            let step = grid_step(origin, top);
+            let end = origin + 255.0 * step;
+            let mid = origin + 100.0 * step;
+            let lo = [
+                origin,
+                origin,
+                -0.0f32.max(origin),
+                0.0f32.max(origin),
+                mid,
+                mid,
+                origin,
+                end,
+            ];
+            let hi = [
+                origin,
+                end,
+                0.0f32.max(origin),
+                end,
+                mid,
+                end,
+                mid.next_up(),
+                end,
+            ];
+            agree(lo, hi.map(|h| h.min(end)), origin, step);
+        }
         let mut s = crate::sampling::Sampler::new(8, 0, 0);
         for case in 0..50_000 {
             let scale = 10f32.powi((case % 13) as i32 - 6);
