@@ -91,7 +91,7 @@ impl Item {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::{__m128, _mm_and_ps, _mm_castsi128_ps, _mm_set_epi32};
-            // SAFETY: `Item` is `repr(C)`, 32 bytes and 16-byte aligned (checked below), so
+            // SAFETY: `Item` is `repr(C)`, 32 bytes and 16-byte aligned (asserted after it), so
             // bytes 0..16 (`min`, `prim`) and 16..32 (`max`, `bin`) are two aligned `__m128`s.
             // The fourth lane holds an integer, which glam's `Vec3A` ignores; it is cleared to
             // 0.0 so that no arithmetic meets its bits as a float (they can be subnormal,

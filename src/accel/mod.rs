@@ -97,7 +97,8 @@ impl Geometry {
     /// Sort the primitives into packets and a BVH; `normals` holds the vertex normals that
     /// smooth primitives refer to.
     pub fn build(prims: Vec<Prim>, normals: Vec<[glam::Vec3A; 3]>) -> Self {
-        // What leaves the BVH, counted in parallel: planes, and spheres in small scenes.
+        // What goes to packets instead of the BVH, counted in parallel: planes, and spheres in
+        // small scenes.
         let (n_spheres, n_planes) = prims
             .par_iter()
             .map(|p| match p.shape.kind() {
@@ -107,9 +108,9 @@ impl Geometry {
             })
             .reduce(|| (0usize, 0usize), |a, b| (a.0 + b.0, a.1 + b.1));
         let pack_spheres = n_spheres <= PACKED_SPHERES;
-        // One pass if any leaves: planes to their packets, spheres to theirs in small scenes,
-        // the rest to the BVH. The packets keep each shape with its primitive, so no kind is
-        // lost. (A mesh leaves its primitives where they are.)
+        // One pass, if anything goes to packets: planes to theirs, spheres to theirs in small
+        // scenes, the rest to the BVH. The packets keep each shape with its primitive, so no
+        // kind is lost. (A mesh has nothing to move and skips the pass.)
         let (mut planes, mut spheres) = (Vec::new(), Vec::new());
         let mut for_bvh = prims;
         if n_planes > 0 || (pack_spheres && n_spheres > 0) {
