@@ -492,6 +492,15 @@ fn best_split(order: &mut [Item], cb: &Aabb, axis: usize, area: f32) -> Option<C
     sweep(&bins_of(order, axis, lo, scale), area)
 }
 
+/// The SAH cost of splitting a node whose box has surface `area` into sides with the given
+/// item boxes and counts: a visit, plus each side's blocks weighted by the chance that a ray
+/// through the node enters that side's box.
+#[inline]
+fn split_cost((left, nl): (Aabb, usize), (right, nr): (Aabb, usize), area: f32) -> f32 {
+    TRAVERSAL_COST
+        + (left.area() * blocks(nl) + right.area() * blocks(nr)) / area.max(f32::MIN_POSITIVE)
+}
+
 /// The SAH's choice among the splits between `bins` of a node whose box has surface `area`:
 /// the bin after which to split, and the item and centroid boxes of both sides; `None` if
 /// every item falls in one bin. Of equal costs the first is kept.
@@ -524,9 +533,7 @@ fn sweep(bins: &Bins, area: f32) -> Option<Chosen> {
         let (k, b) = (full[i], &bins[full[i]]);
         acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
         let (rb, rc) = right[i + 1];
-        let cost = TRAVERSAL_COST
-            + (acc.0.area() * blocks(acc.2) + rb.0.area() * blocks(rc))
-                / area.max(f32::MIN_POSITIVE);
+        let cost = split_cost((acc.0, acc.2), (rb.0, rc), area);
         if cost < best.0 {
             best = (cost, Some((k, (acc.0, acc.1), rb)));
         }
@@ -610,9 +617,7 @@ mod tests {
             if acc.2 == 0 || rc == 0 {
                 continue;
             }
-            let cost = TRAVERSAL_COST
-                + (acc.0.area() * blocks(acc.2) + rb.0.area() * blocks(rc))
-                    / area.max(f32::MIN_POSITIVE);
+            let cost = split_cost((acc.0, acc.2), (rb.0, rc), area);
             if cost < best.0 {
                 best = (cost, Some((k, (acc.0, acc.1), rb)));
             }
@@ -663,7 +668,7 @@ mod tests {
                             .fold((Aabb::EMPTY, 0), |(a, n), b| (a.union(b.0), n + b.2))
                     };
                     let ((la, ln), (ra, rn)) = (side(l), side(r));
-                    (ln > 0 && rn > 0).then(|| la.area() * blocks(ln) + ra.area() * blocks(rn))
+                    (ln > 0 && rn > 0).then(|| split_cost((la, ln), (ra, rn), area))
                 })
                 .collect();
             let least = costs.iter().copied().fold(f32::INFINITY, f32::min);
