@@ -105,14 +105,62 @@ struct Lit {
     point: Vec3A,
 }
 
-/// A Phong hit that reflects light, waiting for its point lights' terms, and its [`Lit`].
+/// A Phong hit that reflects light, waiting for its point lights' terms: what the light pass
+/// reads of its [`Interaction`] and material, in 128 bytes, and its [`Lit`].
 struct End {
-    /// The hit.
-    si: Interaction,
-    /// Its material.
-    phong: Phong,
+    /// The hit point.
+    p: Vec3A,
+    /// The shading normal on the viewer's side.
+    n: Vec3A,
+    /// The geometric normal that tells the origins' sides apart.
+    ng: Vec3A,
+    /// Start of rays leaving on `ng`'s side.
+    front: Vec3A,
+    /// Start of rays leaving on the other side.
+    back: Vec3A,
+    /// The material's `kd`.
+    kd: Vec3A,
+    /// Unit direction towards the viewer.
+    wo: Vec3A,
+    /// The origins' error bound.
+    o_err: f32,
     /// Index of its [`Lit`] in the wave.
     lit: u32,
+    /// The primitive hit, whose material the scalar reflectance reads.
+    prim: u32,
+    /// True if the course's diffuse reflectance `kd max(wi.n, 0)` is the material's.
+    lambert: bool,
+}
+
+// The size the light pass's reads were cut to.
+const _: () = assert!(std::mem::size_of::<End>() == 128);
+
+impl End {
+    /// The light pass's part of `si`, a hit on the Phong material `phong` under `model`.
+    #[inline(always)]
+    fn new(si: &Interaction, phong: &Phong, model: Model, lit: u32) -> Self {
+        End {
+            p: si.hit.p,
+            n: si.n,
+            ng: si.origins.n,
+            front: si.origins.front,
+            back: si.origins.back,
+            kd: phong.kd,
+            wo: si.wo,
+            o_err: si.origins.o_err,
+            lit,
+            prim: si.hit.prim,
+            lambert: model == Model::Course && phong.ks == Vec3A::ZERO,
+        }
+    }
+
+    /// Its Phong material, for the scalar reflectance.
+    fn phong(&self, tr: &Tracer) -> Phong {
+        match tr.materials[tr.geometry.prim(self.prim).material as usize] {
+            Material::Phong(phong) => phong,
+            _ => unreachable!("an End is a Phong hit"),
+        }
+    }
 }
 
 /// Rays waiting to be traced, with their nodes.
@@ -251,11 +299,8 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
     // Eq. 3 waits for the wave's light pass ([`light_sums`]). A surface that reflects nothing
     // has no light terms (`point_lights`).
     if !phong.is_black() {
-        s.ends.push(End {
-            si,
-            phong,
-            lit: s.lit.len() as u32,
-        });
+        s.ends
+            .push(End::new(&si, &phong, tr.model, s.lit.len() as u32));
     }
     // Eq. 2 at depth D ends the path; above it, task 2: Eq. 4 with the directions fixed to
     // the normal w_n and the reflection w_r, weighted by 1 / (4 pi).
@@ -350,19 +395,15 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
         let filled = unsafe { L::from_array8(filled) }.cmpne(zero);
         // The hits in lanes.
         let (p, n, ng, front, back, kd, o_err, diffuse) = unsafe {
-            let mut diffuse = [0.0f32; 8];
-            for (d, end) in diffuse.iter_mut().zip(&e) {
-                let lambert = model == Model::Course && end.phong.ks == Vec3A::ZERO;
-                *d = if lambert { 1.0 } else { 0.0 };
-            }
+            let diffuse = e.map(|e| if e.lambert { 1.0f32 } else { 0.0 });
             (
-                L::transpose3(&e.map(|e| &e.si.hit.p)),
-                L::transpose3(&e.map(|e| &e.si.n)),
-                L::transpose3(&e.map(|e| &e.si.origins.n)),
-                L::transpose3(&e.map(|e| &e.si.origins.front)),
-                L::transpose3(&e.map(|e| &e.si.origins.back)),
-                L::transpose3(&e.map(|e| &e.phong.kd)),
-                L::from_array8(e.map(|e| e.si.origins.o_err)),
+                L::transpose3(&e.map(|e| &e.p)),
+                L::transpose3(&e.map(|e| &e.n)),
+                L::transpose3(&e.map(|e| &e.ng)),
+                L::transpose3(&e.map(|e| &e.front)),
+                L::transpose3(&e.map(|e| &e.back)),
+                L::transpose3(&e.map(|e| &e.kd)),
+                L::from_array8(e.map(|e| e.o_err)),
                 L::from_array8(diffuse).cmpne(zero),
             )
         };
@@ -434,7 +475,7 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
                     }
                     let w = Vec3A::new(v[3][i], v[4][i], v[5][i]);
                     let l = Vec3A::new(v[6][i], v[7][i], v[8][i]);
-                    let t = l * reflectance(model, &end.phong, w, end.si.wo, end.si.n);
+                    let t = l * reflectance(model, &end.phong(tr), w, end.wo, end.n);
                     (v[0][i], v[1][i], v[2][i]) = (t.x, t.y, t.z);
                 }
                 term = unsafe {
