@@ -7,7 +7,7 @@ mod common;
 
 use glam::{Vec3, Vec3A};
 use rtis::accel::{Bvh, Isa, Prim, WideBvh, require_all_isas, wide};
-use rtis::geometry::Ray;
+use rtis::geometry::{BvhRay, Ray};
 use rtis::mesh::displaced_sphere;
 use rtis::sampling::Sampler;
 use rtis::sampling::warp::uniform_sphere;
@@ -355,14 +355,15 @@ fn scalar_leaf(prims: &[Prim], first: usize, count: usize, r: &Ray) -> Option<(u
 fn wide_tree_finds_what_the_binary_tree_finds() {
     let g = build(mesh_prims(20_000));
     let (wide, ranges) = collapse(&g.bvh);
-    let leaf = |b: u32, r: &Ray| {
+    let leaf = |b: u32, r: &BvhRay| {
         let (first, count) = ranges[b as usize];
         scalar_leaf(&g.prims, first, count, r)
     };
-    let any = |b: u32, r: &Ray| leaf(b, r).is_some();
+    let any = |b: u32, r: &BvhRay| leaf(b, r).is_some();
     let (mut hits, mut blocked) = (0, 0);
     let trees = each_isa(&wide);
     for r in rays(20_000, 3) {
+        let r = BvhRay::new(r);
         let expect = g.bvh.closest(&g.prims, &r);
         let occluded = g.bvh.any(&g.prims, &r);
         for wide in &trees {
@@ -414,9 +415,10 @@ fn every_instruction_set_visits_the_same_leaves() {
     }
     let mut visits = 0;
     for r in &rays {
+        let r = &BvhRay::new(*r);
         let trace = |wide: &WideBvh| {
             let log = std::cell::RefCell::new(Vec::new());
-            let leaf = |b: u32, r: &Ray| {
+            let leaf = |b: u32, r: &BvhRay| {
                 log.borrow_mut().push(b);
                 let (first, count) = ranges[b as usize];
                 scalar_leaf(&g.prims, first, count, r)
@@ -458,7 +460,7 @@ fn small_wide_trees() {
     assert_eq!(wide.nodes.len(), 1);
     assert_eq!(wide.nodes[0].child[1..], [wide::EMPTY; wide::WIDTH - 1]);
     assert_eq!(ranges, [(0, 3)], "the one leaf holds all three");
-    let down = Ray::new(Vec3A::new(0.2, 0.2, 1.0), -Vec3A::Z);
+    let down = BvhRay::new(Ray::new(Vec3A::new(0.2, 0.2, 1.0), -Vec3A::Z));
     let hit = wide.closest(&down, |b, _| Some((b, 1.0)), |_| {});
     assert_eq!(hit, Some((0, 1.0)));
     let (empty, no_leaves) = WideBvh::collapse(&[]);
@@ -489,7 +491,7 @@ fn axis_parallel_rays_on_box_sides_agree() {
     }
     let g = build(prims);
     let (wide, ranges) = collapse(&g.bvh);
-    let leaf = |b: u32, r: &Ray| {
+    let leaf = |b: u32, r: &BvhRay| {
         let (first, count) = ranges[b as usize];
         scalar_leaf(&g.prims, first, count, r)
     };
@@ -498,7 +500,7 @@ fn axis_parallel_rays_on_box_sides_agree() {
         for y in 0..=32 {
             for dz in [1.0f32, -1.0] {
                 let o = Vec3A::new(x as f32 * 0.5, y as f32 * 0.5, -dz);
-                let r = Ray::new(o, Vec3A::new(0.0, 0.0, dz));
+                let r = BvhRay::new(Ray::new(o, Vec3A::new(0.0, 0.0, dz)));
                 let expect = scalar_leaf(&g.prims, 0, g.prims.len(), &r);
                 assert_eq!(g.bvh.closest(&g.prims, &r), expect, "{r:?}");
                 for wide in each_isa(&wide) {

@@ -3,7 +3,7 @@
 use glam::Vec3A;
 use proptest::prelude::*;
 use rtis::accel::{Geometry, Prim};
-use rtis::geometry::{Hit, Ray};
+use rtis::geometry::{BvhRay, Hit, Ray};
 use rtis::shape::{Plane, Shape, Sphere, Triangle};
 
 fn unit() -> impl Strategy<Value = Vec3A> {
@@ -128,7 +128,7 @@ proptest! {
         let m = (b - a).cross(d);
         let (sc, sd) = (m.dot(c - a), m.dot(dpt - a));
         prop_assume!(sc * sd < 0.0 && sc.abs() > 1e-3 && sd.abs() > 1e-3);
-        let ray = Ray::new(o, d);
+        let ray = BvhRay::new(Ray::new(o, d));
         let hits = [t1, t2].iter().filter(|t| t.intersect(&ray).is_some()).count();
         prop_assert_eq!(hits, 1);
     }
@@ -156,7 +156,7 @@ fn flat_quad_diagonal_has_no_crack() {
             Vec3A::new(-2.0, 1.7, 3.0),
             Vec3A::new(1e-3, 2e-3, -1e-2),
         ] {
-            let ray = Ray::new(o, (target - o).normalize());
+            let ray = BvhRay::new(Ray::new(o, (target - o).normalize()));
             let hits = [t1, t2]
                 .iter()
                 .filter(|t| t.intersect(&ray).is_some())

@@ -134,12 +134,10 @@ impl Geometry {
                     continue;
                 }
                 let ray = Ray {
+                    o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
+                    d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
+                    t_max: v[7][i],
                     o_err: v[6][i],
-                    ..Ray::bare(
-                        glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
-                        glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
-                        v[7][i],
-                    )
                 };
                 let hit = if planes {
                     self.occluded(&ray)

@@ -10,7 +10,7 @@
 //! the triangle rebuilt from the lane, or on the whole primitive kept for a lane without one.
 
 use super::prim::Prim;
-use crate::geometry::{Ray, gamma};
+use crate::geometry::{BvhRay, Ray, gamma};
 use crate::shape::{Shape, Triangle};
 use glam::{Vec3A, Vec4};
 
@@ -141,7 +141,7 @@ impl Block {
     /// distance, with the scalar loop's tie rule (a later lane at equal distance wins).
     /// `others` holds the shapes of the scalar lanes from [`Block::other`] on.
     #[inline(always)]
-    pub fn closest(&self, others: &[Prim], br: &BlockRay, ray: &Ray) -> Option<(u32, f32)> {
+    pub fn closest(&self, others: &[Prim], br: &BlockRay, ray: &BvhRay) -> Option<(u32, f32)> {
         let (t, exact, mut scalar) = self.test(br, ray.t_max);
         let t = t.to_array();
         let mut best: Option<(u32, f32)> = None;
@@ -152,7 +152,14 @@ impl Block {
             mask &= mask - 1;
             let hit = if scalar & (1 << i) != 0 {
                 scalar &= !(1 << i);
-                self.scalar_hit(others, i, &Ray { t_max, ..*ray })
+                self.scalar_hit(
+                    others,
+                    i,
+                    &BvhRay {
+                        ray: Ray { t_max, ..ray.ray },
+                        ..*ray
+                    },
+                )
             } else {
                 Some(t[i as usize]).filter(|&t| t <= t_max)
             };
@@ -166,7 +173,7 @@ impl Block {
 
     /// True if any of the block's primitives is hit within `(0, ray.t_max]`.
     #[inline(always)]
-    pub fn any(&self, others: &[Prim], br: &BlockRay, ray: &Ray) -> bool {
+    pub fn any(&self, others: &[Prim], br: &BlockRay, ray: &BvhRay) -> bool {
         let (_, exact, mut scalar) = self.test(br, ray.t_max);
         if exact != 0 {
             return true;
@@ -183,10 +190,10 @@ impl Block {
 
     /// The scalar test of lane `lane`: its triangle's, or its other shape's.
     #[inline(never)]
-    fn scalar_hit(&self, others: &[Prim], lane: u32, ray: &Ray) -> Option<f32> {
+    fn scalar_hit(&self, others: &[Prim], lane: u32, ray: &BvhRay) -> Option<f32> {
         match self.triangle(lane as usize) {
             Some(t) => t.intersect(ray),
-            None => others[self.other_index(lane)].shape.intersect(ray),
+            None => others[self.other_index(lane)].shape.intersect_prepared(ray),
         }
     }
 }
@@ -219,7 +226,7 @@ pub struct BlockRay {
 impl BlockRay {
     /// Splat `ray` (which carries the shear constants: [`Ray::for_bvh`] with triangles).
     #[inline(always)]
-    pub fn new(ray: &Ray) -> Self {
+    pub fn new(ray: &BvhRay) -> Self {
         let splat = |v: glam::Vec3A| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];
         BlockRay {
             o: splat(ray.o),

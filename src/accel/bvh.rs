@@ -6,7 +6,7 @@
 //! the wide tree is tested against.
 
 use super::prim::Prim;
-use crate::geometry::{Aabb, Ray};
+use crate::geometry::{Aabb, BvhRay};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -153,7 +153,7 @@ impl Bvh {
 
     /// Nearest primitive hit: its index in `prims` and distance.
     #[inline]
-    pub fn closest(&self, prims: &[Prim], ray: &Ray) -> Option<(u32, f32)> {
+    pub fn closest(&self, prims: &[Prim], ray: &BvhRay) -> Option<(u32, f32)> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -169,7 +169,7 @@ impl Bvh {
                 let first = n.index as usize;
                 for (k, p) in prims[first..first + n.count as usize].iter().enumerate() {
                     if let Some(t) = p.shape.intersect(&r) {
-                        r.t_max = t;
+                        r.ray.t_max = t;
                         best = Some(((first + k) as u32, t));
                     }
                 }
@@ -217,7 +217,7 @@ impl Bvh {
 
     /// True if any primitive is hit within `(0, ray.t_max]`.
     #[inline]
-    pub fn any(&self, prims: &[Prim], ray: &Ray) -> bool {
+    pub fn any(&self, prims: &[Prim], ray: &BvhRay) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
@@ -252,7 +252,7 @@ impl Bvh {
     }
 
     #[inline]
-    fn box_hit(&self, i: usize, ray: &Ray, t_max: f32) -> Option<f32> {
+    fn box_hit(&self, i: usize, ray: &BvhRay, t_max: f32) -> Option<f32> {
         let n = &self.nodes[i];
         Aabb {
             min: n.min.into(),

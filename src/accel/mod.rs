@@ -16,7 +16,7 @@ pub use simd::avx2::F8;
 pub use simd::{Floats, Isa, require_all_isas};
 pub use wide::{WideBvh, WideNode};
 
-use crate::geometry::{Hit, Ray};
+use crate::geometry::{BvhRay, Hit, Ray};
 use crate::shape::{Shape, ShapeKind};
 use block::{Block, BlockRay};
 use lanes::{Lanes, PlaneLanes, RayLanes, SphereLanes};
@@ -349,7 +349,7 @@ impl Geometry {
         if !self.bvh.nodes.is_empty() {
             let r = ray.for_bvh(t_max, self.has_triangles);
             let br = BlockRay::new(&r);
-            let leaf = |b: u32, r: &Ray| {
+            let leaf = |b: u32, r: &BvhRay| {
                 let hit = self.blocks[b as usize].closest(&self.others, &br, r);
                 hit.map(|(lane, t)| (4 * b + lane, t))
             };

@@ -16,7 +16,7 @@
 
 use super::bvh::Node;
 use super::simd::{Isa, Lanes8, baseline::Halves};
-use crate::geometry::Ray;
+use crate::geometry::BvhRay;
 use glam::Vec3A;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -392,8 +392,8 @@ impl WideBvh {
     #[inline]
     pub fn closest(
         &self,
-        ray: &Ray,
-        test: impl FnMut(u32, &Ray) -> Option<(u32, f32)>,
+        ray: &BvhRay,
+        test: impl FnMut(u32, &BvhRay) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
         debug_assert!(self.isa.available());
@@ -410,7 +410,7 @@ impl WideBvh {
     /// True if `test(leaf, ray)` holds for some leaf whose box the ray enters within
     /// `(0, ray.t_max]` (any-hit query for shadow rays).
     #[inline]
-    pub fn any(&self, ray: &Ray, test: impl FnMut(u32, &Ray) -> bool) -> bool {
+    pub fn any(&self, ray: &BvhRay, test: impl FnMut(u32, &BvhRay) -> bool) -> bool {
         debug_assert!(self.isa.available());
         match self.isa {
             // SAFETY: `isa` is private to this file and set only by `collapse` and `Default`
@@ -446,8 +446,8 @@ impl WideBvh {
     #[target_feature(enable = "avx2")]
     unsafe fn closest_avx2(
         &self,
-        ray: &Ray,
-        test: impl FnMut(u32, &Ray) -> Option<(u32, f32)>,
+        ray: &BvhRay,
+        test: impl FnMut(u32, &BvhRay) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
         // SAFETY: the caller's.
@@ -461,7 +461,7 @@ impl WideBvh {
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn any_avx2(&self, ray: &Ray, test: impl FnMut(u32, &Ray) -> bool) -> bool {
+    unsafe fn any_avx2(&self, ray: &BvhRay, test: impl FnMut(u32, &BvhRay) -> bool) -> bool {
         // SAFETY: the caller's.
         unsafe { self.any_in::<super::simd::avx2::Avx2>(ray, test) }
     }
@@ -473,8 +473,8 @@ impl WideBvh {
     #[inline(always)]
     unsafe fn closest_in<L: Lanes8>(
         &self,
-        ray: &Ray,
-        mut test: impl FnMut(u32, &Ray) -> Option<(u32, f32)>,
+        ray: &BvhRay,
+        mut test: impl FnMut(u32, &BvhRay) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
         if self.nodes.is_empty() {
@@ -485,9 +485,9 @@ impl WideBvh {
         let rb = unsafe { RayBox::<L>::new(ray.o, ray.inv_d) };
         let mut best = None;
         // Test leaf `c`; a hit shortens the ray and becomes the best so far.
-        let mut leaf = |c: u32, r: &mut Ray, best: &mut Option<(u32, f32)>| {
+        let mut leaf = |c: u32, r: &mut BvhRay, best: &mut Option<(u32, f32)>| {
             if let Some((p, t)) = test(c & !LEAF, r) {
-                r.t_max = t;
+                r.ray.t_max = t;
                 *best = Some((p, t));
             }
         };
@@ -582,7 +582,11 @@ impl WideBvh {
     /// # Safety
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    unsafe fn any_in<L: Lanes8>(&self, ray: &Ray, mut test: impl FnMut(u32, &Ray) -> bool) -> bool {
+    unsafe fn any_in<L: Lanes8>(
+        &self,
+        ray: &BvhRay,
+        mut test: impl FnMut(u32, &BvhRay) -> bool,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }

@@ -9,4 +9,4 @@ mod ray;
 pub use aabb::Aabb;
 pub use frame::Frame;
 pub use placement::{Placement, Transform};
-pub use ray::{Hit, Origins, Ray, UNIT_ROUNDOFF, gamma};
+pub use ray::{BvhRay, Hit, Origins, Ray, UNIT_ROUNDOFF, gamma};

@@ -1,4 +1,4 @@
-//! A ray with precomputed data for watertight triangle tests, the surface hit record, and the
+//! A ray, the per-ray constants of box and watertight triangle tests ([`BvhRay`]), the surface hit record, and the
 //! rounding-error bounds that place spawned rays (pbrt-v4's approach, "Managing Rounding
 //! Error", section 6.8 of the 4th edition).
 //!
@@ -26,10 +26,12 @@ pub const fn gamma(n: u32) -> f32 {
     nu / (1.0 - nu)
 }
 
-/// A half-line `o + t d` for `t` in `(0, t_max]`.
+/// A half-line `o + t d` for `t` in `(0, t_max]`, with the bound on its origin's error: what
+/// every query reads (48 bytes, so that the shaders' queues of rays stay small). The BVH and
+/// the watertight triangle test add their per-ray constants only where a scene needs them
+/// ([`Ray::for_bvh`]).
 ///
-/// `d` is unit length. The shear constants of Woop et al.'s watertight triangle test are
-/// computed once per ray here, so each triangle test reuses them.
+/// `d` is unit length.
 #[derive(Clone, Copy, Debug)]
 pub struct Ray {
     /// Origin.
@@ -38,27 +40,43 @@ pub struct Ray {
     pub d: Vec3A,
     /// Largest accepted hit distance.
     pub t_max: f32,
+    /// Bound on the error of `o` in each coordinate, against the exact point it stands for
+    /// (0 for camera rays, whose origin is exact).
+    pub o_err: f32,
+}
+
+// The size the shaders' queues of rays are laid out for.
+const _: () = assert!(std::mem::size_of::<Ray>() == 48);
+
+/// A ray with the constants of the BVH's box tests and of the watertight triangle test,
+/// computed once per query ([`Ray::for_bvh`]) and read by every node and triangle it meets.
+/// It reads as its [`Ray`] (`Deref`).
+#[derive(Clone, Copy, Debug)]
+pub struct BvhRay {
+    /// The ray.
+    pub ray: Ray,
     /// Reciprocal of `d`, for slab tests against boxes.
     pub inv_d: Vec3A,
     /// Axis along which `|d|` is largest, and the two others (watertight triangle test).
     pub k: [usize; 3],
     /// Shear constants `(-dx/dz, -dy/dz, 1/dz)` in the permuted frame.
     pub shear: [f32; 3],
-    /// Bound on the error of `o` in each coordinate, against the exact point it stands for
-    /// (0 for camera rays, whose origin is exact).
-    pub o_err: f32,
 }
 
-impl Ray {
-    /// A ray from `o` along the unit vector `d`, unbounded.
-    #[inline]
-    pub fn new(o: Vec3A, d: Vec3A) -> Self {
-        Self::segment(o, d, f32::INFINITY)
-    }
+impl std::ops::Deref for BvhRay {
+    type Target = Ray;
 
-    /// A ray from `o` along the unit vector `d` that stops at distance `t_max`.
+    #[inline(always)]
+    fn deref(&self) -> &Ray {
+        &self.ray
+    }
+}
+
+impl BvhRay {
+    /// `ray` with every constant: `1 / d`, and the axes and shear of the triangle test.
     #[inline]
-    pub fn segment(o: Vec3A, d: Vec3A, t_max: f32) -> Self {
+    pub fn new(ray: Ray) -> Self {
+        let d = ray.d;
         // The axes by selects and array reads, not branches: an incoherent ray's axis and
         // sign are a coin toss to the branch predictor (about one misprediction a ray).
         // `kz` is `d.abs().max_position()` (the first of equal largest).
@@ -74,29 +92,30 @@ impl Ray {
         let inv_d = d.recip();
         // `1 / d[kz]`, the same division.
         let sz = inv_d.to_array()[kz];
-        Ray {
-            o,
-            d,
-            t_max,
+        BvhRay {
+            ray,
             inv_d,
             k: [kx, ky, kz],
             shear: [da[kx] * sz, da[ky] * sz, sz],
-            o_err: 0.0,
         }
     }
+}
 
-    /// A ray with only origin, direction and extent set: what the shaders spawn. The
-    /// geometry queries add the BVH's and the triangle test's data ([`Ray::for_bvh`]) only
-    /// when the scene needs them.
+impl Ray {
+    /// A ray from `o` along the unit vector `d`, unbounded.
     #[inline]
-    pub fn bare(o: Vec3A, d: Vec3A, t_max: f32) -> Self {
+    pub fn new(o: Vec3A, d: Vec3A) -> Self {
+        Self::segment(o, d, f32::INFINITY)
+    }
+
+    /// A ray from `o` along the unit vector `d` that stops at distance `t_max`, with an exact
+    /// origin.
+    #[inline]
+    pub fn segment(o: Vec3A, d: Vec3A, t_max: f32) -> Self {
         Ray {
             o,
             d,
             t_max,
-            inv_d: Vec3A::ZERO,
-            k: [0, 1, 2],
-            shear: [0.0; 3],
             o_err: 0.0,
         }
     }
@@ -109,19 +128,19 @@ impl Ray {
     }
 
     /// This ray, limited to `t_max`, with the reciprocal direction for box tests and, if
-    /// `triangles`, the shear constants of the watertight triangle test.
+    /// `triangles`, the axes and shear constants of the watertight triangle test (without,
+    /// they stay unset: `[0, 1, 2]` and zeros).
     #[inline]
-    pub fn for_bvh(&self, t_max: f32, triangles: bool) -> Ray {
+    pub fn for_bvh(&self, t_max: f32, triangles: bool) -> BvhRay {
+        let ray = Ray { t_max, ..*self };
         if triangles {
-            Ray {
-                o_err: self.o_err,
-                ..Ray::segment(self.o, self.d, t_max)
-            }
+            BvhRay::new(ray)
         } else {
-            Ray {
-                t_max,
+            BvhRay {
+                ray,
                 inv_d: self.d.recip(),
-                ..*self
+                k: [0, 1, 2],
+                shear: [0.0; 3],
             }
         }
     }
@@ -200,8 +219,10 @@ impl Origins {
             self.back
         };
         Ray {
+            o,
+            d: w,
+            t_max,
             o_err: self.o_err,
-            ..Ray::bare(o, w, t_max)
         }
     }
 }
@@ -252,7 +273,7 @@ mod tests {
                 .map(|_| Vec3A::new(s.next_f32(), s.next_f32(), s.next_f32()) * 2.0 - Vec3A::ONE),
         );
         for d in dirs {
-            let r = Ray::new(Vec3A::ZERO, d);
+            let r = BvhRay::new(Ray::new(Vec3A::ZERO, d));
             assert_eq!((r.k, r.shear.map(f32::to_bits)), plain(d), "{d}");
         }
     }

@@ -17,7 +17,7 @@ pub use plane::Plane;
 pub use sphere::Sphere;
 pub use triangle::Triangle;
 
-use crate::geometry::{Aabb, Placement, Ray};
+use crate::geometry::{Aabb, BvhRay, Placement, Ray};
 use crate::mesh::MeshData;
 use glam::{DVec3, Vec3A};
 use std::sync::Arc;
@@ -160,9 +160,22 @@ pub struct Surface {
 }
 
 impl Shape {
-    /// Distance to the nearest intersection in `(0, ray.t_max]`, if any.
-    #[inline(always)]
+    /// Distance to the nearest intersection in `(0, ray.t_max]`, if any. A triangle computes
+    /// the ray's constants for the one test ([`BvhRay::new`]); many tests of one ray share
+    /// them through [`Shape::intersect_prepared`].
+    #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
+        match self {
+            Shape::Sphere(s) => s.intersect(ray),
+            Shape::Plane(p) => p.intersect(ray),
+            Shape::Triangle(t) => t.intersect(&BvhRay::new(*ray)),
+        }
+    }
+
+    /// [`Shape::intersect`] for a ray that carries the triangle test's constants
+    /// ([`Ray::for_bvh`] with triangles).
+    #[inline(always)]
+    pub fn intersect_prepared(&self, ray: &BvhRay) -> Option<f32> {
         match self {
             Shape::Sphere(s) => s.intersect(ray),
             Shape::Plane(p) => p.intersect(ray),

@@ -1,7 +1,7 @@
 //! Triangles with the watertight test of Woop, Benthin and Wald (JCGT 2013).
 
 use super::Surface;
-use crate::geometry::{Aabb, Ray, gamma};
+use crate::geometry::{Aabb, BvhRay, Ray, gamma};
 use glam::Vec3A;
 
 /// A two-sided triangle with vertices `v0, v1, v2` and unit winding normal
@@ -39,7 +39,7 @@ impl Triangle {
     /// function that is exactly zero is decided by a top-left rule, so a ray through an edge
     /// shared by two triangles hits exactly one of them, and never falls through the crack.
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<f32> {
+    pub fn intersect(&self, ray: &BvhRay) -> Option<f32> {
         let [kx, ky, kz] = ray.k;
         let [sx, sy, sz] = ray.shear;
         let a = self.v[0] - ray.o;
