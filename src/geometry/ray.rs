@@ -1,6 +1,6 @@
-//! A ray, the per-ray constants of box and watertight triangle tests ([`BvhRay`]), the surface hit record, and the
-//! rounding-error bounds that place spawned rays (pbrt-v4's approach, "Managing Rounding
-//! Error", section 6.8 of the 4th edition).
+//! A ray, the per-ray constants of box and watertight triangle tests ([`BvhRay`]), the
+//! surface hit record, and the rounding-error bounds that place spawned rays (pbrt-v4's
+//! approach, "Managing Rounding Error", section 6.8 of the 4th edition).
 //!
 //! Every hit point carries a bound on its error, derived from the operations that computed it
 //! ([`gamma`]). A spawned ray starts off the surface by that bound along the normal and carries
