@@ -412,6 +412,8 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
         for light in lights {
             let Light::Point(pl) = light;
             let (x, intensity) = (pl.position, pl.intensity);
+            let bits = intensity.to_array().map(f32::to_bits);
+            let grey = bits[0] == bits[1] && bits[1] == bits[2];
             // `PointLight::toward` and `incident`.
             let to = unsafe {
                 [
@@ -423,12 +425,15 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
             let d2 = dot(to, to);
             let dist = d2.sqrt();
             let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
+            // `I / d^2`: one division where the light is grey (the same operands give the
+            // same quotient), three otherwise.
             let li = unsafe {
-                [
-                    L::splat(intensity.x) / d2,
-                    L::splat(intensity.y) / d2,
-                    L::splat(intensity.z) / d2,
-                ]
+                let x = L::splat(intensity.x) / d2;
+                if grey {
+                    [x, x, x]
+                } else {
+                    [x, L::splat(intensity.y) / d2, L::splat(intensity.z) / d2]
+                }
             };
             // `point_light_ray`: a term unless `d^2` is 0 or not finite, or `wi.n <= 0`.
             let cos = dot(wi, n);
