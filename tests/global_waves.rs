@@ -143,6 +143,14 @@ fn waves_give_the_depth_first_bits_in_the_course_box() {
         "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)), background: (0.5, 0.6, 0.7))"
     );
     agree("a sky", &rtis::extract(&scene(&text)));
+    // Coloured point lights beside the grey ones (the light pass divides once for a grey
+    // light, three times for a coloured one).
+    let text = format!(
+        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)), \
+         entities: [(light: Point(position: (1, 2.5, 4), intensity: (9, 3, 0.5))), \
+         (light: Point(position: (-1.5, 1, 1), intensity: (0, 2, 6)))])"
+    );
+    agree("coloured lights", &rtis::extract(&scene(&text)));
     // Ceiling panels with emission off: no hit samples them, and their rectangles are
     // geometry like any other.
     let area = scenes_dir().join("cornell-area.ron");
