@@ -372,7 +372,10 @@ proptest! {
             })
             .min_by(|a, b| a.1.total_cmp(&b.1));
         let Some((i, t, shape)) = nearest else { return Ok(()) };
-        // Only a sample the ray meets first can be found by a BRDF-sampled ray.
+        // Only a sample the ray meets first can be found by a BRDF-sampled ray: on the light
+        // sampled (the other may stand in front of it, even within the distance tolerance),
+        // at the sampled distance.
+        if !std::ptr::eq(light, &emitters.lights[i]) { return Ok(()) }
         if (t - ls.dist).abs() > 1e-3 * ls.dist.max(1.0) { return Ok(()) }
         let q = shape.surface(&ray, t);
         let cos = q.n.dot(ls.wi).abs();
