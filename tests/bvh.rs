@@ -594,11 +594,7 @@ fn mixed_leaves_of_spheres_and_triangles() {
     for r in rays(5_000, 9) {
         let brute = prims
             .iter()
-            .filter_map(|p| {
-                p.shape
-                    .intersect(&r.for_bvh(r.t_max, true))
-                    .map(|t| (t, p.shape))
-            })
+            .filter_map(|p| p.shape.intersect(&r).map(|t| (t, p.shape)))
             .min_by(|a, b| a.0.total_cmp(&b.0));
         let got: Option<Hit> = g.intersect(&r);
         match (brute, got) {

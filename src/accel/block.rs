@@ -62,9 +62,17 @@ impl Block {
         }
     }
 
+    /// True if lane `lane` holds a triangle: not padding, and not a primitive left to the
+    /// scalar test ([`Block::triangle`] gives it back: [`lane_triangle`] admitted only
+    /// triangles that `Triangle::new` rebuilds).
+    #[inline]
+    pub fn has_triangle(&self, lane: usize) -> bool {
+        lane < self.count as usize && self.scalar & (1 << lane) == 0
+    }
+
     /// The triangle in lane `lane`, or `None` if the lane holds another shape or nothing.
     pub fn triangle(&self, lane: usize) -> Option<Triangle> {
-        if lane >= self.count as usize || self.scalar & (1 << lane) != 0 {
+        if !self.has_triangle(lane) {
             return None;
         }
         let vertex =

@@ -168,7 +168,7 @@ impl Bvh {
             if n.count > 0 {
                 let first = n.index as usize;
                 for (k, p) in prims[first..first + n.count as usize].iter().enumerate() {
-                    if let Some(t) = p.shape.intersect(&r) {
+                    if let Some(t) = p.shape.intersect_prepared(&r) {
                         r.ray.t_max = t;
                         best = Some(((first + k) as u32, t));
                     }
@@ -231,7 +231,7 @@ impl Bvh {
                     let first = n.index as usize;
                     if prims[first..first + n.count as usize]
                         .iter()
-                        .any(|p| p.shape.intersect(ray).is_some())
+                        .any(|p| p.shape.intersect_prepared(ray).is_some())
                     {
                         return true;
                     }

@@ -24,6 +24,6 @@ impl Orthographic {
     pub fn ray(&self, u: f32, v: f32) -> Ray {
         let half_h = 0.5 * self.height;
         let o = self.origin + plane_offset(&self.basis, u, v, half_h * self.aspect, half_h);
-        Ray::segment(o, self.basis.forward, f32::INFINITY)
+        Ray::new(o, self.basis.forward)
     }
 }

@@ -24,6 +24,6 @@ impl Perspective {
     pub fn ray(&self, u: f32, v: f32) -> Ray {
         let half_h = self.tan_half_fov;
         let d = self.basis.forward + plane_offset(&self.basis, u, v, half_h * self.aspect, half_h);
-        Ray::segment(self.origin, d.normalize(), f32::INFINITY)
+        Ray::new(self.origin, d.normalize())
     }
 }

@@ -50,7 +50,9 @@ const _: () = assert!(std::mem::size_of::<Ray>() == 48);
 
 /// A ray with the constants of the BVH's box tests and of the watertight triangle test,
 /// computed once per query ([`Ray::for_bvh`]) and read by every node and triangle it meets.
-/// It reads as its [`Ray`] (`Deref`).
+/// It reads as its [`Ray`] (`Deref`), so it also passes where a `&Ray` is asked: a triangle
+/// test must be given it as a `BvhRay` (the shapes' `intersect_prepared`), or the shapes'
+/// `intersect` computes the constants again.
 #[derive(Clone, Copy, Debug)]
 pub struct BvhRay {
     /// The ray.

@@ -173,7 +173,8 @@ impl Shape {
     }
 
     /// [`Shape::intersect`] for a ray that carries the triangle test's constants
-    /// ([`Ray::for_bvh`] with triangles).
+    /// ([`BvhRay::new`], or [`Ray::for_bvh`] with triangles; not without, whose constants are
+    /// placeholders).
     #[inline(always)]
     pub fn intersect_prepared(&self, ray: &BvhRay) -> Option<f32> {
         match self {

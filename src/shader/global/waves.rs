@@ -128,7 +128,8 @@ struct End {
     lit: u32,
     /// The primitive hit, whose material the scalar reflectance reads.
     prim: u32,
-    /// True if the course's diffuse reflectance `kd max(wi.n, 0)` is the material's.
+    /// True under the Course model for a material without a specular lobe (`ks` zero): the
+    /// light pass computes its reflectance `kd max(wi.n, 0)` in lanes.
     lambert: bool,
 }
 
@@ -156,7 +157,7 @@ impl End {
 
     /// Its Phong material, for the scalar reflectance.
     fn phong(&self, tr: &Tracer) -> Phong {
-        match tr.materials[tr.geometry.prim(self.prim).material as usize] {
+        match tr.materials[tr.geometry.material(self.prim) as usize] {
             Material::Phong(phong) => phong,
             _ => unreachable!("an End is a Phong hit"),
         }
