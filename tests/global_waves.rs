@@ -183,6 +183,34 @@ fn waves_give_the_depth_first_bits_in_the_course_box() {
         "the panel is never seen"
     );
     agree_with("unsampled area lights", &rs, &g);
+    // The same with an emitting sphere, which keeps the scene free of a BVH: its hits are
+    // shaded in lanes, and those seen through mirror and glass emit (each node's `le`).
+    let text = format!(
+        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.1, 0.1, 0.1)), \
+         entities: [(name: \"lamp\", shape: Sphere(center: (1.5, 1.4, 6.5), radius: 1.4), \
+         emitter: Emitter(radiance: (2, 1.5, 1)))])"
+    );
+    let rs = rtis::extract(&scene(&text));
+    assert!(
+        rs.geometry.bvh.nodes.is_empty(),
+        "the lamp put the scene in a BVH"
+    );
+    let g = Global {
+        light_samples: 0,
+        ..global(&rs)
+    };
+    let mut dark = rs.clone();
+    dark.set_effects(rtis::effects::Effects {
+        emission: false,
+        ..rs.effects
+    });
+    let rays = crate::rays(&rs, 200, 11);
+    assert_ne!(
+        trace(&rs, &g, &rays, Order::DepthFirst).0,
+        trace(&dark, &g, &rays, Order::DepthFirst).0,
+        "the lamp is never seen"
+    );
+    agree_with("an unsampled emitting sphere", &rs, &g);
     // Lights outside the room: their shadow rays test the planes too.
     let text = format!(
         "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)))"

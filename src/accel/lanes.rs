@@ -25,6 +25,8 @@ pub struct RayLanes<L = Vec4> {
     plane_k: L,
     /// The error of `o` before the sphere's centre is subtracted: `o_err + gamma(1) max |o_i|`.
     sphere_k: L,
+    /// `max |o_i|`, for the hit records' error along the surface.
+    o_max: L,
 }
 
 impl RayLanes {
@@ -37,6 +39,7 @@ impl RayLanes {
             d: [Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z)],
             plane_k: Vec4::splat(gamma(4) * a + ray.o_err),
             sphere_k: Vec4::splat(ray.o_err + gamma(1) * a),
+            o_max: Vec4::splat(a),
         }
     }
 }
@@ -62,9 +65,7 @@ impl<L: Floats> RayLanes<L> {
     /// lane's constants as [`RayLanes::new`] computes them.
     #[inline(always)]
     pub fn from_parts(o: [L; 3], d: [L; 3], o_err: L) -> Self {
-        // `max |o_i|` in glam's order (`Vec3A::max_element`): max(max(x, z), max(y, z)).
-        let [x, y, z] = [o[0].abs(), o[1].abs(), o[2].abs()];
-        let a = x.max(z).max(y.max(z));
+        let a = abs_max(o);
         // SAFETY: `o_err` is a value of `L`, so the CPU runs `L`'s instruction set.
         let (g4, g1) = unsafe { (L::splat(gamma(4)), L::splat(gamma(1))) };
         RayLanes {
@@ -72,7 +73,113 @@ impl<L: Floats> RayLanes<L> {
             d,
             plane_k: g4 * a + o_err,
             sphere_k: o_err + g1 * a,
+            o_max: a,
         }
+    }
+
+    /// The origins, a coordinate per vector.
+    #[inline(always)]
+    pub fn o(&self) -> [L; 3] {
+        self.o
+    }
+
+    /// The directions, a coordinate per vector.
+    #[inline(always)]
+    pub fn d(&self) -> [L; 3] {
+        self.d
+    }
+}
+
+/// `max |v_i|` in glam's order (`Vec3A::max_element` of `abs`): max(max(x, z), max(y, z)).
+#[inline(always)]
+pub fn abs_max<L: Floats>(v: [L; 3]) -> L {
+    let [x, y, z] = [v[0].abs(), v[1].abs(), v[2].abs()];
+    x.max(z).max(y.max(z))
+}
+
+/// Hit records of a ray per lane, each as its shape's `surface` computes it
+/// ([`Sphere::surface`], [`Plane::surface`]): a [`crate::geometry::Hit`]'s point, normal and
+/// error bounds.
+#[derive(Clone, Copy)]
+pub struct SurfaceLanes<L> {
+    /// Hit points.
+    pub p: [L; 3],
+    /// Unit geometric normals, as the shapes define them.
+    pub n: [L; 3],
+    /// Bounds on the points' error across the surface.
+    pub err: L,
+    /// Bounds on the points' error along the surface.
+    pub err_along: L,
+}
+
+/// `o + t d` lane by lane ([`crate::geometry::Ray::at`]).
+#[inline(always)]
+fn at<L: Floats>(r: &RayLanes<L>, t: L) -> [L; 3] {
+    [
+        r.o[0] + t * r.d[0],
+        r.o[1] + t * r.d[1],
+        r.o[2] + t * r.d[2],
+    ]
+}
+
+/// The hit records of the rays of `r` at distances `t` on spheres of centres `c` and radii
+/// `radius`, one per lane: [`Sphere::surface`]'s operations in its order.
+#[inline(always)]
+pub fn sphere_surface<L: Floats>(c: [L; 3], radius: L, r: &RayLanes<L>, t: L) -> SurfaceLanes<L> {
+    // SAFETY: `t` is a value of `L`, so the CPU runs `L`'s instruction set.
+    let (two, g3, g5, g6) = unsafe {
+        (
+            L::splat(2.0),
+            L::splat(gamma(3)),
+            L::splat(gamma(5)),
+            L::splat(gamma(6)),
+        )
+    };
+    // The normal through the computed point (`normalize`: a division by the length), and the
+    // point put back on the sphere along it.
+    let x = at(r, t);
+    let v = [x[0] - c[0], x[1] - c[1], x[2] - c[2]];
+    let len = dot(v, v).sqrt();
+    let n = [v[0] / len, v[1] / len, v[2] / len];
+    let p = [
+        c[0] + radius * n[0],
+        c[1] + radius * n[1],
+        c[2] + radius * n[2],
+    ];
+    // The error along the ray: the root's error over the rate the ray crosses the sphere, at
+    // most a diameter.
+    let f = [r.o[0] - c[0], r.o[1] - c[1], r.o[2] - c[2]];
+    let ec = g5 * (dot(f, f) + radius * radius);
+    let rate = two * radius * dot(n, r.d).abs();
+    let dt = L::select(ec.cmplt(rate * two * radius), ec / rate, two * radius);
+    SurfaceLanes {
+        p,
+        n,
+        err: g6 * (abs_max(c) + radius),
+        err_along: dt + g3 * (r.o_max + t.abs()),
+    }
+}
+
+/// The hit records of the rays of `r` at distances `t` on planes of unit normals `n` and
+/// offsets `dist`, one per lane: [`Plane::surface`]'s operations in its order.
+#[inline(always)]
+pub fn plane_surface<L: Floats>(n: [L; 3], dist: L, r: &RayLanes<L>, t: L) -> SurfaceLanes<L> {
+    // SAFETY: `t` is a value of `L`, so the CPU runs `L`'s instruction set.
+    let (g3, g4, g6) = unsafe { (L::splat(gamma(3)), L::splat(gamma(4)), L::splat(gamma(6))) };
+    // The computed point projected onto the plane.
+    let x = at(r, t);
+    let s = dot(n, x) - dist;
+    let p = [x[0] - s * n[0], x[1] - s * n[1], x[2] - s * n[2]];
+    // The error along the ray: the plane equation's error over the rate the ray crosses it.
+    let an = [n[0].abs(), n[1].abs(), n[2].abs()];
+    let o_abs = [r.o[0].abs(), r.o[1].abs(), r.o[2].abs()];
+    let dist_abs = dist.abs();
+    let dt = g4 * (dot(an, o_abs) + dist_abs) / dot(n, r.d).abs();
+    SurfaceLanes {
+        p,
+        n,
+        err: g6 * (abs_max(p) + dist_abs),
+        err_along: dt + g3 * (r.o_max + t.abs()),
     }
 }
 
@@ -168,6 +275,12 @@ impl SphereLanes<f32> {
 }
 
 impl<L: Floats> SphereLanes<L> {
+    /// The centres and radii.
+    #[inline(always)]
+    pub fn center_radius(&self) -> ([L; 3], L) {
+        (self.c, self.r)
+    }
+
     /// Distances of each lane's hit in `(0, tm]`, and which lanes hit (the scalar
     /// [`Sphere::intersect`], a lane at a time).
     #[inline(always)]
@@ -261,6 +374,12 @@ impl PlaneLanes<f32> {
 }
 
 impl<L: Floats> PlaneLanes<L> {
+    /// The unit normals and offsets (`n.p = dist` on the plane).
+    #[inline(always)]
+    pub fn normal_dist(&self) -> ([L; 3], L) {
+        (self.n, self.dist)
+    }
+
     /// Distances of each lane's hit in `(0, t_max]`, and which lanes hit (the scalar
     /// [`Plane::intersect`], a lane at a time).
     #[inline(always)]

@@ -1,7 +1,10 @@
 //! The rays below the first Phong hit traced in waves: every ray of one depth together, so
 //! that the geometry answers them in batches with a ray per SIMD lane, eight with AVX2
 //! ([`crate::accel::Geometry::intersect_batch`]); then the direct light of all their hits
-//! together, with a hit per lane, light by light, shadow rays included ([`light_sums`]).
+//! together, with a hit per lane, light by light, shadow rays included ([`light_sums`]). In a
+//! scene without a BVH (planes and a few spheres, as the course's box) each batch is traced
+//! and shaded in lanes from the nearest hit to the children's rays, its light pass on the
+//! batch's own lanes (`lanes.rs`).
 //!
 //! The result is the depth-first walk's ([`super::incident`]) to the bit. Each node of the tree
 //! (one traced ray and the mirror or glass chain behind it) keeps the terms that walk would add
@@ -11,9 +14,11 @@
 //! the walk's order, so a scene whose hits sample area lights is traced depth first
 //! ([`applies`]).
 
+mod lanes;
+
 use super::Global;
 use crate::accel::lanes::dot;
-use crate::accel::{Floats, Isa};
+use crate::accel::{Floats, Geometry, Isa};
 use crate::geometry::{Hit, Ray};
 use crate::light::Light;
 use crate::material::{Material, Model, Phong, reflect};
@@ -156,8 +161,8 @@ impl End {
     }
 
     /// Its Phong material, for the scalar reflectance.
-    fn phong(&self, tr: &Tracer) -> Phong {
-        match tr.materials[tr.geometry.material(self.prim) as usize] {
+    fn phong(&self, geometry: &Geometry, materials: &[Material]) -> Phong {
+        match materials[geometry.material(self.prim) as usize] {
             Material::Phong(phong) => phong,
             _ => unreachable!("an End is a Phong hit"),
         }
@@ -253,6 +258,12 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         s.ends.clear();
         // Each bounce of the mirror and glass chains in one batch, until every chain ends.
         while !s.now.rays.is_empty() {
+            if tr.geometry.bvh.nodes.is_empty() {
+                // Every primitive packed: the batch traced and shaded in lanes.
+                lanes::wave(tr, g, s, depth);
+                std::mem::swap(&mut s.now, &mut s.bounced);
+                continue;
+            }
             tr.geometry.intersect_batch(&s.now.rays, &mut s.hits);
             s.bounced.clear();
             for k in 0..s.now.rays.len() {
@@ -377,10 +388,8 @@ unsafe fn light_sums_avx2(tr: &mut Tracer, s: &mut Scratch) {
 /// The CPU must run `L`'s instruction set.
 #[inline(always)]
 unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
-    let (lights, model, shadows) = (tr.lights, tr.model, tr.effects.shadows);
     // SAFETY: the caller vouches for the instruction set.
-    let (zero, inf, end) =
-        unsafe { (L::splat(0.0), L::splat(f32::INFINITY), L::splat(SHADOW_END)) };
+    let zero = unsafe { L::splat(0.0) };
     for k in (0..s.ends.len()).step_by(L::LANES) {
         let last = s.ends.len() - 1;
         let mut e = [&s.ends[last]; 8];
@@ -393,115 +402,169 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
         for f in filled.iter_mut().take(count) {
             *f = 1.0;
         }
-        let filled = unsafe { L::from_array8(filled) }.cmpne(zero);
         // The hits in lanes.
-        let (p, n, ng, front, back, kd, o_err, diffuse) = unsafe {
+        let h = unsafe {
             let diffuse = e.map(|e| if e.lambert { 1.0f32 } else { 0.0 });
-            (
-                L::transpose3(&e.map(|e| &e.p)),
-                L::transpose3(&e.map(|e| &e.n)),
-                L::transpose3(&e.map(|e| &e.ng)),
-                L::transpose3(&e.map(|e| &e.front)),
-                L::transpose3(&e.map(|e| &e.back)),
-                L::transpose3(&e.map(|e| &e.kd)),
-                L::from_array8(e.map(|e| e.o_err)),
-                L::from_array8(diffuse).cmpne(zero),
-            )
+            let filled = L::from_array8(filled).cmpne(zero);
+            let diffuse = L::from_array8(diffuse).cmpne(zero);
+            LightLanes {
+                p: L::transpose3(&e.map(|e| &e.p)),
+                n: L::transpose3(&e.map(|e| &e.n)),
+                ng: L::transpose3(&e.map(|e| &e.ng)),
+                front: L::transpose3(&e.map(|e| &e.front)),
+                back: L::transpose3(&e.map(|e| &e.back)),
+                kd: L::transpose3(&e.map(|e| &e.kd)),
+                o_err: L::from_array8(e.map(|e| e.o_err)),
+                filled,
+                scalar: L::bitmask(filled & !diffuse),
+            }
         };
-        let (all_diffuse, lambert) = (L::all(diffuse), L::bitmask(diffuse));
-        let mut sum = [zero; 3];
-        for light in lights {
-            let Light::Point(pl) = light;
-            let (x, intensity) = (pl.position, pl.intensity);
-            let bits = intensity.to_array().map(f32::to_bits);
-            let grey = bits[0] == bits[1] && bits[1] == bits[2];
-            // `PointLight::toward` and `incident`.
-            let to = unsafe {
-                [
-                    L::splat(x.x) - p[0],
-                    L::splat(x.y) - p[1],
-                    L::splat(x.z) - p[2],
-                ]
-            };
-            let d2 = dot(to, to);
-            let dist = d2.sqrt();
-            let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
-            // `I / d^2`: one division where the light is grey (the same operands give the
-            // same quotient), three otherwise.
-            let li = unsafe {
-                let x = L::splat(intensity.x) / d2;
-                if grey {
-                    [x, x, x]
-                } else {
-                    [x, L::splat(intensity.y) / d2, L::splat(intensity.z) / d2]
-                }
-            };
-            // `point_light_ray`: a term unless `d^2` is 0 or not finite, or `wi.n <= 0`.
-            let cos = dot(wi, n);
-            let valid = d2.cmpne(zero) & d2.cmplt(inf) & !cos.cmple(zero) & filled;
-            // `Origins::ray`: the side `wi` leaves by.
-            let on_front = dot(ng, wi).cmpge(zero);
-            let o = [
-                L::select(on_front, front[0], back[0]),
-                L::select(on_front, front[1], back[1]),
-                L::select(on_front, front[2], back[2]),
-            ];
-            let seen = if shadows {
-                tr.stats.shadow += u64::from(L::bitmask(valid).count_ones());
-                let planes = !pl.in_room;
-                let blocked = tr
-                    .geometry
-                    .occluded_lanes(o, wi, o_err, dist * end, planes, valid);
-                valid & !blocked
-            } else {
-                valid
-            };
-            // `point_light_term`: `L_i r(wi, wo)`; the course's diffuse `r = kd max(wi.n, 0)`
-            // in lanes, any other by the scalar reflectance. `max(wi.n, 0)` as a select: `cos`
-            // where it is positive, else +0, as `f32::max` gives it on every target (NaN: 0).
-            let cos_i = L::select(cos.cmpgt(zero), cos, zero);
-            let mut term = [
-                li[0] * (kd[0] * cos_i),
-                li[1] * (kd[1] * cos_i),
-                li[2] * (kd[2] * cos_i),
-            ];
-            if !all_diffuse {
-                let mut v = [[0.0f32; 8]; 9];
-                for (c, x) in [
-                    term[0], term[1], term[2], wi[0], wi[1], wi[2], li[0], li[1], li[2],
-                ]
-                .into_iter()
-                .enumerate()
-                {
-                    x.write_to(&mut v[c]);
-                }
-                for (i, end) in e.iter().enumerate().take(count) {
-                    if lambert & (1 << i) != 0 {
-                        continue;
-                    }
-                    let w = Vec3A::new(v[3][i], v[4][i], v[5][i]);
-                    let l = Vec3A::new(v[6][i], v[7][i], v[8][i]);
-                    let t = l * reflectance(model, &end.phong(tr), w, end.wo, end.n);
-                    (v[0][i], v[1][i], v[2][i]) = (t.x, t.y, t.z);
-                }
-                term = unsafe {
-                    [
-                        L::from_array8(v[0]),
-                        L::from_array8(v[1]),
-                        L::from_array8(v[2]),
-                    ]
-                };
-            }
-            for c in 0..3 {
-                sum[c] = sum[c] + L::select(seen, term[c], zero);
-            }
-        }
-        let mut out = [[0.0f32; 8]; 3];
-        for c in 0..3 {
-            sum[c].write_to(&mut out[c]);
-        }
+        let model = tr.model;
+        let (geometry, materials) = (tr.geometry, tr.materials);
+        // SAFETY: the caller vouches for the instruction set.
+        let out = unsafe {
+            point_sums(tr, &h, |i, w, l| {
+                let end = e[i];
+                let phong = end.phong(geometry, materials);
+                l * reflectance(model, &phong, w, end.wo, end.n)
+            })
+        };
         for (i, end) in e.iter().enumerate().take(count) {
             s.lit[end.lit as usize].point = Vec3A::new(out[0][i], out[1][i], out[2][i]);
         }
     }
+}
+
+/// Up to `L::LANES` Phong hits in lanes, as the light pass reads them.
+struct LightLanes<L: Floats> {
+    /// Hit points.
+    p: [L; 3],
+    /// Shading normals on the viewer's side.
+    n: [L; 3],
+    /// Geometric normals that tell the origins' sides apart.
+    ng: [L; 3],
+    /// Starts of rays leaving on `ng`'s side.
+    front: [L; 3],
+    /// Starts of rays leaving on the other side.
+    back: [L; 3],
+    /// The materials' `kd`.
+    kd: [L; 3],
+    /// The origins' error bounds.
+    o_err: L,
+    /// The lanes that hold a hit to light: only they trace shadow rays.
+    filled: L::Mask,
+    /// The lanes (bits) whose reflectance is not the course's diffuse one, computed by the
+    /// scalar `reflectance`.
+    scalar: u32,
+}
+
+/// Eq. 3's point-light sums of the hits of `h`, lane by lane, as [`light_sums_in`] describes:
+/// each light's terms and shadow rays in lanes, the scalar lanes' terms `L_i r(wi, wo)` by
+/// `other(lane, wi, L_i)`. Returns the sums, a row per channel (zero in lanes not filled).
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn point_sums<L: Floats>(
+    tr: &mut Tracer,
+    h: &LightLanes<L>,
+    mut other: impl FnMut(usize, Vec3A, Vec3A) -> Vec3A,
+) -> [[f32; 8]; 3] {
+    let (lights, shadows) = (tr.lights, tr.effects.shadows);
+    // SAFETY: the caller vouches for the instruction set.
+    let (zero, inf, end) =
+        unsafe { (L::splat(0.0), L::splat(f32::INFINITY), L::splat(SHADOW_END)) };
+    let (p, n, ng, front, back, kd, o_err) = (h.p, h.n, h.ng, h.front, h.back, h.kd, h.o_err);
+    let mut sum = [zero; 3];
+    for light in lights {
+        let Light::Point(pl) = light;
+        let (x, intensity) = (pl.position, pl.intensity);
+        let bits = intensity.to_array().map(f32::to_bits);
+        let grey = bits[0] == bits[1] && bits[1] == bits[2];
+        // `PointLight::toward` and `incident`.
+        let to = unsafe {
+            [
+                L::splat(x.x) - p[0],
+                L::splat(x.y) - p[1],
+                L::splat(x.z) - p[2],
+            ]
+        };
+        let d2 = dot(to, to);
+        let dist = d2.sqrt();
+        let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
+        // `I / d^2`: one division where the light is grey (the same operands give the same
+        // quotient), three otherwise.
+        let li = unsafe {
+            let x = L::splat(intensity.x) / d2;
+            if grey {
+                [x, x, x]
+            } else {
+                [x, L::splat(intensity.y) / d2, L::splat(intensity.z) / d2]
+            }
+        };
+        // `point_light_ray`: a term unless `d^2` is 0 or not finite, or `wi.n <= 0`.
+        let cos = dot(wi, n);
+        let valid = d2.cmpne(zero) & d2.cmplt(inf) & !cos.cmple(zero) & h.filled;
+        // `Origins::ray`: the side `wi` leaves by.
+        let on_front = dot(ng, wi).cmpge(zero);
+        let o = [
+            L::select(on_front, front[0], back[0]),
+            L::select(on_front, front[1], back[1]),
+            L::select(on_front, front[2], back[2]),
+        ];
+        let seen = if shadows {
+            tr.stats.shadow += u64::from(L::bitmask(valid).count_ones());
+            let planes = !pl.in_room;
+            let blocked = tr
+                .geometry
+                .occluded_lanes(o, wi, o_err, dist * end, planes, valid);
+            valid & !blocked
+        } else {
+            valid
+        };
+        // `point_light_term`: `L_i r(wi, wo)`; the course's diffuse `r = kd max(wi.n, 0)` in
+        // lanes, any other by the scalar reflectance. `max(wi.n, 0)` as a select: `cos` where
+        // it is positive, else +0, as `f32::max` gives it on every target (NaN: 0).
+        let cos_i = L::select(cos.cmpgt(zero), cos, zero);
+        let mut term = [
+            li[0] * (kd[0] * cos_i),
+            li[1] * (kd[1] * cos_i),
+            li[2] * (kd[2] * cos_i),
+        ];
+        if h.scalar != 0 {
+            let mut v = [[0.0f32; 8]; 9];
+            for (c, x) in [
+                term[0], term[1], term[2], wi[0], wi[1], wi[2], li[0], li[1], li[2],
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                x.write_to(&mut v[c]);
+            }
+            let mut lanes = h.scalar;
+            while lanes != 0 {
+                let i = lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                let w = Vec3A::new(v[3][i], v[4][i], v[5][i]);
+                let l = Vec3A::new(v[6][i], v[7][i], v[8][i]);
+                let t = other(i, w, l);
+                (v[0][i], v[1][i], v[2][i]) = (t.x, t.y, t.z);
+            }
+            term = unsafe {
+                [
+                    L::from_array8(v[0]),
+                    L::from_array8(v[1]),
+                    L::from_array8(v[2]),
+                ]
+            };
+        }
+        for c in 0..3 {
+            sum[c] = sum[c] + L::select(seen, term[c], zero);
+        }
+    }
+    let mut out = [[0.0f32; 8]; 3];
+    for c in 0..3 {
+        sum[c].write_to(&mut out[c]);
+    }
+    out
 }
