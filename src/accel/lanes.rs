@@ -77,12 +77,6 @@ impl<L: Floats> RayLanes<L> {
         }
     }
 
-    /// The origins, a coordinate per vector.
-    #[inline(always)]
-    pub fn o(&self) -> [L; 3] {
-        self.o
-    }
-
     /// The directions, a coordinate per vector.
     #[inline(always)]
     pub fn d(&self) -> [L; 3] {

@@ -106,7 +106,8 @@ struct Lit {
     /// The ambient term `a_t kd` at depth `D` (Eq. 2), else `None`.
     ambient: Option<Vec3A>,
     /// The point lights' sum of Eq. 3 (zero for a surface that reflects nothing, which has no
-    /// light terms), once [`light_sums`] has run.
+    /// light terms), once the light pass has run ([`light_sums`], or the batch's own in
+    /// `lanes.rs`).
     point: Vec3A,
 }
 
@@ -374,15 +375,8 @@ unsafe fn light_sums_avx2(tr: &mut Tracer, s: &mut Scratch) {
     unsafe { light_sums_in::<crate::accel::F8>(tr, s) }
 }
 
-/// [`light_sums`] with the hits `L::LANES` at a time. No closures that compute in lanes, so
-/// that this inlines whole into the AVX2 copy.
-///
-/// Each lane computes what `point_light_ray` and `point_light_term` compute for its hit:
-/// `wi = (x - p) / |x - p|`, `L_i = I / d^2`, no term where `d^2` is 0 or not finite or
-/// `wi.n <= 0`, the shadow ray from the origin on `wi`'s side to `SHADOW_END` of the distance,
-/// and `L_i r(wi, wo)`, in lanes for the course's diffuse reflectance `kd (wi.n)` and by the
-/// scalar `reflectance` for any other (a specular lobe, the Physical model). The lanes' sums
-/// add `+0` where the walk adds `ZERO` for a light that adds nothing, as it does.
+/// [`light_sums`] with the hits `L::LANES` at a time, each chunk's sums by [`point_sums`].
+/// No closures that compute in lanes, so that this inlines whole into the AVX2 copy.
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.
@@ -458,9 +452,17 @@ struct LightLanes<L: Floats> {
     scalar: u32,
 }
 
-/// Eq. 3's point-light sums of the hits of `h`, lane by lane, as [`light_sums_in`] describes:
-/// each light's terms and shadow rays in lanes, the scalar lanes' terms `L_i r(wi, wo)` by
-/// `other(lane, wi, L_i)`. Returns the sums, a row per channel (zero in lanes not filled).
+/// Eq. 3's point-light sums of the hits of `h`, lane by lane, each light's terms and shadow
+/// rays in lanes, added in the lights' order as `point_lights` adds them. Returns the sums, a
+/// row per channel (zero in lanes not filled).
+///
+/// Each lane computes what `point_light_ray` and `point_light_term` compute for its hit:
+/// `wi = (x - p) / |x - p|`, `L_i = I / d^2`, no term where `d^2` is 0 or not finite or
+/// `wi.n <= 0`, the shadow ray from the origin on `wi`'s side to `SHADOW_END` of the distance,
+/// and `L_i r(wi, wo)`, in lanes for the course's diffuse reflectance `kd (wi.n)` and by
+/// `other(lane, wi, L_i)` for the lanes of `h.scalar` (a specular lobe, the Physical model).
+/// The lanes' sums add `+0` where the walk adds `ZERO` for a light that adds nothing, as it
+/// does.
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.

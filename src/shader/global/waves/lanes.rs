@@ -3,8 +3,10 @@
 //! parameters of the primitive it hits during the intersection, so the hit record
 //! ([`sphere_surface`], [`plane_surface`]), the interaction (orientation, the origins and
 //! their error bound) and the light pass ([`super::point_sums`]) run in lanes with no
-//! gathering, and the two rays of task 2 are spawned in lanes. Only the tree's bookkeeping and
-//! the mirror and glass bounces are scalar, lane by lane. Every lane computes what the scalar
+//! gathering, and the two rays of task 2 are spawned in lanes. Scalar, lane by lane: the
+//! tree's bookkeeping, the mirror and glass bounces, the light emitted by a surface a chain
+//! meets, and every reflectance but the course's diffuse one (a specular lobe, the Physical
+//! model), in the light terms and the children's weights. Every lane computes what the scalar
 //! code computes for its ray, operation for operation (`Geometry::intersect`'s order and tie
 //! rule, `Sphere::surface`, `Plane::surface`, `Interaction::new`, `Origins`, `reflect`,
 //! `course_reflectance`), so the result is the depth-first walk's to the bit.
@@ -38,7 +40,8 @@ const SLOT: usize = 19;
 const ROWS: usize = 20;
 
 /// Trace and shade `s.now` in lanes into `s.bounced`, `s.children`, `s.lit` and the nodes:
-/// what `trace_tree`'s batch and `shade` do, for a scene without a BVH.
+/// what `trace_tree`'s batch and `shade` do, for a scene without a BVH, and the light pass of
+/// its Phong hits (each `Lit::point`), which leaves `s.ends` empty for [`super::light_sums`].
 pub fn wave(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
     match tr.geometry.bvh.isa() {
         // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
@@ -80,6 +83,7 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
     let slots = spheres.len() + planes.len();
     // SAFETY: the caller vouches for the instruction set.
     let (zero, one, two) = unsafe { (L::splat(0.0), L::splat(1.0), L::splat(2.0)) };
+    // SAFETY: as above; so for every `unsafe` block below, each makes values of `L`.
     let (unit, two_unit) = unsafe { (L::splat(UNIT_ROUNDOFF), L::splat(2.0 * UNIT_ROUNDOFF)) };
     let end = depth >= g.max_depth || !tr.effects.indirect;
     s.bounced.clear();
@@ -87,12 +91,12 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
     for k in (0..n_rays).step_by(L::LANES) {
         let count = (n_rays - k).min(L::LANES);
         let last = n_rays - 1;
-        let mut four = [&s.now.rays[last]; 8];
-        for (i, r) in four.iter_mut().enumerate().take(L::LANES) {
+        let mut eight = [&s.now.rays[last]; 8];
+        for (i, r) in eight.iter_mut().enumerate().take(L::LANES) {
             *r = &s.now.rays[(k + i).min(last)];
         }
-        let lanes = unsafe { RayLanes::<L>::gather(&four) };
-        let mut t_max = unsafe { L::from_array8(four.map(|r| r.t_max)) };
+        let lanes = unsafe { RayLanes::<L>::gather(&eight) };
+        let mut t_max = unsafe { L::from_array8(eight.map(|r| r.t_max)) };
         // The nearest hit, as `Geometry::intersect_batch` finds it (spheres, then planes; a
         // later primitive at equal distance wins), and the parameters of the primitive each
         // lane hits: a centre and radius, or a normal and offset.
@@ -274,10 +278,10 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
             let diffuse = tr.model == Model::Course && phong.ks == Vec3A::ZERO;
             // Eq. 3 in the chunk's light pass below. A surface that reflects nothing has no
             // light terms (`point_lights`).
+            (kd[0][i], kd[1][i], kd[2][i]) = (phong.kd.x, phong.kd.y, phong.kd.z);
             if !phong.is_black() {
                 lit_lanes |= 1 << i;
                 lit_of[i] = s.lit.len() as u32;
-                (kd[0][i], kd[1][i], kd[2][i]) = (phong.kd.x, phong.kd.y, phong.kd.z);
             }
             lambert |= u32::from(diffuse) << i;
             if !diffuse {
@@ -325,10 +329,10 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
                     l * reflectance(model, &phong, w, -rays[i].d, vec3(NS, i))
                 })
             };
-            let mut lanes = lit_lanes;
-            while lanes != 0 {
-                let i = lanes.trailing_zeros() as usize;
-                lanes &= lanes - 1;
+            let mut bits = lit_lanes;
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
                 s.lit[lit_of[i] as usize].point = Vec3A::new(out[0][i], out[1][i], out[2][i]);
             }
         }
@@ -371,10 +375,10 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
                 rows[3 * c + 2][x] = array(w[x]);
             }
         }
-        let mut lanes = parents;
-        while lanes != 0 {
-            let i = lanes.trailing_zeros() as usize;
-            lanes &= lanes - 1;
+        let mut bits = parents;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
             let node_i = s.now.nodes[k + i];
             let first = s.nodes.len() as u32;
             s.nodes[node_i as usize].children = Some(first);
