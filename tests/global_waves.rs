@@ -100,6 +100,28 @@ fn agree_in(name: &str, rs: &RenderScene, g: &Global) {
     );
 }
 
+/// `rs`'s emitters with no hit sampling them (`light_samples` 0, which a scene file cannot
+/// ask for): chains through mirror and glass see them (emission changes some `L_i`, so each
+/// node's `le` matters), and both orders agree.
+fn unsampled_emitter_seen(name: &str, rs: &RenderScene) {
+    let g = Global {
+        light_samples: 0,
+        ..global(rs)
+    };
+    let mut dark = rs.clone();
+    dark.set_effects(rtis::effects::Effects {
+        emission: false,
+        ..rs.effects
+    });
+    let rays = rays(rs, 200, 11);
+    assert_ne!(
+        trace(rs, &g, &rays, Order::DepthFirst).0,
+        trace(&dark, &g, &rays, Order::DepthFirst).0,
+        "{name}: the emitters are never seen"
+    );
+    agree_with(name, rs, &g);
+}
+
 /// The course's box under every depth from 1 to 6, with glass and mirror chains, and with
 /// each effect switched off in turn.
 #[test]
@@ -166,23 +188,7 @@ fn waves_give_the_depth_first_bits_in_the_course_box() {
          entities: [(name: \"panel\", shape: Rectangle(corner: (-2.9, 2.99, -2.9), u: (5.8, 0, 0), v: (0, 0, 11.8)), \
          emitter: Emitter(radiance: (1, 1, 1)))])"
     );
-    let rs = rtis::extract(&scene(&text));
-    let g = Global {
-        light_samples: 0,
-        ..global(&rs)
-    };
-    let mut dark = rs.clone();
-    dark.set_effects(rtis::effects::Effects {
-        emission: false,
-        ..rs.effects
-    });
-    let rays = rays(&rs, 200, 11);
-    assert_ne!(
-        trace(&rs, &g, &rays, Order::DepthFirst).0,
-        trace(&dark, &g, &rays, Order::DepthFirst).0,
-        "the panel is never seen"
-    );
-    agree_with("unsampled area lights", &rs, &g);
+    unsampled_emitter_seen("unsampled area lights", &rtis::extract(&scene(&text)));
     // The same with an emitting sphere, which keeps the scene free of a BVH: its hits are
     // shaded in lanes, and those seen through mirror and glass emit (each node's `le`).
     let text = format!(
@@ -195,22 +201,7 @@ fn waves_give_the_depth_first_bits_in_the_course_box() {
         rs.geometry.bvh.nodes.is_empty(),
         "the lamp put the scene in a BVH"
     );
-    let g = Global {
-        light_samples: 0,
-        ..global(&rs)
-    };
-    let mut dark = rs.clone();
-    dark.set_effects(rtis::effects::Effects {
-        emission: false,
-        ..rs.effects
-    });
-    let rays = crate::rays(&rs, 200, 11);
-    assert_ne!(
-        trace(&rs, &g, &rays, Order::DepthFirst).0,
-        trace(&dark, &g, &rays, Order::DepthFirst).0,
-        "the lamp is never seen"
-    );
-    agree_with("an unsampled emitting sphere", &rs, &g);
+    unsampled_emitter_seen("an unsampled emitting sphere", &rs);
     // Lights outside the room: their shadow rays test the planes too.
     let text = format!(
         "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)))"

@@ -84,6 +84,18 @@ struct Node {
 }
 
 impl Node {
+    /// The chain of node `i` met the mirror or glass hit `si` (below the chain's limit):
+    /// `follow_specular`'s step, the next ray into `bounced` (counted by its kind), unless the
+    /// effect is off (the chain is absorbed).
+    fn bounce(&mut self, i: u32, si: &Interaction, tr: &mut Tracer, bounced: &mut Rays) {
+        if let Some((next, tint, kind)) = specular_bounce(si, tr.effects) {
+            self.tint *= tint;
+            self.bounces += 1;
+            tr.stats.count(kind);
+            bounced.push(i, next);
+        }
+    }
+
     /// A node about to trace its first ray with weight `beta`.
     fn new(beta: Vec3A) -> Self {
         Node {
@@ -297,14 +309,8 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
         node.le += node.tint * emitted(tr, &si);
     }
     let Material::Phong(phong) = si.material else {
-        if node.bounces == g.max_specular {
-            return;
-        }
-        if let Some((next, tint, kind)) = specular_bounce(&si, tr.effects) {
-            node.tint *= tint;
-            node.bounces += 1;
-            tr.stats.count(kind);
-            s.bounced.push(i, next);
+        if node.bounces < g.max_specular {
+            node.bounce(i, &si, tr, &mut s.bounced);
         }
         return;
     };

@@ -19,7 +19,7 @@ use crate::light::NO_LIGHT;
 use crate::material::{Material, Model, Phong};
 use crate::shader::Tracer;
 use crate::shader::global::Global;
-use crate::shader::surface::{Interaction, emitted, reflectance, specular_bounce};
+use crate::shader::surface::{Interaction, emitted, reflectance};
 use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::PI;
@@ -61,6 +61,19 @@ pub fn wave(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
 unsafe fn wave_avx2(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
     // SAFETY: this function runs only where AVX2 was found.
     unsafe { wave_in::<crate::accel::F8>(tr, g, s, depth) }
+}
+
+/// Where `ok`, the lanes take `x` (a primitive's vector and number: a centre and radius, a
+/// normal and offset) into `into`.
+#[inline(always)]
+fn keep<L: Floats>(ok: L::Mask, x: ([L; 3], L), into: (&mut [L; 3], &mut L)) {
+    let (a, b) = into;
+    *a = [
+        L::select(ok, x.0[0], a[0]),
+        L::select(ok, x.0[1], a[1]),
+        L::select(ok, x.0[2], a[2]),
+    ];
+    *b = L::select(ok, x.1, *b);
 }
 
 /// The lanes of a vector as an array.
@@ -108,12 +121,7 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
             t_max = L::select(ok, t, t_max);
             slot = L::select(ok, unsafe { L::splat(f32::from_bits(j as u32)) }, slot);
             let (c, r) = sphere.center_radius();
-            a = [
-                L::select(ok, c[0], a[0]),
-                L::select(ok, c[1], a[1]),
-                L::select(ok, c[2], a[2]),
-            ];
-            b = L::select(ok, r, b);
+            keep(ok, (c, r), (&mut a, &mut b));
             on_sphere = L::select(ok, one, on_sphere);
         }
         for (j, (_, plane)) in planes.iter().enumerate() {
@@ -122,13 +130,7 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
             t_max = L::select(ok, t, t_max);
             let j = (spheres.len() + j) as u32;
             slot = L::select(ok, unsafe { L::splat(f32::from_bits(j)) }, slot);
-            let (n, dist) = plane.normal_dist();
-            a = [
-                L::select(ok, n[0], a[0]),
-                L::select(ok, n[1], a[1]),
-                L::select(ok, n[2], a[2]),
-            ];
-            b = L::select(ok, dist, b);
+            keep(ok, plane.normal_dist(), (&mut a, &mut b));
             on_sphere = L::select(ok, zero, on_sphere);
         }
         // The hit records: the spheres' and the planes' formulas, each where it applies.
@@ -263,14 +265,8 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
                 node.le += node.tint * le;
             }
             let Material::Phong(phong) = material else {
-                if node.bounces == g.max_specular {
-                    continue;
-                }
-                if let Some((next, tint, kind)) = specular_bounce(&si(), tr.effects) {
-                    node.tint *= tint;
-                    node.bounces += 1;
-                    tr.stats.count(kind);
-                    s.bounced.push(node_i, next);
+                if node.bounces < g.max_specular {
+                    node.bounce(node_i, &si(), tr, &mut s.bounced);
                 }
                 continue;
             };
