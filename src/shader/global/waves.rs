@@ -118,8 +118,7 @@ struct Lit {
     /// The ambient term `a_t kd` at depth `D` (Eq. 2), else `None`.
     ambient: Option<Vec3A>,
     /// The point lights' sum of Eq. 3 (zero for a surface that reflects nothing, which has no
-    /// light terms), once the light pass has run ([`light_sums`], or the batch's own in
-    /// `lanes.rs`).
+    /// light terms), once [`light_sums`] has run.
     point: Vec3A,
 }
 

@@ -11,7 +11,7 @@
 //! rule, `Sphere::surface`, `Plane::surface`, `Interaction::new`, `Origins`, `reflect`,
 //! `course_reflectance`), so the result is the depth-first walk's to the bit.
 
-use super::{LightLanes, Lit, Node, Scratch, point_sums};
+use super::{LightLanes, Node, Scratch, point_sums};
 use crate::accel::lanes::{RayLanes, SurfaceLanes, abs_max, dot, plane_surface, sphere_surface};
 use crate::accel::{Floats, Isa};
 use crate::geometry::{Hit, Origins, Ray, UNIT_ROUNDOFF};
@@ -39,9 +39,10 @@ const ERR_ALONG: usize = 18;
 const SLOT: usize = 19;
 const ROWS: usize = 20;
 
-/// Trace and shade `s.now` in lanes into `s.bounced`, `s.children`, `s.lit` and the nodes:
-/// what `trace_tree`'s batch and `shade` do, for a scene without a BVH, and the light pass of
-/// its Phong hits (each `Lit::point`), which leaves `s.ends` empty for [`super::light_sums`].
+/// Trace and shade `s.now` in lanes into `s.bounced`, `s.children` and the nodes: what
+/// `trace_tree`'s batch and `shade` do for a scene without a BVH, then its Phong hits' light
+/// pass and what `finish_direct_light` adds (each node's `rest`), so that it queues nothing
+/// for [`super::light_sums`] (`s.ends`) or `finish_direct_light` (`s.lit`).
 pub fn wave(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
     match tr.geometry.bvh.isa() {
         // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
@@ -211,10 +212,10 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
         }
         let vec3 = |row: usize, i: usize| Vec3A::new(v[row][i], v[row + 1][i], v[row + 2][i]);
         // The tree's bookkeeping, lane by lane (`shade`).
-        let (mut lit_lanes, mut lambert, mut parents) = (0u32, 0u32, 0u32);
+        let (mut phong_lanes, mut lit_lanes) = (0u32, 0u32);
+        let (mut lambert, mut parents) = (0u32, 0u32);
         let mut kd = [[0.0f32; 8]; 3];
         let mut beta_lanes = [[0.0f32; 8]; 3];
-        let mut lit_of = [0u32; 8];
         let mut phong_of: [Option<Phong>; 8] = [None; 8];
         for i in 0..count {
             let node_i = s.now.nodes[k + i];
@@ -275,26 +276,18 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
             // Eq. 3 in the chunk's light pass below. A surface that reflects nothing has no
             // light terms (`point_lights`).
             (kd[0][i], kd[1][i], kd[2][i]) = (phong.kd.x, phong.kd.y, phong.kd.z);
-            if !phong.is_black() {
-                lit_lanes |= 1 << i;
-                lit_of[i] = s.lit.len() as u32;
-            }
+            phong_lanes |= 1 << i;
+            lit_lanes |= u32::from(!phong.is_black()) << i;
             lambert |= u32::from(diffuse) << i;
             if !diffuse {
                 phong_of[i] = Some(phong);
             }
-            s.lit.push(Lit {
-                node: node_i,
-                beta,
-                ambient: end.then(|| g.ambient * phong.kd),
-                point: Vec3A::ZERO,
-            });
-            if !end {
-                parents |= 1 << i;
-                (beta_lanes[0][i], beta_lanes[1][i], beta_lanes[2][i]) = (beta.x, beta.y, beta.z);
-            }
+            (beta_lanes[0][i], beta_lanes[1][i], beta_lanes[2][i]) = (beta.x, beta.y, beta.z);
+            parents |= u32::from(!end) << i;
         }
-        // Eq. 3: the point lights' sums of the chunk's Phong hits.
+        // Eq. 3: the point lights' sums of the chunk's Phong hits (zero where a surface
+        // reflects nothing).
+        let mut point = [[0.0f32; 8]; 3];
         if lit_lanes != 0 {
             let mut filled = [0.0f32; 8];
             for (i, f) in filled.iter_mut().enumerate() {
@@ -319,18 +312,44 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
             };
             let model = tr.model;
             let rays = &s.now.rays[k..];
-            let out = unsafe {
+            point = unsafe {
                 point_sums(tr, &h, |i, w, l| {
                     let phong = phong_of[i].expect("a scalar lane's material");
                     l * reflectance(model, &phong, w, -rays[i].d, vec3(NS, i))
                 })
             };
-            let mut bits = lit_lanes;
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                s.lit[lit_of[i] as usize].point = Vec3A::new(out[0][i], out[1][i], out[2][i]);
-            }
+        }
+        let (kd, beta) = unsafe {
+            (
+                [
+                    L::from_array8(kd[0]),
+                    L::from_array8(kd[1]),
+                    L::from_array8(kd[2]),
+                ],
+                [
+                    L::from_array8(beta_lanes[0]),
+                    L::from_array8(beta_lanes[1]),
+                    L::from_array8(beta_lanes[2]),
+                ],
+            )
+        };
+        // What each Phong node adds after `beta le` (`finish_direct_light`): `beta` times
+        // Eq. 3 as `direct_light` sums it (the point lights' sum, then the area lights' zero),
+        // plus the ambient term at depth D (Eq. 2).
+        let mut rest = [[0.0f32; 8]; 3];
+        for c in 0..3 {
+            let l_dir = unsafe { L::from_array8(point[c]) } + zero;
+            rest[c] = array(match end {
+                true => beta[c] * (l_dir + unsafe { L::splat(g.ambient[c]) } * kd[c]),
+                false => beta[c] * l_dir,
+            });
+        }
+        let mut bits = phong_lanes;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let node = &mut s.nodes[s.now.nodes[k + i] as usize];
+            node.rest = Some(Vec3A::new(rest[0][i], rest[1][i], rest[2][i]));
         }
         if parents == 0 {
             continue;
@@ -344,20 +363,6 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
             two_cos * ns[1] - wo[1],
             two_cos * ns[2] - wo[2],
         ];
-        let kd = unsafe {
-            [
-                L::from_array8(kd[0]),
-                L::from_array8(kd[1]),
-                L::from_array8(kd[2]),
-            ]
-        };
-        let beta = unsafe {
-            [
-                L::from_array8(beta_lanes[0]),
-                L::from_array8(beta_lanes[1]),
-                L::from_array8(beta_lanes[2]),
-            ]
-        };
         let four_pi = unsafe { L::splat(4.0 * PI) };
         let mut rows = [[[0.0f32; 8]; 3]; 6];
         for (c, w) in [ns, wr].into_iter().enumerate() {
