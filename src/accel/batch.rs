@@ -8,7 +8,9 @@
 //! [`Geometry::plane_each`]): no lane holds a padding primitive (only a batch's last chunk
 //! may repeat its last ray), no closest-lane search runs per ray, and each ray's constants are
 //! computed once. Each lane runs the arithmetic the one-ray query runs for
-//! its pair, in the same order of primitives and with the same tie rule, so the answers are
+//! its pair, in the same order of primitives and with the same tie rule, and keeps the
+//! parameters of the primitive it hits, so that the hit records are computed in the lanes too
+//! ([`Geometry::nearest_lanes`], which the Global shader's waves use as well); the answers are
 //! bit-identical to [`Geometry::intersect`] and [`Geometry::occluded`] in every instruction
 //! set. Scenes with a BVH answer ray by ray.
 //!
@@ -17,10 +19,34 @@
 //! closures, so every lane operation inlines into them.
 
 use super::Geometry;
-use super::lanes::RayLanes;
+use super::lanes::{RayLanes, SurfaceLanes, plane_surface, sphere_surface};
 use super::simd::{Floats, Isa};
 use crate::geometry::{Hit, Ray};
 use glam::Vec4;
+
+/// The nearest hits of up to `L::LANES` rays ([`Geometry::nearest_lanes`]).
+#[derive(Clone, Copy)]
+pub struct Nearest<L> {
+    /// Distances (the rays' `t_max` where they hit nothing).
+    pub t: L,
+    /// Slots of the primitives hit ([`Geometry::slot_prim`]), as the bits of each lane.
+    pub slot: L,
+    /// Hit records.
+    pub hit: SurfaceLanes<L>,
+}
+
+/// Where `ok`, the lanes take `x` (a primitive's vector and number: a centre and radius, a
+/// normal and offset) into `into`.
+#[inline(always)]
+fn keep<L: Floats>(ok: L::Mask, x: ([L; 3], L), into: (&mut [L; 3], &mut L)) {
+    let (a, b) = into;
+    *a = [
+        L::select(ok, x.0[0], a[0]),
+        L::select(ok, x.0[1], a[1]),
+        L::select(ok, x.0[2], a[2]),
+    ];
+    *b = L::select(ok, x.1, *b);
+}
 
 /// The `L::LANES` rays of a batch's chunk starting at `k` (the last ray repeated past the end;
 /// its answers are dropped), and their `t_max`.
@@ -165,7 +191,7 @@ impl Geometry {
         hit & live
     }
 
-    /// The nearest hits of `rays`, `L::LANES` at a time.
+    /// The nearest hits of `rays`, `L::LANES` at a time ([`Geometry::nearest_lanes`]).
     ///
     /// # Safety
     /// The CPU must run `L`'s instruction set.
@@ -173,33 +199,123 @@ impl Geometry {
     unsafe fn intersect_in<L: Floats>(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
         for k in (0..rays.len()).step_by(L::LANES) {
             // SAFETY: the caller vouches for the instruction set.
-            let (four, mut t_max) = unsafe { chunk::<L>(rays, k) };
-            let lanes = unsafe { RayLanes::<L>::gather(&four) };
-            // Each lane's best primitive index, as the bits of a float lane (selects move bits
-            // unchanged), so that no lane takes a branch.
-            let mut best = unsafe { L::splat(f32::from_bits(u32::MAX)) };
-            // Spheres, then planes, as the one-ray query; a later primitive at equal distance
-            // wins. A lane's `ok` holds only hits within its current `t_max`.
-            for (id, sphere) in &self.sphere_each {
-                let (t, ok) = unsafe { sphere.splat::<L>() }.hit(&lanes, t_max);
-                t_max = L::select(ok, t, t_max);
-                best = L::select(ok, unsafe { L::splat(f32::from_bits(*id)) }, best);
+            let (eight, t_max) = unsafe { chunk::<L>(rays, k) };
+            let lanes = unsafe { RayLanes::<L>::gather(&eight) };
+            let near = unsafe { self.nearest_lanes(&lanes, t_max) };
+            let h = near.hit;
+            let mut v = [[0.0f32; 8]; 10];
+            for (row, x) in [
+                near.t,
+                near.slot,
+                h.p[0],
+                h.p[1],
+                h.p[2],
+                h.n[0],
+                h.n[1],
+                h.n[2],
+                h.err,
+                h.err_along,
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                x.write_to(&mut v[row]);
             }
-            for (id, plane) in &self.plane_each {
-                let (t, ok) = unsafe { plane.splat::<L>() }.hit(&lanes, t_max);
-                t_max = L::select(ok, t, t_max);
-                best = L::select(ok, unsafe { L::splat(f32::from_bits(*id)) }, best);
+            let hit = |i: usize| {
+                self.slot_prim(v[1][i].to_bits()).map(|prim| Hit {
+                    t: v[0][i],
+                    p: glam::Vec3A::new(v[2][i], v[3][i], v[4][i]),
+                    n: glam::Vec3A::new(v[5][i], v[6][i], v[7][i]),
+                    err: v[8][i],
+                    err_along: v[9][i],
+                    prim,
+                })
+            };
+            hits.extend((0..(rays.len() - k).min(L::LANES)).map(hit));
+        }
+    }
+
+    /// The nearest hits of the rays in `lanes` within `t_max`, as [`Geometry::intersect`]
+    /// finds them (spheres, then planes; a later primitive at equal distance wins), with
+    /// their hit records: each lane keeps the parameters of the primitive it hits (a centre
+    /// and radius, or a normal and offset) as the tests go, so that its record is computed in
+    /// the lanes ([`sphere_surface`], [`plane_surface`]: `Sphere::surface` and
+    /// `Plane::surface` lane by lane) with nothing gathered. For scenes whose primitives are
+    /// all packed; lanes that hit nothing have a slot no primitive has
+    /// ([`Geometry::slot_prim`]) and a record to be dropped.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    pub unsafe fn nearest_lanes<L: Floats>(&self, lanes: &RayLanes<L>, t_max: L) -> Nearest<L> {
+        // SAFETY: the caller vouches for the instruction set (so for each block below).
+        let (zero, one) = unsafe { (L::splat(0.0), L::splat(1.0)) };
+        let mut t_max = t_max;
+        // Each lane's slot, as the bits of a float lane (selects move bits unchanged), so
+        // that no lane takes a branch. A lane's `ok` holds only hits within its `t_max`.
+        let mut slot = unsafe { L::splat(f32::from_bits(u32::MAX)) };
+        let (mut a, mut b, mut on_sphere) = ([zero; 3], zero, zero);
+        for (j, (_, sphere)) in self.sphere_each.iter().enumerate() {
+            let sphere = unsafe { sphere.splat::<L>() };
+            let (t, ok) = sphere.hit(lanes, t_max);
+            t_max = L::select(ok, t, t_max);
+            slot = L::select(ok, unsafe { L::splat(f32::from_bits(j as u32)) }, slot);
+            keep(ok, sphere.center_radius(), (&mut a, &mut b));
+            on_sphere = L::select(ok, one, on_sphere);
+        }
+        for (j, (_, plane)) in self.plane_each.iter().enumerate() {
+            let plane = unsafe { plane.splat::<L>() };
+            let (t, ok) = plane.hit(lanes, t_max);
+            t_max = L::select(ok, t, t_max);
+            let j = (self.sphere_each.len() + j) as u32;
+            slot = L::select(ok, unsafe { L::splat(f32::from_bits(j)) }, slot);
+            keep(ok, plane.normal_dist(), (&mut a, &mut b));
+            on_sphere = L::select(ok, zero, on_sphere);
+        }
+        // The spheres' and the planes' formulas, each where it applies.
+        let sphere_lanes = on_sphere.cmpne(zero);
+        let hit = if L::all(sphere_lanes) {
+            sphere_surface(a, b, lanes, t_max)
+        } else if !L::any(sphere_lanes) {
+            plane_surface(a, b, lanes, t_max)
+        } else {
+            let (on_s, on_p) = (
+                sphere_surface(a, b, lanes, t_max),
+                plane_surface(a, b, lanes, t_max),
+            );
+            SurfaceLanes {
+                p: [
+                    L::select(sphere_lanes, on_s.p[0], on_p.p[0]),
+                    L::select(sphere_lanes, on_s.p[1], on_p.p[1]),
+                    L::select(sphere_lanes, on_s.p[2], on_p.p[2]),
+                ],
+                n: [
+                    L::select(sphere_lanes, on_s.n[0], on_p.n[0]),
+                    L::select(sphere_lanes, on_s.n[1], on_p.n[1]),
+                    L::select(sphere_lanes, on_s.n[2], on_p.n[2]),
+                ],
+                err: L::select(sphere_lanes, on_s.err, on_p.err),
+                err_along: L::select(sphere_lanes, on_s.err_along, on_p.err_along),
             }
-            let (mut t, mut b) = ([0.0f32; 8], [0.0f32; 8]);
-            t_max.write_to(&mut t);
-            best.write_to(&mut b);
-            for i in 0..(rays.len() - k).min(L::LANES) {
-                let prim = b[i].to_bits();
-                hits.push(match prim {
-                    u32::MAX => None,
-                    _ => Some(self.hit_record(four[i], prim, t[i])),
-                });
-            }
+        };
+        Nearest {
+            t: t_max,
+            slot,
+            hit,
+        }
+    }
+
+    /// The primitive of a slot of [`Geometry::nearest_lanes`] (the packed spheres in order,
+    /// then the planes), or `None` for a lane that hit nothing.
+    #[inline]
+    pub fn slot_prim(&self, slot: u32) -> Option<u32> {
+        let (j, spheres) = (slot as usize, self.sphere_each.len());
+        match self.sphere_each.get(j) {
+            Some(&(prim, _)) => Some(prim),
+            None => self
+                .plane_each
+                .get(j.wrapping_sub(spheres))
+                .map(|&(prim, _)| prim),
         }
     }
 

@@ -1,9 +1,9 @@
 //! One batch of a wave traced and shaded in SIMD lanes, for scenes whose primitives are all
-//! packed (no BVH): a ray per lane from the nearest hit to its children. Each lane keeps the
-//! parameters of the primitive it hits during the intersection, so the hit record
-//! ([`sphere_surface`], [`plane_surface`]), the interaction (orientation, the origins and
-//! their error bound) and the light pass ([`super::point_sums`]) run in lanes with no
-//! gathering, and the two rays of task 2 are spawned in lanes. Scalar, lane by lane: the
+//! packed (no BVH): a ray per lane from the nearest hit to its children. The nearest hits come
+//! with their records in lanes ([`crate::accel::Geometry::nearest_lanes`], which
+//! `intersect_batch` runs too); the interaction (orientation, the origins and their error
+//! bound) and the light pass ([`super::point_sums`]) run in lanes with no gathering, and the
+//! two rays of task 2 are spawned in lanes. Scalar, lane by lane: the
 //! tree's bookkeeping, the mirror and glass bounces, the light emitted by a surface a chain
 //! meets, and every reflectance but the course's diffuse one (a specular lobe, the Physical
 //! model), in the light terms and the children's weights. Every lane computes what the scalar
@@ -12,7 +12,7 @@
 //! `course_reflectance`), so the result is the depth-first walk's to the bit.
 
 use super::{LightLanes, Node, Scratch, point_sums};
-use crate::accel::lanes::{RayLanes, SurfaceLanes, abs_max, dot, plane_surface, sphere_surface};
+use crate::accel::lanes::{RayLanes, abs_max, dot};
 use crate::accel::{Floats, Isa};
 use crate::geometry::{Hit, Origins, Ray, UNIT_ROUNDOFF};
 use crate::light::NO_LIGHT;
@@ -64,19 +64,6 @@ unsafe fn wave_avx2(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
     unsafe { wave_in::<crate::accel::F8>(tr, g, s, depth) }
 }
 
-/// Where `ok`, the lanes take `x` (a primitive's vector and number: a centre and radius, a
-/// normal and offset) into `into`.
-#[inline(always)]
-fn keep<L: Floats>(ok: L::Mask, x: ([L; 3], L), into: (&mut [L; 3], &mut L)) {
-    let (a, b) = into;
-    *a = [
-        L::select(ok, x.0[0], a[0]),
-        L::select(ok, x.0[1], a[1]),
-        L::select(ok, x.0[2], a[2]),
-    ];
-    *b = L::select(ok, x.1, *b);
-}
-
 /// The lanes of a vector as an array.
 #[inline(always)]
 fn array<L: Floats>(x: L) -> [f32; 8] {
@@ -93,10 +80,8 @@ fn array<L: Floats>(x: L) -> [f32; 8] {
 #[inline(always)]
 unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
     let geometry = tr.geometry;
-    let (spheres, planes) = (&geometry.sphere_each, &geometry.plane_each);
-    let slots = spheres.len() + planes.len();
     // SAFETY: the caller vouches for the instruction set.
-    let (zero, one, two) = unsafe { (L::splat(0.0), L::splat(1.0), L::splat(2.0)) };
+    let (zero, two) = unsafe { (L::splat(0.0), L::splat(2.0)) };
     // SAFETY: as above; so for every `unsafe` block below, each makes values of `L`.
     let (unit, two_unit) = unsafe { (L::splat(UNIT_ROUNDOFF), L::splat(2.0 * UNIT_ROUNDOFF)) };
     let end = depth >= g.max_depth || !tr.effects.indirect;
@@ -110,56 +95,10 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
             *r = &s.now.rays[(k + i).min(last)];
         }
         let lanes = unsafe { RayLanes::<L>::gather(&eight) };
-        let mut t_max = unsafe { L::from_array8(eight.map(|r| r.t_max)) };
-        // The nearest hit, as `Geometry::intersect_batch` finds it (spheres, then planes; a
-        // later primitive at equal distance wins), and the parameters of the primitive each
-        // lane hits: a centre and radius, or a normal and offset.
-        let mut slot = unsafe { L::splat(f32::from_bits(u32::MAX)) };
-        let (mut a, mut b, mut on_sphere) = ([zero; 3], zero, zero);
-        for (j, (_, sphere)) in spheres.iter().enumerate() {
-            let sphere = unsafe { sphere.splat::<L>() };
-            let (t, ok) = sphere.hit(&lanes, t_max);
-            t_max = L::select(ok, t, t_max);
-            slot = L::select(ok, unsafe { L::splat(f32::from_bits(j as u32)) }, slot);
-            let (c, r) = sphere.center_radius();
-            keep(ok, (c, r), (&mut a, &mut b));
-            on_sphere = L::select(ok, one, on_sphere);
-        }
-        for (j, (_, plane)) in planes.iter().enumerate() {
-            let plane = unsafe { plane.splat::<L>() };
-            let (t, ok) = plane.hit(&lanes, t_max);
-            t_max = L::select(ok, t, t_max);
-            let j = (spheres.len() + j) as u32;
-            slot = L::select(ok, unsafe { L::splat(f32::from_bits(j)) }, slot);
-            keep(ok, plane.normal_dist(), (&mut a, &mut b));
-            on_sphere = L::select(ok, zero, on_sphere);
-        }
-        // The hit records: the spheres' and the planes' formulas, each where it applies.
-        let sphere_lanes = on_sphere.cmpne(zero);
-        let hit = if L::all(sphere_lanes) {
-            sphere_surface(a, b, &lanes, t_max)
-        } else if !L::any(sphere_lanes) {
-            plane_surface(a, b, &lanes, t_max)
-        } else {
-            let (on_s, on_p) = (
-                sphere_surface(a, b, &lanes, t_max),
-                plane_surface(a, b, &lanes, t_max),
-            );
-            SurfaceLanes {
-                p: [
-                    L::select(sphere_lanes, on_s.p[0], on_p.p[0]),
-                    L::select(sphere_lanes, on_s.p[1], on_p.p[1]),
-                    L::select(sphere_lanes, on_s.p[2], on_p.p[2]),
-                ],
-                n: [
-                    L::select(sphere_lanes, on_s.n[0], on_p.n[0]),
-                    L::select(sphere_lanes, on_s.n[1], on_p.n[1]),
-                    L::select(sphere_lanes, on_s.n[2], on_p.n[2]),
-                ],
-                err: L::select(sphere_lanes, on_s.err, on_p.err),
-                err_along: L::select(sphere_lanes, on_s.err_along, on_p.err_along),
-            }
-        };
+        let t_max = unsafe { L::from_array8(eight.map(|r| r.t_max)) };
+        // The nearest hits and their records, in the lanes.
+        let near = unsafe { geometry.nearest_lanes(&lanes, t_max) };
+        let (hit, t_max, slot) = (near.hit, near.t, near.slot);
         // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal),
         // and `Origins::new`: the point moved off the surface by its error's projection on
         // the normal, to either side, with the origins' error bound.
@@ -219,16 +158,10 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
         let mut phong_of: [Option<Phong>; 8] = [None; 8];
         for i in 0..count {
             let node_i = s.now.nodes[k + i];
-            let j = v[SLOT][i].to_bits() as usize;
-            if j >= slots {
+            let Some(prim) = geometry.slot_prim(v[SLOT][i].to_bits()) else {
                 let node = &mut s.nodes[node_i as usize];
                 node.rest = Some(node.beta * node.tint * tr.background);
                 continue;
-            }
-            let prim = if j < spheres.len() {
-                spheres[j].0
-            } else {
-                planes[j - spheres.len()].0
             };
             let (material, light) = {
                 let p = geometry.prim(prim);
