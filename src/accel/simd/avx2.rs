@@ -131,6 +131,33 @@ impl F8 {
 // SAFETY: `splat`, `from_slice`, `from_array8` and `transpose3` are the only constructors and
 // are unsafe, with AVX2 as the
 // caller's duty; see above for the rest.
+/// For each set of lanes (a byte, bit `i` for lane `i`), the permutation that moves its lanes
+/// to the front in order ([`Floats::compress`]); the other lanes follow in order.
+static PACK: [[u32; 8]; 256] = {
+    let mut table = [[0u32; 8]; 256];
+    let mut bits = 0;
+    while bits < 256 {
+        let (mut front, mut i) = (0, 0);
+        while i < 8 {
+            if bits & (1 << i) != 0 {
+                table[bits][front] = i as u32;
+                front += 1;
+            }
+            i += 1;
+        }
+        let (mut back, mut i) = (front, 0);
+        while i < 8 {
+            if bits & (1 << i) == 0 {
+                table[bits][back] = i as u32;
+                back += 1;
+            }
+            i += 1;
+        }
+        bits += 1;
+    }
+    table
+};
+
 unsafe impl Floats for F8 {
     const LANES: usize = 8;
     type Mask = M8;
@@ -174,6 +201,17 @@ unsafe impl Floats for F8 {
         assert!(out.len() >= 8, "room for eight values");
         // The store writes the first 32 bytes of `out`.
         unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) }
+    }
+    #[inline(always)]
+    fn compress(self, bits: u32, out: &mut [f32]) {
+        assert!(out.len() >= 8, "room for eight values");
+        // The lanes of `bits` moved to the front by one permutation (a move of bits), then
+        // all eight stored: the first 32 bytes of `out`.
+        unsafe {
+            let idx = _mm256_loadu_si256(PACK[(bits & 0xff) as usize].as_ptr().cast());
+            let packed = _mm256_permutevar8x32_ps(self.0, idx);
+            _mm256_storeu_ps(out.as_mut_ptr(), packed)
+        }
     }
     #[inline(always)]
     fn sqrt(self) -> Self {

@@ -36,6 +36,17 @@ unsafe impl Floats for Vec4 {
         self.write_to_slice(out)
     }
     #[inline(always)]
+    fn compress(self, bits: u32, out: &mut [f32]) {
+        assert!(out.len() >= 4, "room for four values");
+        let mut front = 0;
+        for (i, x) in self.to_array().into_iter().enumerate() {
+            if bits & (1 << i) != 0 {
+                out[front] = x;
+                front += 1;
+            }
+        }
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         Vec4::sqrt(self)
     }

@@ -153,6 +153,10 @@ pub unsafe trait Floats:
     unsafe fn transpose3(v: &[&glam::Vec3A; 8]) -> [Self; 3];
     /// The lanes, written to the first `LANES` values of `out`.
     fn write_to(self, out: &mut [f32]);
+    /// The lanes of `bits` (bit `i` for lane `i`), packed in lane order into the first values
+    /// of `out`, bits unchanged: a left-packing store, for queues in columns. Values of `out`
+    /// past those (up to `LANES`) may be overwritten; `out` holds at least `LANES` values.
+    fn compress(self, bits: u32, out: &mut [f32]);
     /// Lane-wise square root.
     fn sqrt(self) -> Self;
     /// Lane-wise absolute value (the sign bit cleared).
@@ -400,6 +404,53 @@ mod tests {
                 assert_eq!(f8(*lane8), bits(want));
                 assert_eq!(lane4.to_array(), want[..4]);
             }
+        }
+    }
+
+    /// `compress` packs exactly the lanes of its bits, in lane order and with their bits
+    /// unchanged (NaN payloads and signed zeros included), for every set of lanes in both
+    /// instruction sets.
+    #[test]
+    fn compress_packs_the_lanes_of_its_bits_in_order() {
+        use super::avx2::F8;
+        use glam::Vec4;
+        let values: [f32; 8] = [
+            f32::from_bits(0x7fc0_1234),
+            -0.0,
+            1.0,
+            f32::from_bits(0xffa0_0001),
+            f32::INFINITY,
+            2.5,
+            1e-45,
+            -7.0,
+        ];
+        let bits_of = |x: &[f32]| x.iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
+        for bits in 0..256u32 {
+            let want: Vec<u32> = (0..8)
+                .filter(|i| bits & (1 << i) != 0)
+                .map(|i| values[i].to_bits())
+                .collect();
+            let (lo, hi) = (bits & 0xf, bits >> 4);
+            let mut out = [0.0f32; 8];
+            let (v, w) = (
+                Vec4::from_slice(&values[..4]),
+                Vec4::from_slice(&values[4..]),
+            );
+            v.compress(lo, &mut out);
+            let n = lo.count_ones() as usize;
+            w.compress(hi, &mut out[n..]);
+            assert_eq!(
+                bits_of(&out[..want.len()]),
+                want,
+                "baseline, lanes {bits:08b}"
+            );
+            if !avx2_to_compare() {
+                continue;
+            }
+            let mut out = [0.0f32; 8];
+            // SAFETY: AVX2 is present (checked above).
+            unsafe { F8::from_slice(&values) }.compress(bits, &mut out);
+            assert_eq!(bits_of(&out[..want.len()]), want, "AVX2, lanes {bits:08b}");
         }
     }
 }

@@ -2,9 +2,9 @@
 //! that the geometry answers them in batches with a ray per SIMD lane, eight with AVX2
 //! ([`crate::accel::Geometry::intersect_batch`]); then the direct light of all their hits
 //! together, with a hit per lane, light by light, shadow rays included ([`light_sums`]). In a
-//! scene without a BVH (planes and a few spheres, as the course's box) each batch is traced
-//! and shaded in lanes from the nearest hit to the children's rays, its light pass on the
-//! batch's own lanes (`lanes.rs`).
+//! scene without a BVH (planes and a few spheres, as the course's box) the waves are traced
+//! and shaded in lanes from the nearest hit to the children's rays, each chunk's light pass on
+//! its own lanes, the rays queued in columns (`lanes.rs`).
 //!
 //! The result is the depth-first walk's ([`super::incident`]) to the bit. Each node of the tree
 //! (one traced ray and the mirror or glass chain behind it) keeps the terms that walk would add
@@ -84,16 +84,15 @@ struct Node {
 }
 
 impl Node {
-    /// The chain of node `i` met the mirror or glass hit `si` (below the chain's limit):
-    /// `follow_specular`'s step, the next ray into `bounced` (counted by its kind), unless the
+    /// The node's chain met the mirror or glass hit `si` (below the chain's limit):
+    /// `follow_specular`'s step, which returns the next ray (counted by its kind), unless the
     /// effect is off (the chain is absorbed).
-    fn bounce(&mut self, i: u32, si: &Interaction, tr: &mut Tracer, bounced: &mut Rays) {
-        if let Some((next, tint, kind)) = specular_bounce(si, tr.effects) {
-            self.tint *= tint;
-            self.bounces += 1;
-            tr.stats.count(kind);
-            bounced.push(i, next);
-        }
+    fn bounce(&mut self, si: &Interaction, tr: &mut Tracer) -> Option<Ray> {
+        let (next, tint, kind) = specular_bounce(si, tr.effects)?;
+        self.tint *= tint;
+        self.bounces += 1;
+        tr.stats.count(kind);
+        Some(next)
     }
 
     /// A node about to trace its first ray with weight `beta`.
@@ -212,6 +211,11 @@ struct Scratch {
     lit: Vec<Lit>,
     ends: Vec<End>,
     stack: Vec<u32>,
+    /// The lanes kernel's queues: the wave traced now (and its bounces), the next depth.
+    queue: lanes::Columns,
+    next: lanes::Columns,
+    /// The lanes kernel's table of the packed primitives' materials.
+    slots: Vec<lanes::Slot>,
 }
 
 /// `L_i` along each ray of `rays` (the indirect rays leaving the first Phong hit, traced at
@@ -254,11 +258,18 @@ fn sum_tree(s: &mut Scratch, root: u32) -> Vec3A {
 /// Trace the trees of `roots` wave by wave into `s.nodes` (the roots first, in order).
 fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
     s.nodes.clear();
+    for _ in roots {
+        s.nodes.push(Node::new(Vec3A::ONE));
+        tr.stats.count(RayKind::Indirect);
+    }
+    if tr.geometry.bvh.nodes.is_empty() {
+        // Every primitive packed: each wave traced and shaded in lanes.
+        lanes::trace(tr, g, roots, s);
+        return;
+    }
     s.children.clear();
     for (i, r) in roots.iter().enumerate() {
-        s.nodes.push(Node::new(Vec3A::ONE));
         s.children.push(i as u32, *r);
-        tr.stats.count(RayKind::Indirect);
     }
     for depth in 1..=g.max_depth {
         if s.children.rays.is_empty() {
@@ -270,12 +281,6 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         s.ends.clear();
         // Each bounce of the mirror and glass chains in one batch, until every chain ends.
         while !s.now.rays.is_empty() {
-            if tr.geometry.bvh.nodes.is_empty() {
-                // Every primitive packed: the batch traced and shaded in lanes.
-                lanes::wave(tr, g, s, depth);
-                std::mem::swap(&mut s.now, &mut s.bounced);
-                continue;
-            }
             tr.geometry.intersect_batch(&s.now.rays, &mut s.hits);
             s.bounced.clear();
             for k in 0..s.now.rays.len() {
@@ -308,8 +313,10 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
         node.le += node.tint * emitted(tr, &si);
     }
     let Material::Phong(phong) = si.material else {
-        if node.bounces < g.max_specular {
-            node.bounce(i, &si, tr, &mut s.bounced);
+        if node.bounces < g.max_specular
+            && let Some(next) = node.bounce(&si, tr)
+        {
+            s.bounced.push(i, next);
         }
         return;
     };

@@ -1,14 +1,21 @@
-//! One batch of a wave traced and shaded in SIMD lanes, for scenes whose primitives are all
-//! packed (no BVH): a ray per lane from the nearest hit to its children. The nearest hits come
-//! with their records in lanes ([`crate::accel::Geometry::nearest_lanes`], which
-//! `intersect_batch` runs too); the interaction (orientation, the origins and their error
-//! bound) and the light pass ([`super::point_sums`]) run in lanes with no gathering, and the
-//! two rays of task 2 are spawned in lanes. Scalar, lane by lane: the
-//! tree's bookkeeping, the mirror and glass bounces, the light emitted by a surface a chain
-//! meets, and every reflectance but the course's diffuse one (a specular lobe, the Physical
-//! model), in the light terms and the children's weights. Every lane computes what the scalar
-//! code computes for its ray, operation for operation (`Geometry::intersect`'s order and tie
-//! rule, `Sphere::surface`, `Plane::surface`, `Interaction::new`, `Origins`, `reflect`,
+//! The waves traced and shaded in SIMD lanes, for scenes whose primitives are all packed (no
+//! BVH): a ray per lane from the nearest hit to its children, the rays queued in columns
+//! ([`Columns`]) so that a chunk loads with one load per coordinate and the children are
+//! written with one left-packing store per coordinate ([`crate::accel::Floats::compress`]).
+//!
+//! A wave's rays are one stream: a mirror or glass bounce is queued behind the rays of its
+//! depth and traced in a later chunk of the same wave, so every chunk but the wave's last
+//! fills its lanes. The nearest hits come with their records in lanes
+//! ([`crate::accel::Geometry::nearest_lanes`], which `intersect_batch` runs too); the
+//! interaction (orientation, the origins and their error bound), the light pass
+//! ([`super::point_sums`]), each Phong node's sum and the two rays of task 2 with their
+//! weights run in lanes. What each primitive's material is comes from a table built once per
+//! call ([`Slot`]). Scalar, lane by lane: the tree's bookkeeping (a node's sum, its
+//! children), the mirror and glass bounces, the light emitted by a surface a chain meets, and
+//! every reflectance but the course's diffuse one (a specular lobe, the Physical model), in
+//! the light terms and the children's weights. Every lane computes what the scalar code
+//! computes for its ray, operation for operation (`Geometry::intersect`'s order and tie rule,
+//! `Sphere::surface`, `Plane::surface`, `Interaction::new`, `Origins`, `reflect`,
 //! `course_reflectance`), so the result is the depth-first walk's to the bit.
 
 use super::{LightLanes, Node, Scratch, point_sums};
@@ -16,17 +23,175 @@ use crate::accel::lanes::{RayLanes, abs_max, dot};
 use crate::accel::{Floats, Isa};
 use crate::geometry::{Hit, Origins, Ray, UNIT_ROUNDOFF};
 use crate::light::NO_LIGHT;
-use crate::material::{Material, Model, Phong};
+use crate::material::{Material, Model};
 use crate::shader::Tracer;
 use crate::shader::global::Global;
 use crate::shader::surface::{Interaction, emitted, reflectance};
-use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::PI;
 
-/// Rows of a chunk's lane arrays: hit point, geometric normal, shading normal (the geometric
-/// one on the viewer's side), front and back origins (three each), then the origins' error,
-/// the distance, the hit's two error bounds, and the slot of the primitive hit.
+/// Columns of a [`Columns`] queue: origin, direction, the origin's error bound, `t_max`.
+const OX: usize = 0;
+const DX: usize = 3;
+const OE: usize = 6;
+const TM: usize = 7;
+
+/// Rays waiting to be traced, with their nodes, a column per coordinate (structure of
+/// arrays). Each column holds at least eight values past the last ray, so that a chunk of
+/// lanes loads whole and a left-packing store has room (values past the last ray are left
+/// over from earlier rays, or zero, and only ever fill lanes that are dropped).
+#[derive(Default)]
+pub(super) struct Columns {
+    /// `o.x`, `o.y`, `o.z`, `d.x`, `d.y`, `d.z`, `o_err`, `t_max`.
+    rows: [Vec<f32>; 8],
+    /// The rays' nodes.
+    nodes: Vec<u32>,
+    /// How many rays.
+    len: usize,
+}
+
+impl Columns {
+    /// No rays (the columns keep their memory).
+    fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// Room for `n` more rays and a chunk of lanes past them.
+    fn reserve(&mut self, n: usize) {
+        let want = self.len + n + 8;
+        if self.nodes.len() < want {
+            let want = want.next_power_of_two();
+            for row in &mut self.rows {
+                row.resize(want, 0.0);
+            }
+            self.nodes.resize(want, 0);
+        }
+    }
+
+    /// Queue `rays` for the nodes from `node` on, one each.
+    fn push(&mut self, node: u32, rays: &[Ray]) {
+        self.reserve(rays.len());
+        let (k, n) = (self.len, rays.len());
+        let [ox, oy, oz, dx, dy, dz, oe, tm] = self.rows.each_mut().map(|r| &mut r[k..k + n]);
+        for (j, r) in rays.iter().enumerate() {
+            (ox[j], oy[j], oz[j]) = (r.o.x, r.o.y, r.o.z);
+            (dx[j], dy[j], dz[j]) = (r.d.x, r.d.y, r.d.z);
+            (oe[j], tm[j]) = (r.o_err, r.t_max);
+        }
+        for (j, slot) in self.nodes[k..k + n].iter_mut().enumerate() {
+            *slot = node + j as u32;
+        }
+        self.len += n;
+    }
+
+    /// `L::LANES` values of column `row` from ray `k` on.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn load<L: Floats>(&self, row: usize, k: usize) -> L {
+        // SAFETY: the caller vouches for the instruction set; the column holds eight values
+        // past `len` (`reserve`).
+        unsafe { L::from_slice(&self.rows[row][k..]) }
+    }
+}
+
+/// What the kernel reads of the primitive in one slot of
+/// [`crate::accel::Geometry::nearest_lanes`], looked up once per call.
+#[derive(Clone, Copy)]
+pub(super) struct Slot {
+    /// The primitive.
+    prim: u32,
+    /// Its material.
+    material: Material,
+    /// Its area light, or [`NO_LIGHT`].
+    light: u32,
+    /// A Phong material's `kd` (zero for mirror and glass).
+    kd: Vec3A,
+    /// A Phong material.
+    phong: bool,
+    /// A Phong material that reflects light (`point_lights` has terms for it).
+    lit: bool,
+    /// A Phong material whose reflectance is the course's diffuse `kd max(w.n, 0)` (the Course
+    /// model, `ks` zero): computed in lanes.
+    lambert: bool,
+}
+
+/// The slot table of `tr`'s packed primitives, into `slots`.
+fn slot_table(tr: &Tracer, slots: &mut Vec<Slot>) {
+    slots.clear();
+    let geometry = tr.geometry;
+    while let Some(prim) = geometry.slot_prim(slots.len() as u32) {
+        let p = geometry.prim(prim);
+        let material = tr.materials[p.material as usize];
+        let phong = match material {
+            Material::Phong(phong) => Some(phong),
+            _ => None,
+        };
+        slots.push(Slot {
+            prim,
+            material,
+            light: p.light,
+            kd: phong.map_or(Vec3A::ZERO, |p| p.kd),
+            phong: phong.is_some(),
+            lit: phong.is_some_and(|p| !p.is_black()),
+            lambert: phong.is_some_and(|p| tr.model == Model::Course && p.ks == Vec3A::ZERO),
+        });
+    }
+}
+
+/// Trace the trees of `roots` wave by wave into `s.nodes`, whose roots (one per ray of
+/// `roots`, in order) the caller has made: what `trace_tree`'s waves and `shade` do for a
+/// scene without a BVH, each Phong hit's light pass and sum included (its node's `rest`).
+pub fn trace(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
+    match tr.geometry.bvh.isa() {
+        // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { trace_avx2(tr, g, roots, s) },
+        // SAFETY: `Vec4` runs on every CPU.
+        _ => unsafe { trace_in::<glam::Vec4>(tr, g, roots, s) },
+    }
+}
+
+/// [`trace`] in eight AVX2 lanes.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn trace_avx2(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
+    // SAFETY: this function runs only where AVX2 was found.
+    unsafe { trace_in::<crate::accel::F8>(tr, g, roots, s) }
+}
+
+/// [`trace`], `L::LANES` rays at a time.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn trace_in<L: Floats>(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
+    slot_table(tr, &mut s.slots);
+    s.queue.clear();
+    s.queue.push(0, roots);
+    for depth in 1..=g.max_depth {
+        if s.queue.len == 0 {
+            break;
+        }
+        s.next.clear();
+        // The wave's rays, chunk by chunk; bounces join the queue behind them.
+        let mut k = 0;
+        while k < s.queue.len {
+            // SAFETY: the caller vouches for the instruction set.
+            k += unsafe { chunk::<L>(tr, g, s, depth, k) };
+        }
+        std::mem::swap(&mut s.queue, &mut s.next);
+    }
+}
+
+/// Rows of a chunk's lane arrays, for the lanes whose whole interaction is built (a mirror or
+/// glass bounce, an emitter a chain meets): hit point, geometric normal, shading normal (the
+/// geometric one on the viewer's side), front and back origins (three each), then the
+/// origins' error, the distance and the hit's two error bounds.
 const P: usize = 0;
 const NH: usize = 3;
 const NS: usize = 6;
@@ -36,33 +201,7 @@ const O_ERR: usize = 15;
 const T: usize = 16;
 const ERR: usize = 17;
 const ERR_ALONG: usize = 18;
-const SLOT: usize = 19;
-const ROWS: usize = 20;
-
-/// Trace and shade `s.now` in lanes into `s.bounced`, `s.children` and the nodes: what
-/// `trace_tree`'s batch and `shade` do for a scene without a BVH, then its Phong hits' light
-/// pass and what `finish_direct_light` adds (each node's `rest`), so that it queues nothing
-/// for [`super::light_sums`] (`s.ends`) or `finish_direct_light` (`s.lit`).
-pub fn wave(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
-    match tr.geometry.bvh.isa() {
-        // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => unsafe { wave_avx2(tr, g, s, depth) },
-        // SAFETY: `Vec4` runs on every CPU.
-        _ => unsafe { wave_in::<glam::Vec4>(tr, g, s, depth) },
-    }
-}
-
-/// [`wave`] in eight AVX2 lanes.
-///
-/// # Safety
-/// The CPU must have AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn wave_avx2(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
-    // SAFETY: this function runs only where AVX2 was found.
-    unsafe { wave_in::<crate::accel::F8>(tr, g, s, depth) }
-}
+const ROWS: usize = 19;
 
 /// The lanes of a vector as an array.
 #[inline(always)]
@@ -72,55 +211,98 @@ fn array<L: Floats>(x: L) -> [f32; 8] {
     a
 }
 
-/// [`wave`], `L::LANES` rays at a time. No closures that compute in lanes, so that this
-/// inlines whole into the AVX2 copy.
+/// Trace and shade the queue's rays from `k` on, `L::LANES` of them at most, at depth `depth`:
+/// their nodes' sums into `s.nodes`, bounces into `s.queue`, children into `s.next`. Returns
+/// how many rays it took. No closures that compute in lanes, so that this inlines whole into
+/// the AVX2 copy.
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.
 #[inline(always)]
-unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32) {
+unsafe fn chunk<L: Floats>(
+    tr: &mut Tracer,
+    g: &Global,
+    s: &mut Scratch,
+    depth: u32,
+    k: usize,
+) -> usize {
     let geometry = tr.geometry;
-    // SAFETY: the caller vouches for the instruction set.
+    // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block below,
+    // each makes values of `L`.
     let (zero, two) = unsafe { (L::splat(0.0), L::splat(2.0)) };
-    // SAFETY: as above; so for every `unsafe` block below, each makes values of `L`.
     let (unit, two_unit) = unsafe { (L::splat(UNIT_ROUNDOFF), L::splat(2.0 * UNIT_ROUNDOFF)) };
     let end = depth >= g.max_depth || !tr.effects.indirect;
-    s.bounced.clear();
-    let n_rays = s.now.rays.len();
-    for k in (0..n_rays).step_by(L::LANES) {
-        let count = (n_rays - k).min(L::LANES);
-        let last = n_rays - 1;
-        let mut eight = [&s.now.rays[last]; 8];
-        for (i, r) in eight.iter_mut().enumerate().take(L::LANES) {
-            *r = &s.now.rays[(k + i).min(last)];
+    let q = &s.queue;
+    let count = (q.len - k).min(L::LANES);
+    let (o, d, o_err, t_max) = unsafe {
+        (
+            [q.load(OX, k), q.load(OX + 1, k), q.load(OX + 2, k)],
+            [q.load(DX, k), q.load(DX + 1, k), q.load(DX + 2, k)],
+            q.load::<L>(OE, k),
+            q.load::<L>(TM, k),
+        )
+    };
+    let nodes: [u32; 8] = q.nodes[k..k + 8].try_into().expect("eight nodes");
+    let lanes = RayLanes::from_parts(o, d, o_err);
+    // The nearest hits and their records, in the lanes.
+    let near = unsafe { geometry.nearest_lanes(&lanes, t_max) };
+    let (hit, t_max, slot) = (near.hit, near.t, array(near.slot));
+    // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal),
+    // and `Origins::new`: the point moved off the surface by its error's projection on the
+    // normal, to either side, with the origins' error bound.
+    let wo = [-d[0], -d[1], -d[2]];
+    let (p, nh) = (hit.p, hit.n);
+    let flip = dot(nh, wo).cmplt(zero);
+    let ns = [
+        L::select(flip, -nh[0], nh[0]),
+        L::select(flip, -nh[1], nh[1]),
+        L::select(flip, -nh[2], nh[2]),
+    ];
+    let n_sum = (nh[0].abs() + nh[1].abs()) + nh[2].abs();
+    let off = n_sum * hit.err + two_unit * abs_max(p);
+    let front = [p[0] + off * nh[0], p[1] + off * nh[1], p[2] + off * nh[2]];
+    let back = [p[0] - off * nh[0], p[1] - off * nh[1], p[2] - off * nh[2]];
+    let widest = [
+        front[0].abs().max(back[0].abs()),
+        front[1].abs().max(back[1].abs()),
+        front[2].abs().max(back[2].abs()),
+    ];
+    let o_err = hit.err + off + two * hit.err_along + unit * abs_max(widest);
+    // The tree's bookkeeping, lane by lane (`shade`): misses end at the background; a chain's
+    // ray adds what its surface emits; Phong hits gather their weights and `kd`; the rest
+    // (mirror and glass, emitters) wait for their whole interaction below.
+    let (mut phong_lanes, mut lit_lanes, mut lambert, mut whole) = (0u32, 0u32, 0u32, 0u32);
+    let mut beta = [Vec3A::ZERO; 8];
+    let mut kd = [Vec3A::ZERO; 8];
+    for i in 0..count {
+        let node = &mut s.nodes[nodes[i] as usize];
+        let Some(e) = s.slots.get(slot[i].to_bits() as usize) else {
+            node.rest = Some(node.beta * node.tint * tr.background);
+            continue;
+        };
+        // The emitter a node's own ray hits is the direct light of the hit it left.
+        let emits = e.light != NO_LIGHT && tr.effects.emission;
+        if node.bounces > 0 {
+            if emits {
+                whole |= 1 << i;
+            } else {
+                node.le += node.tint * Vec3A::ZERO;
+            }
         }
-        let lanes = unsafe { RayLanes::<L>::gather(&eight) };
-        let t_max = unsafe { L::from_array8(eight.map(|r| r.t_max)) };
-        // The nearest hits and their records, in the lanes.
-        let near = unsafe { geometry.nearest_lanes(&lanes, t_max) };
-        let (hit, t_max, slot) = (near.hit, near.t, near.slot);
-        // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal),
-        // and `Origins::new`: the point moved off the surface by its error's projection on
-        // the normal, to either side, with the origins' error bound.
-        let d = lanes.d();
-        let wo = [-d[0], -d[1], -d[2]];
-        let (p, nh) = (hit.p, hit.n);
-        let flip = dot(nh, wo).cmplt(zero);
-        let ns = [
-            L::select(flip, -nh[0], nh[0]),
-            L::select(flip, -nh[1], nh[1]),
-            L::select(flip, -nh[2], nh[2]),
-        ];
-        let n_sum = (nh[0].abs() + nh[1].abs()) + nh[2].abs();
-        let off = n_sum * hit.err + two_unit * abs_max(p);
-        let front = [p[0] + off * nh[0], p[1] + off * nh[1], p[2] + off * nh[2]];
-        let back = [p[0] - off * nh[0], p[1] - off * nh[1], p[2] - off * nh[2]];
-        let widest = [
-            front[0].abs().max(back[0].abs()),
-            front[1].abs().max(back[1].abs()),
-            front[2].abs().max(back[2].abs()),
-        ];
-        let o_err = hit.err + off + two * hit.err_along + unit * abs_max(widest);
+        if !e.phong {
+            whole |= 1 << i;
+            continue;
+        }
+        beta[i] = node.beta * node.tint;
+        kd[i] = e.kd;
+        phong_lanes |= 1 << i;
+        lit_lanes |= u32::from(e.lit) << i;
+        lambert |= u32::from(e.lambert) << i;
+    }
+    let parents = if end { 0 } else { phong_lanes };
+    // The lanes that need their whole interaction: emitters a chain meets, and mirror and
+    // glass bounces, queued behind this wave's rays.
+    if whole != 0 {
         let mut v = [[0.0f32; 8]; ROWS];
         for (row, x) in [
             p[0],
@@ -142,201 +324,190 @@ unsafe fn wave_in<L: Floats>(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth
             t_max,
             hit.err,
             hit.err_along,
-            slot,
         ]
         .into_iter()
         .enumerate()
         {
             x.write_to(&mut v[row]);
         }
-        let vec3 = |row: usize, i: usize| Vec3A::new(v[row][i], v[row + 1][i], v[row + 2][i]);
-        // The tree's bookkeeping, lane by lane (`shade`).
-        let (mut phong_lanes, mut lit_lanes) = (0u32, 0u32);
-        let (mut lambert, mut parents) = (0u32, 0u32);
-        let mut kd = [[0.0f32; 8]; 3];
-        let mut beta_lanes = [[0.0f32; 8]; 3];
-        let mut phong_of: [Option<Phong>; 8] = [None; 8];
-        for i in 0..count {
-            let node_i = s.now.nodes[k + i];
-            let Some(prim) = geometry.slot_prim(v[SLOT][i].to_bits()) else {
-                let node = &mut s.nodes[node_i as usize];
-                node.rest = Some(node.beta * node.tint * tr.background);
-                continue;
-            };
-            let (material, light) = {
-                let p = geometry.prim(prim);
-                (tr.materials[p.material as usize], p.light)
-            };
-            // The whole interaction, for the rare lanes that need it.
-            let si = || Interaction {
+        let (mut dv, vec3) = ([[0.0f32; 8]; 3], |v: &[[f32; 8]], row: usize, i: usize| {
+            Vec3A::new(v[row][i], v[row + 1][i], v[row + 2][i])
+        });
+        for (c, x) in d.into_iter().enumerate() {
+            x.write_to(&mut dv[c]);
+        }
+        let mut bits = whole;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let e = s.slots[slot[i].to_bits() as usize];
+            let si = Interaction {
                 hit: Hit {
                     t: v[T][i],
-                    p: vec3(P, i),
-                    n: vec3(NH, i),
+                    p: vec3(&v, P, i),
+                    n: vec3(&v, NH, i),
                     err: v[ERR][i],
                     err_along: v[ERR_ALONG][i],
-                    prim,
+                    prim: e.prim,
                 },
-                wo: -s.now.rays[k + i].d,
-                n: vec3(NS, i),
-                material,
+                wo: -vec3(&dv, 0, i),
+                n: vec3(&v, NS, i),
+                material: e.material,
                 origins: Origins {
-                    front: vec3(FRONT, i),
-                    back: vec3(BACK, i),
-                    n: vec3(NH, i),
+                    front: vec3(&v, FRONT, i),
+                    back: vec3(&v, BACK, i),
+                    n: vec3(&v, NH, i),
                     o_err: v[O_ERR][i],
                 },
-                light,
+                light: e.light,
             };
-            let node = &mut s.nodes[node_i as usize];
-            // The emitter a node's own ray hits is the direct light of the hit it left.
-            if node.bounces > 0 {
-                let le = if light == NO_LIGHT || !tr.effects.emission {
-                    Vec3A::ZERO
-                } else {
-                    emitted(tr, &si())
-                };
-                node.le += node.tint * le;
+            let node = &mut s.nodes[nodes[i] as usize];
+            if node.bounces > 0 && e.light != NO_LIGHT && tr.effects.emission {
+                node.le += node.tint * emitted(tr, &si);
             }
-            let Material::Phong(phong) = material else {
-                if node.bounces < g.max_specular {
-                    node.bounce(node_i, &si(), tr, &mut s.bounced);
-                }
-                continue;
-            };
-            let beta = node.beta * node.tint;
-            let diffuse = tr.model == Model::Course && phong.ks == Vec3A::ZERO;
-            // Eq. 3 in the chunk's light pass below. A surface that reflects nothing has no
-            // light terms (`point_lights`).
-            (kd[0][i], kd[1][i], kd[2][i]) = (phong.kd.x, phong.kd.y, phong.kd.z);
-            phong_lanes |= 1 << i;
-            lit_lanes |= u32::from(!phong.is_black()) << i;
-            lambert |= u32::from(diffuse) << i;
-            if !diffuse {
-                phong_of[i] = Some(phong);
-            }
-            (beta_lanes[0][i], beta_lanes[1][i], beta_lanes[2][i]) = (beta.x, beta.y, beta.z);
-            parents |= u32::from(!end) << i;
-        }
-        // Eq. 3: the point lights' sums of the chunk's Phong hits (zero where a surface
-        // reflects nothing).
-        let mut point = [[0.0f32; 8]; 3];
-        if lit_lanes != 0 {
-            let mut filled = [0.0f32; 8];
-            for (i, f) in filled.iter_mut().enumerate() {
-                *f = if lit_lanes & (1 << i) != 0 { 1.0 } else { 0.0 };
-            }
-            let h = unsafe {
-                LightLanes {
-                    p,
-                    n: ns,
-                    ng: nh,
-                    front,
-                    back,
-                    kd: [
-                        L::from_array8(kd[0]),
-                        L::from_array8(kd[1]),
-                        L::from_array8(kd[2]),
-                    ],
-                    o_err,
-                    filled: L::from_array8(filled).cmpne(zero),
-                    scalar: lit_lanes & !lambert,
-                }
-            };
-            let model = tr.model;
-            let rays = &s.now.rays[k..];
-            point = unsafe {
-                point_sums(tr, &h, |i, w, l| {
-                    let phong = phong_of[i].expect("a scalar lane's material");
-                    l * reflectance(model, &phong, w, -rays[i].d, vec3(NS, i))
-                })
-            };
-        }
-        let (kd, beta) = unsafe {
-            (
-                [
-                    L::from_array8(kd[0]),
-                    L::from_array8(kd[1]),
-                    L::from_array8(kd[2]),
-                ],
-                [
-                    L::from_array8(beta_lanes[0]),
-                    L::from_array8(beta_lanes[1]),
-                    L::from_array8(beta_lanes[2]),
-                ],
-            )
-        };
-        // What each Phong node adds after `beta le` (`finish_direct_light`): `beta` times
-        // Eq. 3 as `direct_light` sums it (the point lights' sum, then the area lights' zero),
-        // plus the ambient term at depth D (Eq. 2).
-        let mut rest = [[0.0f32; 8]; 3];
-        for c in 0..3 {
-            let l_dir = unsafe { L::from_array8(point[c]) } + zero;
-            rest[c] = array(match end {
-                true => beta[c] * (l_dir + unsafe { L::splat(g.ambient[c]) } * kd[c]),
-                false => beta[c] * l_dir,
-            });
-        }
-        let mut bits = phong_lanes;
-        while bits != 0 {
-            let i = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            let node = &mut s.nodes[s.now.nodes[k + i] as usize];
-            node.rest = Some(Vec3A::new(rest[0][i], rest[1][i], rest[2][i]));
-        }
-        if parents == 0 {
-            continue;
-        }
-        // Task 2: Eq. 4 with the directions fixed to the normal w_n and the reflection w_r of
-        // `wo` (`reflect`: `2 (n.wo) n - wo`), weighted by 1 / (4 pi); each ray leaves from
-        // the origin on its side.
-        let two_cos = two * dot(ns, wo);
-        let wr = [
-            two_cos * ns[0] - wo[0],
-            two_cos * ns[1] - wo[1],
-            two_cos * ns[2] - wo[2],
-        ];
-        let four_pi = unsafe { L::splat(4.0 * PI) };
-        let mut rows = [[[0.0f32; 8]; 3]; 6];
-        for (c, w) in [ns, wr].into_iter().enumerate() {
-            // `course_reflectance` of a diffuse material: `kd max(w.n, 0)`, `max` as a select.
-            let cos = dot(w, ns);
-            let cos = L::select(cos.cmpgt(zero), cos, zero);
-            let side = dot(nh, w).cmpge(zero);
-            for x in 0..3 {
-                rows[3 * c][x] = array((beta[x] * (kd[x] * cos)) / four_pi);
-                rows[3 * c + 1][x] = array(L::select(side, front[x], back[x]));
-                rows[3 * c + 2][x] = array(w[x]);
-            }
-        }
-        let mut bits = parents;
-        while bits != 0 {
-            let i = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            let node_i = s.now.nodes[k + i];
-            let first = s.nodes.len() as u32;
-            s.nodes[node_i as usize].children = Some(first);
-            for c in 0..2 {
-                let get = |r: usize| Vec3A::new(rows[r][0][i], rows[r][1][i], rows[r][2][i]);
-                let w = get(3 * c + 2);
-                let b = if lambert & (1 << i) != 0 {
-                    get(3 * c)
-                } else {
-                    let beta = Vec3A::new(beta_lanes[0][i], beta_lanes[1][i], beta_lanes[2][i]);
-                    let wo = -s.now.rays[k + i].d;
-                    let phong = phong_of[i].expect("a scalar lane's material");
-                    beta * reflectance(tr.model, &phong, w, wo, vec3(NS, i)) / (4.0 * PI)
-                };
-                s.nodes.push(Node::new(b));
-                let ray = Ray {
-                    o: get(3 * c + 1),
-                    d: w,
-                    t_max: f32::INFINITY,
-                    o_err: v[O_ERR][i],
-                };
-                s.children.push(first + c as u32, ray);
-                tr.stats.count(RayKind::Indirect);
+            if !e.phong
+                && node.bounces < g.max_specular
+                && let Some(next) = node.bounce(&si, tr)
+            {
+                s.queue.push(nodes[i], &[next]);
             }
         }
     }
+    // The rows the scalar reflectance reads (`wo` and the shading normal), where a Phong lane
+    // is not the course's diffuse one.
+    let scalar = phong_lanes & !lambert;
+    let mut sv = [[0.0f32; 8]; 6];
+    if scalar != 0 {
+        for (row, x) in [wo[0], wo[1], wo[2], ns[0], ns[1], ns[2]]
+            .into_iter()
+            .enumerate()
+        {
+            x.write_to(&mut sv[row]);
+        }
+    }
+    let wo_n = |i: usize| {
+        (
+            Vec3A::new(sv[0][i], sv[1][i], sv[2][i]),
+            Vec3A::new(sv[3][i], sv[4][i], sv[5][i]),
+        )
+    };
+    let (beta_l, kd_l) = unsafe {
+        (
+            L::transpose3(&beta.each_ref()),
+            L::transpose3(&kd.each_ref()),
+        )
+    };
+    // Eq. 3: the point lights' sums of the chunk's Phong hits (zero where a surface reflects
+    // nothing).
+    let mut point = [[0.0f32; 8]; 3];
+    if lit_lanes != 0 {
+        let mut filled = [0.0f32; 8];
+        for (i, f) in filled.iter_mut().enumerate() {
+            *f = if lit_lanes & (1 << i) != 0 { 1.0 } else { 0.0 };
+        }
+        let h = LightLanes {
+            p,
+            n: ns,
+            ng: nh,
+            front,
+            back,
+            kd: kd_l,
+            o_err,
+            filled: unsafe { L::from_array8(filled) }.cmpne(zero),
+            scalar: lit_lanes & !lambert,
+        };
+        let (model, slots) = (tr.model, &s.slots);
+        point = unsafe {
+            point_sums(tr, &h, |i, w, l| {
+                let Material::Phong(phong) = slots[slot[i].to_bits() as usize].material else {
+                    unreachable!("a lit lane is a Phong hit")
+                };
+                let (wo, n) = wo_n(i);
+                l * reflectance(model, &phong, w, wo, n)
+            })
+        };
+    }
+    // What each Phong node adds after `beta le` (`finish_direct_light`): `beta` times Eq. 3
+    // as `direct_light` sums it (the point lights' sum, then the area lights' zero), plus the
+    // ambient term at depth D (Eq. 2).
+    let mut rest = [[0.0f32; 8]; 3];
+    for c in 0..3 {
+        let l_dir = unsafe { L::from_array8(point[c]) } + zero;
+        rest[c] = array(match end {
+            true => beta_l[c] * (l_dir + unsafe { L::splat(g.ambient[c]) } * kd_l[c]),
+            false => beta_l[c] * l_dir,
+        });
+    }
+    let mut bits = phong_lanes;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let node = &mut s.nodes[nodes[i] as usize];
+        node.rest = Some(Vec3A::new(rest[0][i], rest[1][i], rest[2][i]));
+    }
+    if parents == 0 {
+        return count;
+    }
+    // Task 2: Eq. 4 with the directions fixed to the normal w_n and the reflection w_r of
+    // `wo` (`reflect`: `2 (n.wo) n - wo`), weighted by 1 / (4 pi); each ray leaves from the
+    // origin on its side. The parents' rays are packed into the next wave's columns, the
+    // normals' first, then the reflections'.
+    let two_cos = two * dot(ns, wo);
+    let wr = [
+        two_cos * ns[0] - wo[0],
+        two_cos * ns[1] - wo[1],
+        two_cos * ns[2] - wo[2],
+    ];
+    let (four_pi, inf) = unsafe { (L::splat(4.0 * PI), L::splat(f32::INFINITY)) };
+    let n_parents = parents.count_ones() as usize;
+    let next = &mut s.next;
+    next.reserve(2 * n_parents);
+    let at = next.len;
+    let mut weights = [[[0.0f32; 8]; 3]; 2];
+    let mut dirs = [[[0.0f32; 8]; 3]; 2];
+    for (c, w) in [ns, wr].into_iter().enumerate() {
+        // `course_reflectance` of a diffuse material: `kd max(w.n, 0)`, `max` as a select.
+        let cos = dot(w, ns);
+        let cos = L::select(cos.cmpgt(zero), cos, zero);
+        let side = dot(nh, w).cmpge(zero);
+        let start = at + c * n_parents;
+        for x in 0..3 {
+            weights[c][x] = array((beta_l[x] * (kd_l[x] * cos)) / four_pi);
+            L::select(side, front[x], back[x]).compress(parents, &mut next.rows[OX + x][start..]);
+            w[x].compress(parents, &mut next.rows[DX + x][start..]);
+            if scalar != 0 {
+                w[x].write_to(&mut dirs[c][x]);
+            }
+        }
+        o_err.compress(parents, &mut next.rows[OE][start..]);
+        inf.compress(parents, &mut next.rows[TM][start..]);
+    }
+    // The children's nodes, parent by parent in lane order, each parent's normal first.
+    let first = s.nodes.len() as u32;
+    let mut bits = parents;
+    let mut r = 0;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let child = first + 2 * r as u32;
+        s.nodes[nodes[i] as usize].children = Some(child);
+        for c in 0..2 {
+            let b = if lambert & (1 << i) != 0 {
+                Vec3A::new(weights[c][0][i], weights[c][1][i], weights[c][2][i])
+            } else {
+                let Material::Phong(phong) = s.slots[slot[i].to_bits() as usize].material else {
+                    unreachable!("a parent is a Phong hit")
+                };
+                let (wo, n) = wo_n(i);
+                let w = Vec3A::new(dirs[c][0][i], dirs[c][1][i], dirs[c][2][i]);
+                beta[i] * reflectance(tr.model, &phong, w, wo, n) / (4.0 * PI)
+            };
+            s.nodes.push(Node::new(b));
+            s.next.nodes[at + c * n_parents + r] = child + c as u32;
+        }
+        r += 1;
+    }
+    s.next.len += 2 * n_parents;
+    tr.stats.indirect += 2 * n_parents as u64;
+    count
 }
