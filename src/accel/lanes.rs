@@ -76,12 +76,6 @@ impl<L: Floats> RayLanes<L> {
             o_max: a,
         }
     }
-
-    /// The directions, a coordinate per vector.
-    #[inline(always)]
-    pub fn d(&self) -> [L; 3] {
-        self.d
-    }
 }
 
 /// `max |v_i|` in glam's order (`Vec3A::max_element` of `abs`): max(max(x, z), max(y, z)).

@@ -128,9 +128,6 @@ impl F8 {
     }
 }
 
-// SAFETY: `splat`, `from_slice`, `from_array8` and `transpose3` are the only constructors and
-// are unsafe, with AVX2 as the
-// caller's duty; see above for the rest.
 /// For each set of lanes (a byte, bit `i` for lane `i`), the permutation that moves its lanes
 /// to the front in order ([`Floats::compress`]); the other lanes follow in order.
 static PACK: [[u32; 8]; 256] = {
@@ -158,6 +155,9 @@ static PACK: [[u32; 8]; 256] = {
     table
 };
 
+// SAFETY: `splat`, `from_slice`, `from_array8` and `transpose3` are the only constructors and
+// are unsafe, with AVX2 as the
+// caller's duty; see above for the rest.
 unsafe impl Floats for F8 {
     const LANES: usize = 8;
     type Mask = M8;

@@ -203,7 +203,8 @@ impl Rays {
 #[derive(Default)]
 struct Scratch {
     nodes: Vec<Node>,
-    /// The rays traced now, the chains' next rays (same depth), the children (next depth).
+    /// The rays traced now, the chains' next rays (same depth), the children (next depth):
+    /// the queues of scenes with a BVH (the lanes kernel has its own, `queue` and `next`).
     now: Rays,
     bounced: Rays,
     children: Rays,

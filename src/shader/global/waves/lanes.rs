@@ -4,14 +4,15 @@
 //! written with one left-packing store per coordinate ([`crate::accel::Floats::compress`]).
 //!
 //! A wave's rays are one stream: a mirror or glass bounce is queued behind the rays of its
-//! depth and traced in a later chunk of the same wave, so every chunk but the wave's last
-//! fills its lanes. The nearest hits come with their records in lanes
+//! depth and traced in a later chunk of the same wave, so that most chunks fill their lanes
+//! (a chunk that reaches the queue's end before the bounces of earlier chunks join it does
+//! not). The nearest hits come with their records in lanes
 //! ([`crate::accel::Geometry::nearest_lanes`], which `intersect_batch` runs too); the
 //! interaction (orientation, the origins and their error bound), the light pass
 //! ([`super::point_sums`]), each Phong node's sum and the two rays of task 2 with their
 //! weights run in lanes. What each primitive's material is comes from a table built once per
-//! call ([`Slot`]). Scalar, lane by lane: the tree's bookkeeping (a node's sum, its
-//! children), the mirror and glass bounces, the light emitted by a surface a chain meets, and
+//! call ([`Slot`]). Scalar, lane by lane: the tree's bookkeeping (storing a node's sum, its
+//! children's nodes), the mirror and glass bounces, the light emitted by a surface a chain meets, and
 //! every reflectance but the course's diffuse one (a specular lobe, the Physical model), in
 //! the light terms and the children's weights. Every lane computes what the scalar code
 //! computes for its ray, operation for operation (`Geometry::intersect`'s order and tie rule,
@@ -171,6 +172,7 @@ unsafe fn trace_avx2(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch
 #[inline(always)]
 unsafe fn trace_in<L: Floats>(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
     slot_table(tr, &mut s.slots);
+    debug_assert_eq!(s.nodes.len(), roots.len(), "the roots are nodes 0 to n - 1");
     s.queue.clear();
     s.queue.push(0, roots);
     for depth in 1..=g.max_depth {
