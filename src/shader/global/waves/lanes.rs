@@ -274,6 +274,8 @@ unsafe fn chunk<L: Floats>(
     // ray adds what its surface emits; Phong hits gather their weights and `kd`; the rest
     // (mirror and glass, emitters) wait for their whole interaction below.
     let (mut phong_lanes, mut lit_lanes, mut lambert, mut whole) = (0u32, 0u32, 0u32, 0u32);
+    // The chains' rays that meet an emitter (a subset of `whole`).
+    let mut emitting = 0u32;
     let mut beta = [Vec3A::ZERO; 8];
     let mut kd = [Vec3A::ZERO; 8];
     for i in 0..count {
@@ -286,6 +288,7 @@ unsafe fn chunk<L: Floats>(
         let emits = e.light != NO_LIGHT && tr.effects.emission;
         if node.bounces > 0 {
             if emits {
+                emitting |= 1 << i;
                 whole |= 1 << i;
             } else {
                 node.le += node.tint * Vec3A::ZERO;
@@ -364,7 +367,7 @@ unsafe fn chunk<L: Floats>(
                 light: e.light,
             };
             let node = &mut s.nodes[nodes[i] as usize];
-            if node.bounces > 0 && e.light != NO_LIGHT && tr.effects.emission {
+            if emitting & (1 << i) != 0 {
                 node.le += node.tint * emitted(tr, &si);
             }
             if !e.phong
