@@ -242,7 +242,7 @@ fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
             Plane::through(Vec3A::new(0.0, 0.0, 9.0), -Vec3A::Z).oriented(1.0),
         )),
     ];
-    let rays: Vec<Ray> = (0..8)
+    let rays: Vec<Ray> = (0..16)
         .map(|k| {
             let d = match k {
                 6 => Vec3A::ZERO,
@@ -255,7 +255,7 @@ fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
             }
         })
         .collect();
-    let lane = |f: fn(&Ray) -> f32| -> [f32; 8] { std::array::from_fn(|i| f(&rays[i])) };
+    let lane = |f: fn(&Ray) -> f32| -> [f32; 16] { std::array::from_fn(|i| f(&rays[i])) };
     let parts = [
         lane(|r| r.o.x),
         lane(|r| r.o.y),
@@ -279,16 +279,26 @@ fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
                 })
                 .collect();
             assert!(one.iter().any(|&b| b) && one.iter().any(|&b| !b), "{one:?}");
-            // Four SSE lanes: rays 0 to 3, then 4 to 7; lanes 1 and 2 not live.
-            for first in [0, 4] {
+            // Four SSE lanes: rays 0 to 3, 4 to 7 and so on; lanes 1 and 2 not live.
+            for first in [0, 4, 8, 12] {
                 // SAFETY: `Vec4` runs on every CPU.
                 unsafe { in_lanes::<glam::Vec4>(&g, &parts, first, 0b1001, planes, &one) };
             }
-            // Eight AVX2 lanes; lanes 1 and 4 not live.
+            // Eight AVX2 lanes, rays 0 to 7 then 8 to 15; lanes 1 and 4 not live.
             #[cfg(target_arch = "x86_64")]
             if rtis::accel::Isa::Avx2.available() {
-                // SAFETY: AVX2 is present (checked just above).
-                unsafe { in_lanes::<rtis::accel::F8>(&g, &parts, 0, 0b1110_1101, planes, &one) };
+                for first in [0, 8] {
+                    let live = 0b1110_1101;
+                    // SAFETY: AVX2 is present (checked just above).
+                    unsafe { in_lanes::<rtis::accel::F8>(&g, &parts, first, live, planes, &one) };
+                }
+            }
+            // Sixteen AVX-512 lanes; lanes 1, 4, 8 and 11 not live.
+            #[cfg(target_arch = "x86_64")]
+            if rtis::accel::Isa::Avx512.available() {
+                let live = 0b1111_0110_1110_1101;
+                // SAFETY: AVX-512F is present (checked just above).
+                unsafe { in_lanes::<rtis::accel::F16>(&g, &parts, 0, live, planes, &one) };
             }
         }
     }
@@ -302,21 +312,21 @@ fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
 /// The CPU must run `L`'s instruction set.
 unsafe fn in_lanes<L: rtis::accel::Floats>(
     g: &Geometry,
-    parts: &[[f32; 8]; 8],
+    parts: &[[f32; 16]; 8],
     first: usize,
     live: u32,
     planes: bool,
     one: &[bool],
 ) {
     let v = |k: usize| {
-        let mut row = [0.0; 8];
+        let mut row = [0.0; 16];
         row[..L::LANES].copy_from_slice(&parts[k][first..first + L::LANES]);
         // SAFETY: the caller vouches for the instruction set.
-        unsafe { L::from_array8(row) }
+        unsafe { L::from_array(row) }
     };
-    let flags: [f32; 8] = std::array::from_fn(|i| (live >> i & 1) as f32);
+    let flags: [f32; 16] = std::array::from_fn(|i| (live >> i & 1) as f32);
     // SAFETY: as above.
-    let live_mask = unsafe { L::from_array8(flags).cmpne(L::splat(0.0)) };
+    let live_mask = unsafe { L::from_array(flags).cmpne(L::splat(0.0)) };
     let m = g.occluded_lanes(
         [v(0), v(1), v(2)],
         [v(3), v(4), v(5)],

@@ -1,10 +1,12 @@
-//! The binary on a CPU older than this one (src/accel/simd/): run under QEMU's user-mode
+//! The binary on CPUs older than this one (src/accel/simd/): run under QEMU's user-mode
 //! emulator as its baseline x86-64 CPU (`-cpu qemu64`: SSE2 and SSE3, no AVX, no SSE4, no
-//! POPCNT), which stops a process with SIGILL at its first instruction the CPU lacks. There
-//! the binary must pick the baseline node test, render a mesh scene (closest-hit and shadow
-//! queries through the BVH) and the course's box under the Global shader (batches of rays in
-//! SSE lanes instead of AVX2's) to the same pixels, bit for bit, as the native run (AVX2 on a
-//! CI machine), and refuse `--isa avx2` with an error instead of crashing.
+//! POPCNT) and as an AVX2 CPU without AVX-512 (`-cpu Haswell`), which stop a process with
+//! SIGILL at its first instruction the CPU lacks. There the binary must pick the baseline (or
+//! AVX2) instruction set, render a mesh scene (closest-hit and shadow queries through the BVH)
+//! and the course's box under the Global shader (batches of rays in four SSE or eight AVX2
+//! lanes instead of the native run's) to the same pixels, bit for bit, as the native run
+//! (AVX2 or AVX-512 on a CI machine), and refuse an instruction set it lacks (`--isa`) with an
+//! error instead of crashing.
 //!
 //! Needs `qemu-x86_64` (Debian's qemu-user), which `.ci/run` installs; without it the test
 //! says so and passes, unless `RTIS_REQUIRE_QEMU=1` (set by `.ci/run`) asks for it.
@@ -34,12 +36,12 @@ fn qemu() -> Option<PathBuf> {
     found
 }
 
-/// `rtis args`, natively or under `qemu-x86_64 -cpu qemu64`.
-fn rtis(emulated: Option<&Path>, args: &[&str]) -> Output {
+/// `rtis args`, natively or under `qemu-x86_64 -cpu CPU` (`emulated`: QEMU and the CPU).
+fn rtis(emulated: Option<(&Path, &str)>, args: &[&str]) -> Output {
     let mut cmd = match emulated {
-        Some(qemu) => {
+        Some((qemu, cpu)) => {
             let mut c = Command::new(qemu);
-            c.args(["-cpu", "qemu64", RTIS]);
+            c.args(["-cpu", cpu, RTIS]);
             c
         }
         None => Command::new(RTIS),
@@ -93,13 +95,13 @@ fn same_pixels(scene: &str, native: &[u32], old: &[u32]) {
 }
 
 #[test]
-fn an_older_cpu_renders_the_same_image_through_the_baseline_node_test() {
+fn older_cpus_render_the_same_images_in_their_own_instruction_sets() {
     // The native run must be the other instruction set where CI asks for it.
     rtis::accel::require_all_isas();
     let Some(qemu) = qemu() else { return };
     let tmp = TempDir::new();
     let dir = &tmp.0;
-    let render = |emulated: Option<&Path>, scene: &str, name: &str| {
+    let render = |emulated: Option<(&Path, &str)>, scene: &str, name: &str| {
         let scene = format!("{}/scenes/{scene}", env!("CARGO_MANIFEST_DIR"));
         let path = dir.join(name);
         let out = rtis(
@@ -127,36 +129,49 @@ fn an_older_cpu_renders_the_same_image_through_the_baseline_node_test() {
         let bits: Vec<u32> = image.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect();
         (bits, stderr(&out))
     };
-    let (native, native_log) = render(None, "mesh.ron", "native.exr");
-    let (old, old_log) = render(Some(&qemu), "mesh.ron", "qemu64.exr");
-    let native_isa = rtis::accel::Isa::detect().name();
-    assert!(
-        native_log.contains(&format!("node test in {native_isa}")),
-        "{native_log}"
-    );
-    assert!(old_log.contains("node test in baseline"), "{old_log}");
-    same_pixels("mesh.ron", &native, &old);
-    // No BVH: the Global shader's batches of rays, in four SSE lanes here.
-    let (native, _) = render(None, "cornell-two-bounce.ron", "box-native.exr");
-    let (old, _) = render(Some(&qemu), "cornell-two-bounce.ron", "box-qemu64.exr");
-    same_pixels("cornell-two-bounce.ron", &native, &old);
-    // Asked for an instruction set it lacks, the bench refuses by name.
-    let refused = rtis(
-        Some(&qemu),
-        &[
-            "bench",
-            "--section",
-            "meshes",
-            "--triangles",
-            "1000",
-            "--isa",
-            "avx2",
-        ],
-    );
-    assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
-    assert!(
-        stderr(&refused).contains("--isa avx2: this CPU does not run it"),
-        "{}",
-        stderr(&refused)
-    );
+    let native_isa = rtis::accel::Isa::detect();
+    let (mesh, mesh_log) = render(None, "mesh.ron", "native.exr");
+    let (cornell, cornell_log) = render(None, "cornell-two-bounce.ron", "box-native.exr");
+    let says = |log: &str, isa: rtis::accel::Isa| {
+        let simd = format!("SIMD: {}, {} rays per batch", isa.name(), isa.lanes());
+        assert!(log.contains(&simd), "{simd}?\n{log}");
+    };
+    says(&cornell_log, native_isa);
+    let node = format!("node test in {}", native_isa.node_test().name());
+    assert!(mesh_log.contains(&node), "{node}?\n{mesh_log}");
+    for (cpu, isa, lacks) in [
+        ("qemu64", rtis::accel::Isa::Baseline, "avx2"),
+        ("Haswell", rtis::accel::Isa::Avx2, "avx512"),
+    ] {
+        let emulated = Some((qemu.as_path(), cpu));
+        let (old, old_log) = render(emulated, "mesh.ron", &format!("{cpu}.exr"));
+        says(&old_log, isa);
+        let node = format!("node test in {}", isa.name());
+        assert!(old_log.contains(&node), "{cpu}: {node}?\n{old_log}");
+        same_pixels(&format!("mesh.ron on {cpu}"), &mesh, &old);
+        // No BVH: the Global shader's batches of rays, in the emulated CPU's lanes.
+        let (old, old_log) = render(
+            emulated,
+            "cornell-two-bounce.ron",
+            &format!("box-{cpu}.exr"),
+        );
+        says(&old_log, isa);
+        same_pixels(&format!("cornell-two-bounce.ron on {cpu}"), &cornell, &old);
+        // Asked for an instruction set it lacks, the bench refuses by name.
+        let refused = rtis(
+            emulated,
+            &[
+                "bench",
+                "--section",
+                "meshes",
+                "--triangles",
+                "1000",
+                "--isa",
+                lacks,
+            ],
+        );
+        assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+        let message = format!("--isa {lacks}: this CPU does not run it");
+        assert!(stderr(&refused).contains(&message), "{}", stderr(&refused));
+    }
 }

@@ -3,7 +3,7 @@
 //! A shader that holds many rays at once (the Global shader's tree of indirect rays) hands
 //! them over together, or builds them in lanes itself (the shadow rays of its hits,
 //! [`Geometry::occluded_lanes`]). Where every primitive is packed (planes,
-//! and the spheres of small scenes), the rays fill the lanes (eight with AVX2, four with SSE)
+//! and the spheres of small scenes), the rays fill the lanes (sixteen with AVX-512, eight with AVX2, four with SSE)
 //! and each primitive is splatted across them ([`Geometry::sphere_each`],
 //! [`Geometry::plane_each`]): no lane holds a padding primitive (only a batch's last chunk
 //! may repeat its last ray), no closest-lane search runs per ray, and each ray's constants are
@@ -20,7 +20,7 @@
 
 use super::Geometry;
 use super::lanes::{RayLanes, SurfaceLanes, plane_surface, sphere_surface};
-use super::simd::{Floats, Isa};
+use super::simd::{Floats, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
 use glam::Vec4;
 
@@ -54,14 +54,14 @@ fn keep<L: Floats>(ok: L::Mask, x: ([L; 3], L), into: (&mut [L; 3], &mut L)) {
 /// # Safety
 /// The CPU must run `L`'s instruction set.
 #[inline(always)]
-unsafe fn chunk<L: Floats>(rays: &[Ray], k: usize) -> ([&Ray; 8], L) {
+unsafe fn chunk<L: Floats>(rays: &[Ray], k: usize) -> ([&Ray; MAX_LANES], L) {
     let last = rays.len() - 1;
-    let mut eight = [&rays[last]; 8];
-    for (i, r) in eight.iter_mut().enumerate().take(L::LANES) {
+    let mut lanes = [&rays[last]; MAX_LANES];
+    for (i, r) in lanes.iter_mut().enumerate().take(L::LANES) {
         *r = &rays[(k + i).min(last)];
     }
     // SAFETY: the caller vouches for the instruction set.
-    (eight, unsafe { L::from_array8(eight.map(|r| r.t_max)) })
+    (lanes, unsafe { L::from_array(lanes.map(|r| r.t_max)) })
 }
 
 impl Geometry {
@@ -83,6 +83,9 @@ impl Geometry {
             // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => unsafe { self.intersect_avx2(rays, hits) },
+            // SAFETY: as above.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => unsafe { self.intersect_avx512(rays, hits) },
             // SAFETY: `Vec4` runs on every CPU.
             _ => unsafe { self.intersect_in::<Vec4>(rays, hits) },
         }
@@ -104,6 +107,9 @@ impl Geometry {
             // SAFETY: as in `intersect_batch`.
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => unsafe { self.occluded_avx2(rays, planes, blocked) },
+            // SAFETY: as above.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => unsafe { self.occluded_avx512(rays, planes, blocked) },
             // SAFETY: `Vec4` runs on every CPU.
             _ => unsafe { self.occluded_in::<Vec4>(rays, planes, blocked) },
         }
@@ -131,6 +137,28 @@ impl Geometry {
         unsafe { self.occluded_in::<super::simd::avx2::F8>(rays, planes, blocked) }
     }
 
+    /// [`Geometry::intersect_batch`] in sixteen AVX-512 lanes.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn intersect_avx512(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+        // SAFETY: this function runs only where AVX-512F was found.
+        unsafe { self.intersect_in::<super::simd::avx512::F16>(rays, hits) }
+    }
+
+    /// [`Geometry::occluded_batch`] in sixteen AVX-512 lanes.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn occluded_avx512(&self, rays: &[Ray], planes: bool, blocked: &mut Vec<bool>) {
+        // SAFETY: this function runs only where AVX-512F was found.
+        unsafe { self.occluded_in::<super::simd::avx512::F16>(rays, planes, blocked) }
+    }
+
     /// Which of the segments in the lanes are blocked, as [`Geometry::occluded`] answers each
     /// (or [`Geometry::occluded_in_room`] if not `planes`): from origins `o` (with errors
     /// `o_err`) along unit directions `d` to `t_max`. Only the lanes of `live` are asked; the
@@ -147,7 +175,7 @@ impl Geometry {
     ) -> L::Mask {
         if !self.all_packed() {
             // Ray by ray through the BVH.
-            let (mut v, mut lane) = ([[0.0f32; 8]; 8], [0.0f32; 8]);
+            let (mut v, mut lane) = ([[0.0f32; MAX_LANES]; 8], [0.0f32; MAX_LANES]);
             for (k, x) in [o[0], o[1], o[2], d[0], d[1], d[2], o_err, t_max]
                 .into_iter()
                 .enumerate()
@@ -173,7 +201,7 @@ impl Geometry {
                 *blocked = if hit { 1.0 } else { 0.0 };
             }
             // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
-            return unsafe { L::from_array8(lane).cmpne(L::splat(0.0)) };
+            return unsafe { L::from_array(lane).cmpne(L::splat(0.0)) };
         }
         let lanes = RayLanes::from_parts(o, d, o_err);
         // No lane blocked yet (nothing is below itself, NaN included).
@@ -203,7 +231,7 @@ impl Geometry {
             let lanes = unsafe { RayLanes::<L>::gather(&eight) };
             let near = unsafe { self.nearest_lanes(&lanes, t_max) };
             let h = near.hit;
-            let mut v = [[0.0f32; 8]; 10];
+            let mut v = [[0.0f32; MAX_LANES]; 10];
             for (row, x) in [
                 near.t,
                 near.slot,
@@ -332,7 +360,7 @@ impl Geometry {
                 (
                     L::transpose3(&four.map(|r| &r.o)),
                     L::transpose3(&four.map(|r| &r.d)),
-                    L::from_array8(four.map(|r| r.o_err)),
+                    L::from_array(four.map(|r| r.o_err)),
                 )
             };
             // Every lane asks (nothing is below itself: all clear, then all set).

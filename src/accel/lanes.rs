@@ -9,7 +9,7 @@
 //! SSE or eight in AVX2 (the tests are written once over the `Floats` lane type). Each lane computes what
 //! the scalar test computes for its pair, so every layout gives the same bits.
 
-use super::simd::Floats;
+use super::simd::{Floats, MAX_LANES};
 use crate::geometry::{Ray, gamma};
 use crate::shape::{Plane, Sphere};
 use glam::{BVec4A, Vec4};
@@ -52,12 +52,12 @@ impl<L: Floats> RayLanes<L> {
     /// # Safety
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    pub unsafe fn gather(rays: &[&Ray; 8]) -> Self {
+    pub unsafe fn gather(rays: &[&Ray; MAX_LANES]) -> Self {
         // SAFETY: the caller vouches for the instruction set.
         unsafe {
             let o = L::transpose3(&rays.map(|r| &r.o));
             let d = L::transpose3(&rays.map(|r| &r.d));
-            RayLanes::from_parts(o, d, L::from_array8(rays.map(|r| r.o_err)))
+            RayLanes::from_parts(o, d, L::from_array(rays.map(|r| r.o_err)))
         }
     }
 

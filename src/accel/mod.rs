@@ -13,7 +13,9 @@ pub use bvh::{Bvh, Node};
 pub use prim::{FLAT, Prim};
 #[cfg(target_arch = "x86_64")]
 pub use simd::avx2::F8;
-pub use simd::{Floats, Isa, require_all_isas};
+#[cfg(target_arch = "x86_64")]
+pub use simd::avx512::F16;
+pub use simd::{Floats, Isa, MAX_LANES, require_all_isas};
 pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::{BvhRay, Hit, Ray};

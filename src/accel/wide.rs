@@ -399,9 +399,10 @@ impl WideBvh {
         debug_assert!(self.isa.available());
         match self.isa {
             // SAFETY: `isa` is private to this file and set only by `collapse` and `Default`
-            // (both `Isa::detect`) and by `set_isa`, which checks: AVX2 only where the CPU has it.
+            // (both `Isa::detect`) and by `set_isa`, which checks: AVX2 (or AVX-512, whose
+            // CPUs all have AVX2: its node test is AVX2's) only where the CPU has it.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => unsafe { self.closest_avx2(ray, test, touch) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { self.closest_avx2(ray, test, touch) },
             // SAFETY: the baseline runs on every CPU.
             _ => unsafe { self.closest_in::<Halves>(ray, test, touch) },
         }
@@ -414,9 +415,10 @@ impl WideBvh {
         debug_assert!(self.isa.available());
         match self.isa {
             // SAFETY: `isa` is private to this file and set only by `collapse` and `Default`
-            // (both `Isa::detect`) and by `set_isa`, which checks: AVX2 only where the CPU has it.
+            // (both `Isa::detect`) and by `set_isa`, which checks: AVX2 (or AVX-512, whose
+            // CPUs all have AVX2: its node test is AVX2's) only where the CPU has it.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => unsafe { self.any_avx2(ray, test) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { self.any_avx2(ray, test) },
             // SAFETY: the baseline runs on every CPU.
             _ => unsafe { self.any_in::<Halves>(ray, test) },
         }

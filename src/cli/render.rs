@@ -165,11 +165,13 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
     eprintln!("effects {}", prepared.effects);
+    let isa = prepared.geometry.bvh.isa();
+    eprintln!("SIMD: {}, {} rays per batch", isa.name(), isa.lanes());
     if prepared.geometry.in_bvh > 0 {
         eprintln!(
             "BVH: {} primitives, node test in {}",
             prepared.geometry.in_bvh,
-            prepared.geometry.bvh.isa().name()
+            isa.node_test().name()
         );
     }
     let pool = rayon::ThreadPoolBuilder::new()

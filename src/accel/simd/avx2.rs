@@ -82,7 +82,7 @@ pub struct F8(__m256);
 pub struct M8(__m256);
 
 // SAFETY (of the `unsafe` blocks from here on): an `F8` or `M8` exists, so AVX2 was found (the
-// only constructors are the unsafe `Floats::splat`, `from_slice`, `from_array8` and
+// only constructors are the unsafe `Floats::splat`, `from_slice`, `from_array` and
 // `transpose3`, and the operations
 // below, which take a value). The intrinsics only compute on registers, except the marked
 // loads and stores.
@@ -155,7 +155,7 @@ static PACK: [[u32; 8]; 256] = {
     table
 };
 
-// SAFETY: `splat`, `from_slice`, `from_array8` and `transpose3` are the only constructors and
+// SAFETY: `splat`, `from_slice`, `from_array` and `transpose3` are the only constructors and
 // are unsafe, with AVX2 as the
 // caller's duty; see above for the rest.
 unsafe impl Floats for F8 {
@@ -172,11 +172,13 @@ unsafe impl Floats for F8 {
         F8(unsafe { _mm256_loadu_ps(x.as_ptr()) })
     }
     #[inline(always)]
-    unsafe fn from_array8(v: [f32; 8]) -> Self {
+    unsafe fn from_array<const N: usize>(v: [f32; N]) -> Self {
+        const { assert!(N >= 8, "eight values") };
         F8(unsafe { _mm256_setr_ps(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]) })
     }
     #[inline(always)]
-    unsafe fn transpose3(v: &[&glam::Vec3A; 8]) -> [Self; 3] {
+    unsafe fn transpose3<const N: usize>(v: &[&glam::Vec3A; N]) -> [Self; 3] {
+        const { assert!(N >= 8, "eight vectors") };
         // Vectors i and i + 4 share a register (low and high half); a 4x4 transposition
         // within both halves at once then puts vector i's coordinates in lane i.
         unsafe {

@@ -17,11 +17,13 @@ unsafe impl Floats for Vec4 {
         Vec4::from_slice(x)
     }
     #[inline(always)]
-    unsafe fn from_array8(v: [f32; 8]) -> Self {
+    unsafe fn from_array<const N: usize>(v: [f32; N]) -> Self {
+        const { assert!(N >= 4, "four values") };
         Vec4::new(v[0], v[1], v[2], v[3])
     }
     #[inline(always)]
-    unsafe fn transpose3(v: &[&glam::Vec3A; 8]) -> [Self; 3] {
+    unsafe fn transpose3<const N: usize>(v: &[&glam::Vec3A; N]) -> [Self; 3] {
+        const { assert!(N >= 4, "four vectors") };
         let m = glam::Mat4::from_cols(
             v[0].extend(0.0),
             v[1].extend(0.0),

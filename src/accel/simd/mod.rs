@@ -1,16 +1,22 @@
 //! Float lanes in the instruction set the CPU has: the closed set [`Isa`], one file per
 //! variant, chosen at run time. [`Lanes8`] serves the wide BVH's node test (eight lanes in
-//! both sets); [`Floats`] serves the sphere and plane tests of batched rays (four lanes in
-//! SSE, eight in AVX2).
+//! every set: AVX-512 runs AVX2's); [`Floats`] serves the sphere and plane tests of batched
+//! rays (four lanes in SSE, eight in AVX2, sixteen in AVX-512).
 //!
 //! Every variant computes the same IEEE operations lane by lane (no fused multiply-add), so
 //! the queries' answers are bit-identical whichever runs; only the speed differs. The
-//! build targets baseline x86-64, so a binary runs on any x86-64 CPU and takes AVX2 where
-//! [`Isa::detect`] finds it, as Embree's ISA dispatch does.
+//! build targets baseline x86-64, so a binary runs on any x86-64 CPU and takes AVX2 or
+//! AVX-512 where [`Isa::detect`] finds it, as Embree's ISA dispatch does.
 
 #[cfg(target_arch = "x86_64")]
 pub mod avx2;
+#[cfg(target_arch = "x86_64")]
+pub mod avx512;
 pub mod baseline;
+
+/// The most lanes a [`Floats`] has (AVX-512's sixteen): the size of the arrays that the
+/// batched queries and the lanes kernel fill a lane at a time.
+pub const MAX_LANES: usize = 16;
 
 /// The instruction sets the node test is written for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -19,12 +25,17 @@ pub enum Isa {
     Baseline,
     /// One eight-lane AVX2 register (x86-64 only).
     Avx2,
+    /// Sixteen-lane AVX-512F registers for the batched queries and the lanes kernel, AVX2
+    /// for the node test (x86-64 only; every AVX-512 CPU has AVX2).
+    Avx512,
 }
 
 impl Isa {
     /// The widest instruction set this CPU runs.
     pub fn detect() -> Isa {
-        if Isa::Avx2.available() {
+        if Isa::Avx512.available() {
+            Isa::Avx512
+        } else if Isa::Avx2.available() {
             Isa::Avx2
         } else {
             Isa::Baseline
@@ -37,14 +48,19 @@ impl Isa {
             Isa::Baseline => true,
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => {
+                std::arch::is_x86_feature_detected!("avx512f")
+                    && std::arch::is_x86_feature_detected!("avx2")
+            }
             #[cfg(not(target_arch = "x86_64"))]
-            Isa::Avx2 => false,
+            Isa::Avx2 | Isa::Avx512 => false,
         }
     }
 
     /// Every instruction set this CPU runs, baseline first.
     pub fn all_available() -> Vec<Isa> {
-        [Isa::Baseline, Isa::Avx2]
+        [Isa::Baseline, Isa::Avx2, Isa::Avx512]
             .into_iter()
             .filter(|isa| isa.available())
             .collect()
@@ -55,6 +71,25 @@ impl Isa {
         match self {
             Isa::Baseline => "baseline",
             Isa::Avx2 => "avx2",
+            Isa::Avx512 => "avx512",
+        }
+    }
+
+    /// How many rays a batched query or the lanes kernel holds at once ([`Floats::LANES`]).
+    pub fn lanes(self) -> usize {
+        match self {
+            Isa::Baseline => 4,
+            Isa::Avx2 => 8,
+            Isa::Avx512 => 16,
+        }
+    }
+
+    /// The instruction set of the wide BVH's node test ((`Lanes8`): AVX-512 runs AVX2's, as
+    /// a node's eight children fill eight lanes.
+    pub fn node_test(self) -> Isa {
+        match self {
+            Isa::Avx512 => Isa::Avx2,
+            isa => isa,
         }
     }
 }
@@ -100,7 +135,8 @@ pub trait Lanes8: Copy {
 }
 
 /// A vector of `f32` lanes with the operations of the sphere and plane tests
-/// (`accel::lanes`): four lanes in a `glam::Vec4` on every CPU, eight in an AVX2 register.
+/// (`accel::lanes`): four lanes in a `glam::Vec4` on every CPU, eight in an AVX2 register,
+/// sixteen in an AVX-512 one.
 ///
 /// As for the node test's lanes, every operation is IEEE single precision lane by lane,
 /// exactly as glam's `Vec4` computes it (negation and `copysign` as sign-bit operations, `max`
@@ -110,7 +146,7 @@ pub trait Lanes8: Copy {
 /// operands of a sum; every comparison treats all NaNs alike.)
 ///
 /// # Safety
-/// Making a value from nothing (`splat`, `from_slice`, `from_array8`, `transpose3`) runs the
+/// Making a value from nothing (`splat`, `from_slice`, `from_array`, `transpose3`) runs the
 /// set's instructions, so only
 /// callers that checked the CPU may do it; every other operation takes a value, whose existence
 /// shows that the check was made.
@@ -122,7 +158,7 @@ pub unsafe trait Floats:
     + std::ops::Div<Output = Self>
     + std::ops::Neg<Output = Self>
 {
-    /// How many lanes.
+    /// How many lanes (at most [`MAX_LANES`]).
     const LANES: usize;
     /// One flag per lane, all bits set or clear.
     type Mask: Copy
@@ -140,17 +176,18 @@ pub unsafe trait Floats:
     /// The CPU must run the set; `x` holds at least `LANES` values.
     unsafe fn from_slice(x: &[f32]) -> Self;
     /// The first `LANES` values of `v`, one per lane, from registers (no trip through memory,
-    /// which would stall the load behind the separate stores).
+    /// which would stall the load behind the separate stores). `N` is at least `LANES` (a
+    /// compile-time check).
     ///
     /// # Safety
     /// The CPU must run the set.
-    unsafe fn from_array8(v: [f32; 8]) -> Self;
+    unsafe fn from_array<const N: usize>(v: [f32; N]) -> Self;
     /// The `x`, `y` and `z` of the first `LANES` vectors of `v`, lane `i` from `v[i]`: a
-    /// transposition by shuffles.
+    /// transposition by shuffles. `N` is at least `LANES` (a compile-time check).
     ///
     /// # Safety
     /// The CPU must run the set.
-    unsafe fn transpose3(v: &[&glam::Vec3A; 8]) -> [Self; 3];
+    unsafe fn transpose3<const N: usize>(v: &[&glam::Vec3A; N]) -> [Self; 3];
     /// The lanes, written to the first `LANES` values of `out`.
     fn write_to(self, out: &mut [f32]);
     /// The lanes of `bits` (bit `i` for lane `i`), packed in lane order into the first values
@@ -185,15 +222,22 @@ pub unsafe trait Floats:
     fn bitmask(m: Self::Mask) -> u32;
 }
 
-/// For tests that compare instruction sets: panics if the environment asks for all of them
-/// (`RTIS_REQUIRE_AVX2=1`, which `.ci/run` sets) and the CPU lacks one, so that a CI machine
-/// without AVX2 cannot pass by comparing the baseline with itself.
+/// For tests that compare instruction sets: panics if the environment asks for one the CPU
+/// lacks (`RTIS_REQUIRE_AVX2=1`, which `.ci/run` sets, and `RTIS_REQUIRE_AVX512=1`, which it
+/// sets where the CPU reports AVX-512F), so that a CI machine cannot pass by comparing the
+/// baseline with itself.
 pub fn require_all_isas() {
-    if std::env::var_os("RTIS_REQUIRE_AVX2").is_some_and(|v| v == "1") {
-        assert!(
-            Isa::Avx2.available(),
-            "RTIS_REQUIRE_AVX2=1 but this CPU has no AVX2"
-        );
+    for (var, isa) in [
+        ("RTIS_REQUIRE_AVX2", Isa::Avx2),
+        ("RTIS_REQUIRE_AVX512", Isa::Avx512),
+    ] {
+        if std::env::var_os(var).is_some_and(|v| v == "1") {
+            assert!(
+                isa.available(),
+                "{var}=1 but this CPU does not run {}",
+                isa.name()
+            );
+        }
     }
 }
 
@@ -221,23 +265,12 @@ mod tests {
         2.0,
     ];
 
-    /// True if this CPU has AVX2 to compare with the baseline; false (saying so) if not, which
-    /// fails instead where `RTIS_REQUIRE_AVX2=1`.
-    fn avx2_to_compare() -> bool {
-        super::require_all_isas();
-        let present = Isa::Avx2.available();
-        if !present {
-            eprintln!("no AVX2 here: nothing to compare");
-        }
-        present
-    }
-
     /// Every lane operation gives the same bits in both instruction sets, on the values where
     /// implementations differ if they differ at all: NaN in either operand, zeros of both
     /// signs, infinities, equal operands, subnormals and bytes at both ends.
     #[test]
     fn every_lane_operation_agrees_bit_for_bit() {
-        if !avx2_to_compare() {
+        if !to_compare(Isa::Avx2) {
             return;
         }
         let (specials, n) = (SPECIALS, SPECIALS.len());
@@ -296,61 +329,76 @@ mod tests {
         }
     }
 
-    /// Every [`Floats`] operation gives the same bits in eight AVX2 lanes as in two `Vec4`
-    /// halves, on the same special values (NaN of both signs, signed zeros, infinities,
+    /// True if this CPU runs `isa` to compare with the baseline; false (saying so) if not,
+    /// which fails instead where the environment requires it ([`require_all_isas`]).
+    fn to_compare(isa: Isa) -> bool {
+        super::require_all_isas();
+        let present = isa.available();
+        if !present {
+            eprintln!("no {} here: nothing to compare", isa.name());
+        }
+        present
+    }
+
+    /// The first `L::LANES` lanes' bits, every NaN as one: which NaN an operation on two NaNs
+    /// returns depends on the order of its operands, which IEEE leaves open and the compiler
+    /// may swap.
+    fn lane_bits<L: Floats>(v: L) -> Vec<u32> {
+        let mut out = [0.0; MAX_LANES];
+        v.write_to(&mut out);
+        out[..L::LANES]
+            .iter()
+            .map(|x| if x.is_nan() { u32::MAX } else { x.to_bits() })
+            .collect()
+    }
+
+    /// Every [`Floats`] operation of `L` gives the same bits as `glam::Vec4` on each quarter of
+    /// its lanes, on the special values (NaN of both signs, signed zeros, infinities,
     /// subnormals, equal operands), and the transposition and gathers put each value in its
     /// lane.
-    #[test]
-    fn every_float_operation_agrees_bit_for_bit() {
-        use super::avx2::F8;
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    unsafe fn floats_agree_with_vec4<L: Floats>() {
         use glam::Vec4;
-        if !avx2_to_compare() {
-            return;
-        }
         let (specials, n) = (SPECIALS, SPECIALS.len());
-        let lanes = |k: usize| -> [f32; 8] { std::array::from_fn(|i| specials[(k + 5 * i) % n]) };
-        // Bits, every NaN as one: which NaN an operation on two NaNs returns depends on the
-        // order of its operands, which IEEE leaves open and the compiler may swap.
-        let bits = |v: [f32; 8]| v.map(|x| if x.is_nan() { u32::MAX } else { x.to_bits() });
-        // SAFETY: AVX2 is present (checked above); `Vec4` runs everywhere.
+        let lanes =
+            |k: usize| -> [f32; MAX_LANES] { std::array::from_fn(|i| specials[(k + 5 * i) % n]) };
+        let quarters = L::LANES / 4;
+        // SAFETY: the caller vouches for `L`; `Vec4` runs everywhere.
         unsafe {
-            let f8 = |v: F8| {
-                let mut out = [0.0; 8];
-                v.write_to(&mut out);
-                bits(out)
-            };
-            let v4 = |lo: Vec4, hi: Vec4| {
-                let mut out = [0.0; 8];
-                lo.write_to(&mut out[..4]);
-                hi.write_to(&mut out[4..]);
-                bits(out)
+            let v4 = |q: &[Vec4]| -> Vec<u32> { q.iter().flat_map(|&v| lane_bits(v)).collect() };
+            let mask4 = |q: &[u32]| -> u32 {
+                q.iter()
+                    .enumerate()
+                    .fold(0, |acc, (k, &m)| acc | m << (4 * k))
             };
             for a in 0..n {
                 for b in 0..n {
                     let (x, y) = (lanes(a), lanes(b));
-                    let (xv, yv) = (F8::from_slice(&x), F8::from_slice(&y));
-                    let (xl, xh) = (Vec4::from_slice(&x[..4]), Vec4::from_slice(&x[4..]));
-                    let (yl, yh) = (Vec4::from_slice(&y[..4]), Vec4::from_slice(&y[4..]));
-                    // `$e` over `p` and `q`, in eight lanes and in two halves.
+                    let (xv, yv) = (L::from_slice(&x), L::from_slice(&y));
+                    let xq: Vec<Vec4> = (0..quarters)
+                        .map(|k| Vec4::from_slice(&x[4 * k..]))
+                        .collect();
+                    let yq: Vec<Vec4> = (0..quarters)
+                        .map(|k| Vec4::from_slice(&y[4 * k..]))
+                        .collect();
+                    // `$e` over `p` and `q`, in `L`'s lanes and in `Vec4` quarters.
                     macro_rules! same {
                         (|$p:ident, $q:ident| $e:expr) => {{
                             #[allow(unused_variables)]
-                            let eight = {
+                            let wide = {
                                 let ($p, $q) = (xv, yv);
                                 $e
                             };
                             #[allow(unused_variables)]
-                            let (lo, hi) = (
-                                {
-                                    let ($p, $q) = (xl, yl);
+                            let four: Vec<Vec4> = (0..quarters)
+                                .map(|k| {
+                                    let ($p, $q) = (xq[k], yq[k]);
                                     $e
-                                },
-                                {
-                                    let ($p, $q) = (xh, yh);
-                                    $e
-                                },
-                            );
-                            assert_eq!(f8(eight), v4(lo, hi), "{x:?} {y:?}");
+                                })
+                                .collect();
+                            assert_eq!(lane_bits(wide), v4(&four), "{x:?} {y:?}");
                         }};
                     }
                     same!(|p, q| p + q);
@@ -362,48 +410,70 @@ mod tests {
                     same!(|p, q| Floats::abs(p));
                     same!(|p, q| Floats::copysign(p, q));
                     same!(|p, q| Floats::max(p, q));
-                    let masks = |p: F8, q: F8| {
-                        [p.cmpge(q), p.cmple(q), p.cmpgt(q), p.cmplt(q), p.cmpne(q)]
-                            .map(F8::bitmask)
+                    let masks = |p: L, q: L| {
+                        [p.cmpge(q), p.cmple(q), p.cmpgt(q), p.cmplt(q), p.cmpne(q)].map(L::bitmask)
                     };
                     let masks4 = |p: Vec4, q: Vec4| {
                         [p.cmpge(q), p.cmple(q), p.cmpgt(q), p.cmplt(q), p.cmpne(q)]
                             .map(|m| m.bitmask())
                     };
-                    let (lo, hi) = (masks4(xl, yl), masks4(xh, yh));
-                    let joined: [u32; 5] = std::array::from_fn(|i| lo[i] | hi[i] << 4);
+                    let per: Vec<[u32; 5]> = (0..quarters).map(|k| masks4(xq[k], yq[k])).collect();
+                    let joined: [u32; 5] = std::array::from_fn(|i| {
+                        mask4(&per.iter().map(|m| m[i]).collect::<Vec<u32>>())
+                    });
                     assert_eq!(masks(xv, yv), joined, "{x:?} {y:?}");
                     let m = xv.cmplt(yv);
-                    let (ml, mh) = (xl.cmplt(yl), xh.cmplt(yh));
+                    let mq: Vec<_> = (0..quarters).map(|k| xq[k].cmplt(yq[k])).collect();
+                    let sel: Vec<Vec4> = (0..quarters)
+                        .map(|k| Vec4::select(mq[k], xq[k], yq[k]))
+                        .collect();
+                    assert_eq!(lane_bits(L::select(m, xv, yv)), v4(&sel));
+                    assert_eq!(L::any(m), mq.iter().any(|m| m.any()));
+                    assert_eq!(L::all(m), mq.iter().all(|m| m.all()));
+                    let quarter_masks = |f: &dyn Fn(usize) -> u32| {
+                        mask4(&(0..quarters).map(f).collect::<Vec<u32>>())
+                    };
+                    assert_eq!(L::bitmask(!m), quarter_masks(&|k| (!mq[k]).bitmask()));
                     assert_eq!(
-                        f8(F8::select(m, xv, yv)),
-                        v4(Vec4::select(ml, xl, yl), Vec4::select(mh, xh, yh))
-                    );
-                    assert_eq!(F8::any(m), ml.any() || mh.any());
-                    assert_eq!(F8::all(m), ml.all() && mh.all());
-                    assert_eq!(F8::bitmask(!m), (!ml).bitmask() | (!mh).bitmask() << 4);
-                    assert_eq!(
-                        F8::bitmask(m & xv.cmpne(yv)),
-                        (ml & xl.cmpne(yl)).bitmask() | (mh & xh.cmpne(yh)).bitmask() << 4
+                        L::bitmask(m & xv.cmpne(yv)),
+                        quarter_masks(&|k| (mq[k] & xq[k].cmpne(yq[k])).bitmask())
                     );
                     assert_eq!(
-                        F8::bitmask(m | xv.cmpne(yv)),
-                        (ml | xl.cmpne(yl)).bitmask() | (mh | xh.cmpne(yh)).bitmask() << 4
+                        L::bitmask(m | xv.cmpne(yv)),
+                        quarter_masks(&|k| (mq[k] | xq[k].cmpne(yq[k])).bitmask())
                     );
-                    assert_eq!(f8(F8::from_array8(x)), bits(x));
-                    assert_eq!(f8(F8::splat(x[3])), bits([x[3]; 8]));
+                    let exact = |v: &[f32]| -> Vec<u32> {
+                        v[..L::LANES]
+                            .iter()
+                            .map(|x| if x.is_nan() { u32::MAX } else { x.to_bits() })
+                            .collect()
+                    };
+                    assert_eq!(lane_bits(L::from_array(x)), exact(&x));
+                    assert_eq!(lane_bits(L::splat(x[3])), exact(&[x[3]; MAX_LANES]));
                 }
             }
             // The transposition: lane i holds vector i's coordinates.
-            let v: [glam::Vec3A; 8] =
+            let v: [glam::Vec3A; MAX_LANES] =
                 std::array::from_fn(|i| glam::Vec3A::new(i as f32, 10.0 + i as f32, -(i as f32)));
-            let t = F8::transpose3(&std::array::from_fn(|i| &v[i]));
-            let t4 = Vec4::transpose3(&std::array::from_fn(|i| &v[i]));
-            for (axis, (lane8, lane4)) in t.iter().zip(&t4).enumerate() {
-                let want: [f32; 8] = std::array::from_fn(|i| v[i][axis]);
-                assert_eq!(f8(*lane8), bits(want));
-                assert_eq!(lane4.to_array(), want[..4]);
+            let t = L::transpose3(&std::array::from_fn::<_, MAX_LANES, _>(|i| &v[i]));
+            for (axis, lane) in t.iter().enumerate() {
+                let want: Vec<u32> = (0..L::LANES).map(|i| v[i][axis].to_bits()).collect();
+                assert_eq!(lane_bits(*lane), want, "axis {axis}");
             }
+        }
+    }
+
+    #[test]
+    fn every_float_operation_agrees_bit_for_bit() {
+        // SAFETY: `Vec4` runs everywhere.
+        unsafe { floats_agree_with_vec4::<glam::Vec4>() };
+        if to_compare(Isa::Avx2) {
+            // SAFETY: AVX2 is present.
+            unsafe { floats_agree_with_vec4::<super::avx2::F8>() };
+        }
+        if to_compare(Isa::Avx512) {
+            // SAFETY: AVX-512F is present.
+            unsafe { floats_agree_with_vec4::<super::avx512::F16>() };
         }
     }
 
@@ -444,13 +514,36 @@ mod tests {
                 want,
                 "baseline, lanes {bits:08b}"
             );
-            if !avx2_to_compare() {
+            if !to_compare(Isa::Avx2) {
                 continue;
             }
             let mut out = [0.0f32; 8];
             // SAFETY: AVX2 is present (checked above).
             unsafe { F8::from_slice(&values) }.compress(bits, &mut out);
             assert_eq!(bits_of(&out[..want.len()]), want, "AVX2, lanes {bits:08b}");
+        }
+        if !to_compare(Isa::Avx512) {
+            return;
+        }
+        // Sixteen lanes: the eight values and their negations, every set of lanes.
+        let sixteen: [f32; 16] = std::array::from_fn(|i| match i < 8 {
+            true => values[i],
+            false => -values[i - 8],
+        });
+        // SAFETY: AVX-512F is present (checked above).
+        let v = unsafe { super::avx512::F16::from_slice(&sixteen) };
+        for bits in 0..1u32 << 16 {
+            let want: Vec<u32> = (0..16)
+                .filter(|i| bits & (1 << i) != 0)
+                .map(|i| sixteen[i].to_bits())
+                .collect();
+            let mut out = [0.0f32; 16];
+            v.compress(bits, &mut out);
+            assert_eq!(
+                bits_of(&out[..want.len()]),
+                want,
+                "AVX-512, lanes {bits:016b}"
+            );
         }
     }
 }

@@ -18,7 +18,7 @@ mod lanes;
 
 use super::Global;
 use crate::accel::lanes::dot;
-use crate::accel::{Floats, Geometry, Isa};
+use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
 use crate::light::Light;
 use crate::material::{Material, Model, Phong, reflect};
@@ -372,6 +372,9 @@ fn light_sums(tr: &mut Tracer, s: &mut Scratch) {
         // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { light_sums_avx2(tr, s) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { light_sums_avx512(tr, s) },
         // SAFETY: `Vec4` runs on every CPU.
         _ => unsafe { light_sums_in::<glam::Vec4>(tr, s) },
     }
@@ -388,6 +391,17 @@ unsafe fn light_sums_avx2(tr: &mut Tracer, s: &mut Scratch) {
     unsafe { light_sums_in::<crate::accel::F8>(tr, s) }
 }
 
+/// [`light_sums`] in sixteen AVX-512 lanes.
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn light_sums_avx512(tr: &mut Tracer, s: &mut Scratch) {
+    // SAFETY: this function runs only where AVX-512F was found.
+    unsafe { light_sums_in::<crate::accel::F16>(tr, s) }
+}
+
 /// [`light_sums`] with the hits `L::LANES` at a time, each chunk's sums by [`point_sums`].
 /// No closures that compute in lanes, so that this inlines whole into the AVX2 copy.
 ///
@@ -399,21 +413,21 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
     let zero = unsafe { L::splat(0.0) };
     for k in (0..s.ends.len()).step_by(L::LANES) {
         let last = s.ends.len() - 1;
-        let mut e = [&s.ends[last]; 8];
+        let mut e = [&s.ends[last]; MAX_LANES];
         for (i, slot) in e.iter_mut().enumerate().take(L::LANES) {
             *slot = &s.ends[(k + i).min(last)];
         }
         let count = (s.ends.len() - k).min(L::LANES);
         // The lanes that hold a hit (the rest repeat the last one): only they trace.
-        let mut filled = [0.0f32; 8];
+        let mut filled = [0.0f32; MAX_LANES];
         for f in filled.iter_mut().take(count) {
             *f = 1.0;
         }
         // The hits in lanes.
         let h = unsafe {
             let diffuse = e.map(|e| if e.lambert { 1.0f32 } else { 0.0 });
-            let filled = L::from_array8(filled).cmpne(zero);
-            let diffuse = L::from_array8(diffuse).cmpne(zero);
+            let filled = L::from_array(filled).cmpne(zero);
+            let diffuse = L::from_array(diffuse).cmpne(zero);
             LightLanes {
                 p: L::transpose3(&e.map(|e| &e.p)),
                 n: L::transpose3(&e.map(|e| &e.n)),
@@ -421,7 +435,7 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
                 front: L::transpose3(&e.map(|e| &e.front)),
                 back: L::transpose3(&e.map(|e| &e.back)),
                 kd: L::transpose3(&e.map(|e| &e.kd)),
-                o_err: L::from_array8(e.map(|e| e.o_err)),
+                o_err: L::from_array(e.map(|e| e.o_err)),
                 filled,
                 scalar: L::bitmask(filled & !diffuse),
             }
@@ -484,7 +498,7 @@ unsafe fn point_sums<L: Floats>(
     tr: &mut Tracer,
     h: &LightLanes<L>,
     mut other: impl FnMut(usize, Vec3A, Vec3A) -> Vec3A,
-) -> [[f32; 8]; 3] {
+) -> [[f32; MAX_LANES]; 3] {
     let (lights, shadows) = (tr.lights, tr.effects.shadows);
     // SAFETY: the caller vouches for the instruction set.
     let (zero, inf, end) =
@@ -547,7 +561,7 @@ unsafe fn point_sums<L: Floats>(
             li[2] * (kd[2] * cos_i),
         ];
         if h.scalar != 0 {
-            let mut v = [[0.0f32; 8]; 9];
+            let mut v = [[0.0f32; MAX_LANES]; 9];
             for (c, x) in [
                 term[0], term[1], term[2], wi[0], wi[1], wi[2], li[0], li[1], li[2],
             ]
@@ -567,9 +581,9 @@ unsafe fn point_sums<L: Floats>(
             }
             term = unsafe {
                 [
-                    L::from_array8(v[0]),
-                    L::from_array8(v[1]),
-                    L::from_array8(v[2]),
+                    L::from_array(v[0]),
+                    L::from_array(v[1]),
+                    L::from_array(v[2]),
                 ]
             };
         }
@@ -577,7 +591,7 @@ unsafe fn point_sums<L: Floats>(
             sum[c] = sum[c] + L::select(seen, term[c], zero);
         }
     }
-    let mut out = [[0.0f32; 8]; 3];
+    let mut out = [[0.0f32; MAX_LANES]; 3];
     for c in 0..3 {
         sum[c].write_to(&mut out[c]);
     }

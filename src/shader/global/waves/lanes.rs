@@ -21,7 +21,7 @@
 
 use super::{LightLanes, Node, Scratch, point_sums};
 use crate::accel::lanes::{RayLanes, abs_max, dot};
-use crate::accel::{Floats, Isa};
+use crate::accel::{Floats, Isa, MAX_LANES};
 use crate::geometry::{Hit, Origins, Ray, UNIT_ROUNDOFF};
 use crate::light::NO_LIGHT;
 use crate::material::{Material, Model};
@@ -38,7 +38,7 @@ const OE: usize = 6;
 const TM: usize = 7;
 
 /// Rays waiting to be traced, with their nodes, a column per coordinate (structure of
-/// arrays). Each column holds at least eight values past the last ray, so that a chunk of
+/// arrays). Each column holds at least [`MAX_LANES`] values past the last ray, so that a chunk of
 /// lanes loads whole and a left-packing store has room (values past the last ray are left
 /// over from earlier rays, or zero, and only ever fill lanes that are dropped).
 #[derive(Default)]
@@ -59,7 +59,7 @@ impl Columns {
 
     /// Room for `n` more rays and a chunk of lanes past them.
     fn reserve(&mut self, n: usize) {
-        let want = self.len + n + 8;
+        let want = self.len + n + MAX_LANES;
         if self.nodes.len() < want {
             let want = want.next_power_of_two();
             for row in &mut self.rows {
@@ -91,7 +91,7 @@ impl Columns {
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
     unsafe fn load<L: Floats>(&self, row: usize, k: usize) -> L {
-        // SAFETY: the caller vouches for the instruction set; the column holds eight values
+        // SAFETY: the caller vouches for the instruction set; the column holds `MAX_LANES` values
         // past `len` (`reserve`).
         unsafe { L::from_slice(&self.rows[row][k..]) }
     }
@@ -149,6 +149,9 @@ pub fn trace(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { trace_avx2(tr, g, roots, s) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { trace_avx512(tr, g, roots, s) },
         // SAFETY: `Vec4` runs on every CPU.
         _ => unsafe { trace_in::<glam::Vec4>(tr, g, roots, s) },
     }
@@ -163,6 +166,17 @@ pub fn trace(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
 unsafe fn trace_avx2(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
     // SAFETY: this function runs only where AVX2 was found.
     unsafe { trace_in::<crate::accel::F8>(tr, g, roots, s) }
+}
+
+/// [`trace`] in sixteen AVX-512 lanes.
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn trace_avx512(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
+    // SAFETY: this function runs only where AVX-512F was found.
+    unsafe { trace_in::<crate::accel::F16>(tr, g, roots, s) }
 }
 
 /// [`trace`], `L::LANES` rays at a time.
@@ -207,8 +221,8 @@ const ROWS: usize = 19;
 
 /// The lanes of a vector as an array.
 #[inline(always)]
-fn array<L: Floats>(x: L) -> [f32; 8] {
-    let mut a = [0.0f32; 8];
+fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
+    let mut a = [0.0f32; MAX_LANES];
     x.write_to(&mut a);
     a
 }
@@ -244,7 +258,9 @@ unsafe fn chunk<L: Floats>(
             q.load::<L>(TM, k),
         )
     };
-    let nodes: [u32; 8] = q.nodes[k..k + 8].try_into().expect("eight nodes");
+    let nodes: [u32; MAX_LANES] = q.nodes[k..k + MAX_LANES]
+        .try_into()
+        .expect("a chunk of nodes");
     let lanes = RayLanes::from_parts(o, d, o_err);
     // The nearest hits and their records, in the lanes.
     let near = unsafe { geometry.nearest_lanes(&lanes, t_max) };
@@ -276,8 +292,8 @@ unsafe fn chunk<L: Floats>(
     let (mut phong_lanes, mut lit_lanes, mut lambert, mut whole) = (0u32, 0u32, 0u32, 0u32);
     // The chains' rays that meet an emitter (a subset of `whole`).
     let mut emitting = 0u32;
-    let mut beta = [Vec3A::ZERO; 8];
-    let mut kd = [Vec3A::ZERO; 8];
+    let mut beta = [Vec3A::ZERO; MAX_LANES];
+    let mut kd = [Vec3A::ZERO; MAX_LANES];
     for i in 0..count {
         let node = &mut s.nodes[nodes[i] as usize];
         let Some(e) = s.slots.get(slot[i].to_bits() as usize) else {
@@ -308,7 +324,7 @@ unsafe fn chunk<L: Floats>(
     // The lanes that need their whole interaction: emitters a chain meets, and mirror and
     // glass bounces, queued behind this wave's rays.
     if whole != 0 {
-        let mut v = [[0.0f32; 8]; ROWS];
+        let mut v = [[0.0f32; MAX_LANES]; ROWS];
         for (row, x) in [
             p[0],
             p[1],
@@ -335,9 +351,12 @@ unsafe fn chunk<L: Floats>(
         {
             x.write_to(&mut v[row]);
         }
-        let (mut dv, vec3) = ([[0.0f32; 8]; 3], |v: &[[f32; 8]], row: usize, i: usize| {
-            Vec3A::new(v[row][i], v[row + 1][i], v[row + 2][i])
-        });
+        let (mut dv, vec3) = (
+            [[0.0f32; MAX_LANES]; 3],
+            |v: &[[f32; MAX_LANES]], row: usize, i: usize| {
+                Vec3A::new(v[row][i], v[row + 1][i], v[row + 2][i])
+            },
+        );
         for (c, x) in d.into_iter().enumerate() {
             x.write_to(&mut dv[c]);
         }
@@ -381,7 +400,7 @@ unsafe fn chunk<L: Floats>(
     // The rows the scalar reflectance reads (`wo` and the shading normal), where a Phong lane
     // is not the course's diffuse one.
     let scalar = phong_lanes & !lambert;
-    let mut sv = [[0.0f32; 8]; 6];
+    let mut sv = [[0.0f32; MAX_LANES]; 6];
     if scalar != 0 {
         for (row, x) in [wo[0], wo[1], wo[2], ns[0], ns[1], ns[2]]
             .into_iter()
@@ -404,9 +423,9 @@ unsafe fn chunk<L: Floats>(
     };
     // Eq. 3: the point lights' sums of the chunk's Phong hits (zero where a surface reflects
     // nothing).
-    let mut point = [[0.0f32; 8]; 3];
+    let mut point = [[0.0f32; MAX_LANES]; 3];
     if lit_lanes != 0 {
-        let mut filled = [0.0f32; 8];
+        let mut filled = [0.0f32; MAX_LANES];
         for (i, f) in filled.iter_mut().enumerate() {
             *f = if lit_lanes & (1 << i) != 0 { 1.0 } else { 0.0 };
         }
@@ -418,7 +437,7 @@ unsafe fn chunk<L: Floats>(
             back,
             kd: kd_l,
             o_err,
-            filled: unsafe { L::from_array8(filled) }.cmpne(zero),
+            filled: unsafe { L::from_array(filled) }.cmpne(zero),
             scalar: lit_lanes & !lambert,
         };
         let (model, slots) = (tr.model, &s.slots);
@@ -435,9 +454,9 @@ unsafe fn chunk<L: Floats>(
     // What each Phong node adds after `beta le` (`finish_direct_light`): `beta` times Eq. 3
     // as `direct_light` sums it (the point lights' sum, then the area lights' zero), plus the
     // ambient term at depth D (Eq. 2).
-    let mut rest = [[0.0f32; 8]; 3];
+    let mut rest = [[0.0f32; MAX_LANES]; 3];
     for c in 0..3 {
-        let l_dir = unsafe { L::from_array8(point[c]) } + zero;
+        let l_dir = unsafe { L::from_array(point[c]) } + zero;
         rest[c] = array(match end {
             true => beta_l[c] * (l_dir + unsafe { L::splat(g.ambient[c]) } * kd_l[c]),
             false => beta_l[c] * l_dir,
@@ -468,8 +487,8 @@ unsafe fn chunk<L: Floats>(
     let next = &mut s.next;
     next.reserve(2 * n_parents);
     let at = next.len;
-    let mut weights = [[[0.0f32; 8]; 3]; 2];
-    let mut dirs = [[[0.0f32; 8]; 3]; 2];
+    let mut weights = [[[0.0f32; MAX_LANES]; 3]; 2];
+    let mut dirs = [[[0.0f32; MAX_LANES]; 3]; 2];
     for (c, w) in [ns, wr].into_iter().enumerate() {
         // `course_reflectance` of a diffuse material: `kd max(w.n, 0)`, `max` as a select.
         let cos = dot(w, ns);
