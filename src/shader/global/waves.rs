@@ -246,7 +246,12 @@ fn sum_tree(s: &mut Scratch, root: u32) -> Vec3A {
     s.stack.push(root);
     while let Some(i) = s.stack.pop() {
         let node = &s.nodes[i as usize];
-        l += node.beta * node.le;
+        // `beta le`, skipped where it is a zero (`le` zero, `beta` finite): adding a zero
+        // leaves `l` as it is, as `l` is never -0 (it starts at +0, and a sum is -0 only
+        // where both terms are), so the sum keeps its bits without the add's latency.
+        if node.le != Vec3A::ZERO || !node.beta.is_finite() {
+            l += node.beta * node.le;
+        }
         if let Some(rest) = node.rest {
             l += rest;
         }

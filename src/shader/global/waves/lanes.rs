@@ -72,17 +72,15 @@ impl Columns {
     /// Queue `rays` for the nodes from `node` on, one each.
     fn push(&mut self, node: u32, rays: &[Ray]) {
         self.reserve(rays.len());
-        let (k, n) = (self.len, rays.len());
-        let [ox, oy, oz, dx, dy, dz, oe, tm] = self.rows.each_mut().map(|r| &mut r[k..k + n]);
+        let k = self.len;
         for (j, r) in rays.iter().enumerate() {
-            (ox[j], oy[j], oz[j]) = (r.o.x, r.o.y, r.o.z);
-            (dx[j], dy[j], dz[j]) = (r.d.x, r.d.y, r.d.z);
-            (oe[j], tm[j]) = (r.o_err, r.t_max);
+            let values = [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.o_err, r.t_max];
+            for (row, x) in self.rows.iter_mut().zip(values) {
+                row[k + j] = x;
+            }
+            self.nodes[k + j] = node + j as u32;
         }
-        for (j, slot) in self.nodes[k..k + n].iter_mut().enumerate() {
-            *slot = node + j as u32;
-        }
-        self.len += n;
+        self.len += rays.len();
     }
 
     /// `L::LANES` values of column `row` from ray `k` on.
