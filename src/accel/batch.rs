@@ -3,8 +3,8 @@
 //! A shader that holds many rays at once (the Global shader's tree of indirect rays) hands
 //! them over together, or builds them in lanes itself (the shadow rays of its hits,
 //! [`Geometry::occluded_lanes`]). Where every primitive is packed (planes,
-//! and the spheres of small scenes), the rays fill the lanes (sixteen with AVX-512, eight with AVX2, four with SSE)
-//! and each primitive is splatted across them ([`Geometry::sphere_each`],
+//! and the spheres of small scenes), the rays fill the lanes (sixteen with AVX-512, eight
+//! with AVX2, four with SSE) and each primitive is splatted across them ([`Geometry::sphere_each`],
 //! [`Geometry::plane_each`]): no lane holds a padding primitive (only a batch's last chunk
 //! may repeat its last ray), no closest-lane search runs per ray, and each ray's constants are
 //! computed once. Each lane runs the arithmetic the one-ray query runs for
@@ -14,9 +14,9 @@
 //! bit-identical to [`Geometry::intersect`] and [`Geometry::occluded`] in every instruction
 //! set. Scenes with a BVH answer ray by ray.
 //!
-//! The instruction set is the BVH's ([`super::WideBvh::isa`]): AVX2 where the CPU has it. The
-//! AVX2 copies are `#[target_feature]` functions around the generic code, which has no
-//! closures, so every lane operation inlines into them.
+//! The instruction set is the BVH's ([`super::WideBvh::isa`]): AVX-512 or AVX2 where the CPU
+//! has it. Their copies are `#[target_feature]` functions around the generic code, which has
+//! no closures, so every lane operation inlines into them.
 
 use super::Geometry;
 use super::lanes::{RayLanes, SurfaceLanes, plane_surface, sphere_surface};

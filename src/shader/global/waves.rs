@@ -1,6 +1,6 @@
 //! The rays below the first Phong hit traced in waves: every ray of one depth together, so
-//! that the geometry answers them in batches with a ray per SIMD lane, eight with AVX2
-//! ([`crate::accel::Geometry::intersect_batch`]); then the direct light of all their hits
+//! that the geometry answers them in batches with a ray per SIMD lane, sixteen with AVX-512
+//! and eight with AVX2 ([`crate::accel::Geometry::intersect_batch`]); then the direct light of all their hits
 //! together, with a hit per lane, light by light, shadow rays included ([`light_sums`]). In a
 //! scene without a BVH (planes and a few spheres, as the course's box) the waves are traced
 //! and shaded in lanes from the nearest hit to the children's rays, each chunk's light pass on
@@ -372,7 +372,7 @@ fn finish_direct_light(s: &mut Scratch) {
 }
 
 /// Eq. 3's point-light sum at every hit of `s.ends`, into its [`Lit`]: the hits in SIMD lanes
-/// (eight with AVX2), each light's terms and shadow rays computed and answered lane by lane,
+/// (sixteen with AVX-512, eight with AVX2), each light's terms and shadow rays computed and answered lane by lane,
 /// added in the lights' order as `point_lights` adds them.
 fn light_sums(tr: &mut Tracer, s: &mut Scratch) {
     match tr.geometry.bvh.isa() {
@@ -410,7 +410,8 @@ unsafe fn light_sums_avx512(tr: &mut Tracer, s: &mut Scratch) {
 }
 
 /// [`light_sums`] with the hits `L::LANES` at a time, each chunk's sums by [`point_sums`].
-/// No closures that compute in lanes, so that this inlines whole into the AVX2 copy.
+/// No closures that compute in lanes, so that this inlines whole into the AVX2 and AVX-512
+/// copies.
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.

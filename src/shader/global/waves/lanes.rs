@@ -228,7 +228,7 @@ fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
 /// Trace and shade the queue's rays from `k` on, `L::LANES` of them at most, at depth `depth`:
 /// their nodes' sums into `s.nodes`, bounces into `s.queue`, children into `s.next`. Returns
 /// how many rays it took. No closures that compute in lanes, so that this inlines whole into
-/// the AVX2 copy.
+/// the AVX2 and AVX-512 copies.
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.
