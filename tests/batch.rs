@@ -244,9 +244,18 @@ fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
     ];
     let rays: Vec<Ray> = (0..16)
         .map(|k| {
+            // The upper eight mix rays blocked by either sphere with rays that miss both.
             let d = match k {
                 6 => Vec3A::ZERO,
                 7 => Vec3A::NAN,
+                8 => Vec3A::new(-0.1, 0.0, 5.0).normalize(),
+                9 => Vec3A::new(0.9, -0.5, 1.0).normalize(),
+                10 => Vec3A::new(1.9, 1.0, 4.0).normalize(),
+                11 => Vec3A::new(-0.8, 0.6, 1.0).normalize(),
+                12 => Vec3A::new(0.3, 0.5, 5.0).normalize(),
+                13 => -Vec3A::Z,
+                14 => Vec3A::new(0.85, 0.0, 5.0).normalize(),
+                15 => Vec3A::new(0.0, 1.0, 0.2).normalize(),
                 _ => Vec3A::new(k as f32 * 0.12 - 0.3, 0.05 * k as f32, 1.0).normalize(),
             };
             Ray {
@@ -279,6 +288,12 @@ fn rays_in_lanes_answer_as_one_ray_queries_and_only_where_live() {
                 })
                 .collect();
             assert!(one.iter().any(|&b| b) && one.iter().any(|&b| !b), "{one:?}");
+            // Both answers in the upper half too, so that its lanes are told apart.
+            let upper = &one[8..];
+            assert!(
+                upper.iter().any(|&b| b) && upper.iter().any(|&b| !b),
+                "{one:?}"
+            );
             // Four SSE lanes: rays 0 to 3, 4 to 7 and so on; lanes 1 and 2 not live.
             for first in [0, 4, 8, 12] {
                 // SAFETY: `Vec4` runs on every CPU.

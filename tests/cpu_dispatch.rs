@@ -86,7 +86,7 @@ fn same_pixels(scene: &str, native: &[u32], old: &[u32]) {
     if let Some(i) = (0..native.len()).find(|&i| native[i] != old[i]) {
         let differ = native.iter().zip(old).filter(|(a, b)| a != b).count();
         panic!(
-            "{scene}: the emulated older CPU rendered another image: {differ} channels differ, \
+            "{scene}: another instruction set rendered another image: {differ} channels differ, \
              the first at {i} ({} against {})",
             f32::from_bits(native[i]),
             f32::from_bits(old[i])
@@ -101,22 +101,24 @@ fn older_cpus_render_the_same_images_in_their_own_instruction_sets() {
     let Some(qemu) = qemu() else { return };
     let tmp = TempDir::new();
     let dir = &tmp.0;
-    let render = |emulated: Option<(&Path, &str)>, scene: &str, name: &str| {
+    // `rtis render scene` (with `--isa isa` where given) into `name`: the pixels and the log.
+    let render_isa = |emulated: Option<(&Path, &str)>, scene: &str, name: &str, isa: &str| {
         let scene = format!("{}/scenes/{scene}", env!("CARGO_MANIFEST_DIR"));
         let path = dir.join(name);
-        let out = rtis(
-            emulated,
-            &[
-                "render",
-                &scene,
-                "--width",
-                "96",
-                "--threads",
-                "2",
-                "-o",
-                path.to_str().unwrap(),
-            ],
-        );
+        let mut args = vec![
+            "render",
+            &scene,
+            "--width",
+            "96",
+            "--threads",
+            "2",
+            "-o",
+            path.to_str().unwrap(),
+        ];
+        if !isa.is_empty() {
+            args.extend(["--isa", isa]);
+        }
+        let out = rtis(emulated, &args);
         assert!(
             out.status.success(),
             "{name}: {:?}\n{}",
@@ -129,6 +131,7 @@ fn older_cpus_render_the_same_images_in_their_own_instruction_sets() {
         let bits: Vec<u32> = image.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect();
         (bits, stderr(&out))
     };
+    let render = |emulated, scene: &str, name: &str| render_isa(emulated, scene, name, "");
     let native_isa = rtis::accel::Isa::detect();
     let (mesh, mesh_log) = render(None, "mesh.ron", "native.exr");
     let (cornell, cornell_log) = render(None, "cornell-two-bounce.ron", "box-native.exr");
@@ -139,6 +142,13 @@ fn older_cpus_render_the_same_images_in_their_own_instruction_sets() {
     says(&cornell_log, native_isa);
     let node = format!("node test in {}", native_isa.node_test().name());
     assert!(mesh_log.contains(&node), "{node}?\n{mesh_log}");
+    // Natively, `--isa` picks each instruction set this CPU runs, to the same pixels.
+    for isa in rtis::accel::Isa::all_available() {
+        let name = format!("box-{}.exr", isa.name());
+        let (chosen, log) = render_isa(None, "cornell-two-bounce.ron", &name, isa.name());
+        says(&log, isa);
+        same_pixels(&format!("--isa {}", isa.name()), &cornell, &chosen);
+    }
     for (cpu, isa, lacks) in [
         ("qemu64", rtis::accel::Isa::Baseline, "avx2"),
         ("Haswell", rtis::accel::Isa::Avx2, "avx512"),
@@ -173,5 +183,20 @@ fn older_cpus_render_the_same_images_in_their_own_instruction_sets() {
         assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
         let message = format!("--isa {lacks}: this CPU does not run it");
         assert!(stderr(&refused).contains(&message), "{}", stderr(&refused));
+        // And so does the renderer.
+        let out = dir.join("refused.png");
+        let args = [
+            "render",
+            "--width",
+            "8",
+            "-o",
+            out.to_str().unwrap(),
+            "--isa",
+            lacks,
+        ];
+        let refused = rtis(emulated, &args);
+        assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+        assert!(stderr(&refused).contains(&message), "{}", stderr(&refused));
+        assert!(!out.exists(), "a refused render wrote {out:?}");
     }
 }

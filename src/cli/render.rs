@@ -4,6 +4,7 @@ use super::interrupt::{self, Graceful};
 use super::{CliError, Interrupted, load};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use rtis::accel::Isa;
 use rtis::render::estimate::{self, MAX_RAYS_UNFORCED, human_seconds};
 use rtis::render::output::Transfer;
 use rtis::render::pass::{self, Pass};
@@ -47,6 +48,39 @@ pub struct RenderArgs {
     /// a pass EXR of exact sums for `rtis merge` (default name NAME.pass-I-of-N.exr).
     #[arg(long, value_parser = pass::parse_pass, value_name = "I/N")]
     pass: Option<(u32, u32)>,
+    /// Instruction set of the SIMD code: the widest this CPU runs (auto), or one named, to
+    /// measure what it is worth. The image is the same in each.
+    #[arg(long, value_enum, default_value_t = IsaChoice::Auto)]
+    isa: IsaChoice,
+}
+
+/// `--isa` of `rtis render`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum IsaChoice {
+    /// The widest this CPU runs.
+    Auto,
+    /// Four-lane SSE2 (any x86-64 CPU).
+    Baseline,
+    /// Eight-lane AVX2.
+    Avx2,
+    /// Sixteen-lane AVX-512 for batched rays, AVX2's node test.
+    Avx512,
+}
+
+impl IsaChoice {
+    /// The instruction set meant, or an error if this CPU does not run it.
+    fn isa(self) -> Result<Isa, CliError> {
+        let isa = match self {
+            IsaChoice::Auto => return Ok(Isa::detect()),
+            IsaChoice::Baseline => Isa::Baseline,
+            IsaChoice::Avx2 => Isa::Avx2,
+            IsaChoice::Avx512 => Isa::Avx512,
+        };
+        match isa.available() {
+            true => Ok(isa),
+            false => Err(format!("--isa {}: this CPU does not run it", isa.name()).into()),
+        }
+    }
 }
 
 /// The parser of an image side: a whole number of pixels from 1 to [`render::MAX_SIDE`].
@@ -160,12 +194,16 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
 
-    let prepared = rtis::extract(&scene);
+    let isa = a.isa.isa()?;
+    let mut prepared = rtis::extract(&scene);
+    assert!(
+        prepared.geometry.bvh.set_isa(isa),
+        "checked by IsaChoice::isa"
+    );
     for w in &prepared.warnings {
         eprintln!("warning: {w}");
     }
     eprintln!("effects {}", prepared.effects);
-    let isa = prepared.geometry.bvh.isa();
     eprintln!("SIMD: {}, {} rays per batch", isa.name(), isa.lanes());
     if prepared.geometry.in_bvh > 0 {
         eprintln!(

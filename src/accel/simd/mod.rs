@@ -18,7 +18,7 @@ pub mod baseline;
 /// batched queries and the lanes kernel fill a lane at a time.
 pub const MAX_LANES: usize = 16;
 
-/// The instruction sets the node test is written for.
+/// The instruction sets the node test and the batched ray tests are written for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
     /// Two four-lane halves: SSE2 (part of every x86-64 CPU), or scalar code elsewhere.
@@ -49,9 +49,13 @@ impl Isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
             #[cfg(target_arch = "x86_64")]
+            // `avx512f` as rustc enables it implies AVX2, FMA and F16C: all checked, though
+            // every AVX-512 CPU has them.
             Isa::Avx512 => {
                 std::arch::is_x86_feature_detected!("avx512f")
                     && std::arch::is_x86_feature_detected!("avx2")
+                    && std::arch::is_x86_feature_detected!("fma")
+                    && std::arch::is_x86_feature_detected!("f16c")
             }
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx2 | Isa::Avx512 => false,
@@ -84,8 +88,8 @@ impl Isa {
         }
     }
 
-    /// The instruction set of the wide BVH's node test ((`Lanes8`): AVX-512 runs AVX2's, as
-    /// a node's eight children fill eight lanes.
+    /// The instruction set of the wide BVH's node test (`Lanes8`): AVX-512 runs AVX2's, as a
+    /// node's eight children fill eight lanes.
     pub fn node_test(self) -> Isa {
         match self {
             Isa::Avx512 => Isa::Avx2,
@@ -160,7 +164,8 @@ pub unsafe trait Floats:
 {
     /// How many lanes (at most [`MAX_LANES`]).
     const LANES: usize;
-    /// One flag per lane, all bits set or clear.
+    /// One flag per lane: a lane of all bits set or clear (SSE, AVX2), or one bit of a mask
+    /// register (AVX-512).
     type Mask: Copy
         + std::ops::BitAnd<Output = Self::Mask>
         + std::ops::BitOr<Output = Self::Mask>
@@ -449,6 +454,17 @@ mod tests {
                             .collect()
                     };
                     assert_eq!(lane_bits(L::from_array(x)), exact(&x));
+                    // `all` and `any` on every lane: all set, then each lane clear in turn.
+                    let (one, zero) = (L::splat(1.0), L::splat(0.0));
+                    assert!(L::all(one.cmpgt(zero)) && L::any(one.cmpgt(zero)));
+                    assert!(!L::any(one.cmplt(zero)) && !L::all(one.cmplt(zero)));
+                    for lane in 0..L::LANES {
+                        let mut v = [1.0f32; MAX_LANES];
+                        v[lane] = -1.0;
+                        let m = L::from_array(v).cmpgt(zero);
+                        assert!(!L::all(m) && L::any(m), "lane {lane}");
+                        assert_eq!(L::bitmask(m), ((1u32 << L::LANES) - 1) & !(1 << lane));
+                    }
                     assert_eq!(lane_bits(L::splat(x[3])), exact(&[x[3]; MAX_LANES]));
                 }
             }

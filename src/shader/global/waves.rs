@@ -1,10 +1,10 @@
-//! The rays below the first Phong hit traced in waves: every ray of one depth together, so
-//! that the geometry answers them in batches with a ray per SIMD lane, sixteen with AVX-512
-//! and eight with AVX2 ([`crate::accel::Geometry::intersect_batch`]); then the direct light of all their hits
-//! together, with a hit per lane, light by light, shadow rays included ([`light_sums`]). In a
-//! scene without a BVH (planes and a few spheres, as the course's box) the waves are traced
-//! and shaded in lanes from the nearest hit to the children's rays, each chunk's light pass on
-//! its own lanes, the rays queued in columns (`lanes.rs`).
+//! The rays below the first Phong hit traced in waves: every ray of one depth together, so that the
+//! geometry answers them in batches with a ray per SIMD lane, sixteen with AVX-512 and eight with
+//! AVX2 ([`crate::accel::Geometry::intersect_batch`]); then the direct light of all their hits
+//! together, with a hit per lane, light by light, shadow rays included ([`light_sums`]). In a scene
+//! without a BVH (planes and a few spheres, as the course's box) the waves are traced and shaded in
+//! lanes from the nearest hit to the children's rays, each chunk's light pass on its own lanes, the
+//! rays queued in columns (`lanes.rs`).
 //!
 //! The result is the depth-first walk's ([`super::incident`]) to the bit. Each node of the tree
 //! (one traced ray and the mirror or glass chain behind it) keeps the terms that walk would add
@@ -39,7 +39,7 @@ pub const MAX_LIGHTS: usize = 64;
 /// Samples are traced in groups of at most about this many nodes: enough hits that most
 /// chunks of a wave fill their lanes (sixteen with AVX-512: the course's box at n = 64, D = 3
 /// fills 14.4 of them on average, 12.8 with 256 nodes), few enough that a group's buffers stay
-/// small (about 56 KB of nodes, within a core's L2 cache).
+/// small (about 48 KB of nodes: a `Node` is 96 bytes here).
 const GROUP_NODES: usize = 512;
 
 /// True if the waves give the depth-first walk's result, and fit their memory bounds: there is
@@ -372,8 +372,8 @@ fn finish_direct_light(s: &mut Scratch) {
 }
 
 /// Eq. 3's point-light sum at every hit of `s.ends`, into its [`Lit`]: the hits in SIMD lanes
-/// (sixteen with AVX-512, eight with AVX2), each light's terms and shadow rays computed and answered lane by lane,
-/// added in the lights' order as `point_lights` adds them.
+/// (sixteen with AVX-512, eight with AVX2), each light's terms and shadow rays computed and
+/// answered lane by lane, added in the lights' order as `point_lights` adds them.
 fn light_sums(tr: &mut Tracer, s: &mut Scratch) {
     match tr.geometry.bvh.isa() {
         // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
