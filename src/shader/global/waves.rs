@@ -81,8 +81,6 @@ struct Node {
     /// to, or times its Phong hit's direct light (Eq. 3), plus the ambient term at depth `D`
     /// (Eq. 2); `None` if it is absorbed.
     rest: Option<Vec3A>,
-    /// Index of its first child (the normal's ray; the reflection's follows), if it has two.
-    children: Option<u32>,
 }
 
 impl Node {
@@ -105,7 +103,6 @@ impl Node {
             tint: Vec3A::ONE,
             le: Vec3A::ZERO,
             rest: None,
-            children: None,
         }
     }
 }
@@ -201,10 +198,26 @@ impl Rays {
     }
 }
 
+/// The first child of a node without children.
+const NO_KIDS: u32 = u32::MAX;
+
+impl Scratch {
+    /// A new node about to trace its first ray with weight `beta` (its index is the count
+    /// before).
+    fn add_node(&mut self, beta: Vec3A) {
+        self.nodes.push(Node::new(beta));
+        self.kids.push(NO_KIDS);
+    }
+}
+
 /// Buffers of one sample group, kept between waves and calls.
 #[derive(Default)]
 struct Scratch {
     nodes: Vec<Node>,
+    /// Each node's first child (the normal's ray; the reflection's follows), or [`NO_KIDS`]:
+    /// apart from the nodes, so that the sum's walk from node to node reads 4 bytes a step
+    /// and the nodes' loads do not wait on one another.
+    kids: Vec<u32>,
     /// The rays traced now, the chains' next rays (same depth), the children (next depth):
     /// the queues of scenes with a BVH (the lanes kernel has its own, `queue` and `next`).
     now: Rays,
@@ -213,7 +226,6 @@ struct Scratch {
     hits: Vec<Option<Hit>>,
     lit: Vec<Lit>,
     ends: Vec<End>,
-    stack: Vec<u32>,
     /// The lanes kernel's queues: the wave traced now (and its bounces), the next depth.
     queue: lanes::Columns,
     next: lanes::Columns,
@@ -233,31 +245,33 @@ pub fn incident(tr: &mut Tracer, g: &Global, rays: &[Ray]) -> Vec<Vec3A> {
         let mut out = Vec::with_capacity(rays.len());
         for chunk in rays.chunks(group(g)) {
             trace_tree(tr, g, chunk, s);
-            out.extend((0..chunk.len()).map(|root| sum_tree(s, root as u32)));
+            out.extend((0..chunk.len()).map(|root| sum_tree(&s.nodes, &s.kids, root as u32)));
         }
         out
     })
 }
 
 /// The depth-first sum of the tree at `root`: a node, its normal's subtree, its reflection's.
-fn sum_tree(s: &mut Scratch, root: u32) -> Vec3A {
+///
+/// The pending subtrees wait in a local array (the sum stays in a register): a tree has at
+/// most [`MAX_NODES`] nodes, so it is at most 8 levels deep and at most 9 subtrees wait at once.
+fn sum_tree(nodes: &[Node], kids: &[u32], root: u32) -> Vec3A {
     let mut l = Vec3A::ZERO;
-    s.stack.clear();
-    s.stack.push(root);
-    while let Some(i) = s.stack.pop() {
-        let node = &s.nodes[i as usize];
-        // `beta le`, skipped where it is a zero (`le` zero, `beta` finite): adding a zero
-        // leaves `l` as it is, as `l` is never -0 (it starts at +0, and a sum is -0 only
-        // where both terms are), so the sum keeps its bits without the add's latency.
-        if node.le != Vec3A::ZERO || !node.beta.is_finite() {
-            l += node.beta * node.le;
-        }
+    let (mut stack, mut sp) = ([0u32; 16], 1);
+    stack[0] = root;
+    while sp > 0 {
+        sp -= 1;
+        let i = stack[sp] as usize;
+        let node = &nodes[i];
+        l += node.beta * node.le;
         if let Some(rest) = node.rest {
             l += rest;
         }
-        if let Some(c) = node.children {
-            s.stack.push(c + 1);
-            s.stack.push(c);
+        let c = kids[i];
+        if c != NO_KIDS {
+            stack[sp] = c + 1;
+            stack[sp + 1] = c;
+            sp += 2;
         }
     }
     l
@@ -266,8 +280,9 @@ fn sum_tree(s: &mut Scratch, root: u32) -> Vec3A {
 /// Trace the trees of `roots` wave by wave into `s.nodes` (the roots first, in order).
 fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
     s.nodes.clear();
+    s.kids.clear();
     for _ in roots {
-        s.nodes.push(Node::new(Vec3A::ONE));
+        s.add_node(Vec3A::ONE);
         tr.stats.count(RayKind::Indirect);
     }
     if tr.geometry.bvh.nodes.is_empty() {
@@ -348,11 +363,11 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
         return;
     }
     let first = s.nodes.len() as u32;
-    s.nodes[i as usize].children = Some(first);
+    s.kids[i as usize] = first;
     let (wo, n) = (si.wo, si.n);
     for (k, w) in [n, reflect(wo, n)].into_iter().enumerate() {
         let b = beta * reflectance(tr.model, &phong, w, wo, n) / (4.0 * PI);
-        s.nodes.push(Node::new(b));
+        s.add_node(b);
         s.children.push(first + k as u32, si.spawn(w));
         tr.stats.count(RayKind::Indirect);
     }

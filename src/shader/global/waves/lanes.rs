@@ -19,7 +19,7 @@
 //! `Sphere::surface`, `Plane::surface`, `Interaction::new`, `Origins`, `reflect`,
 //! `course_reflectance`), so the result is the depth-first walk's to the bit.
 
-use super::{LightLanes, Node, Scratch, point_sums};
+use super::{LightLanes, Scratch, point_sums};
 use crate::accel::lanes::{RayLanes, abs_max, dot};
 use crate::accel::{Floats, Isa, MAX_LANES};
 use crate::geometry::{Hit, Origins, Ray, UNIT_ROUNDOFF};
@@ -72,15 +72,28 @@ impl Columns {
     /// Queue `rays` for the nodes from `node` on, one each.
     fn push(&mut self, node: u32, rays: &[Ray]) {
         self.reserve(rays.len());
-        let k = self.len;
-        for (j, r) in rays.iter().enumerate() {
-            let values = [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.o_err, r.t_max];
-            for (row, x) in self.rows.iter_mut().zip(values) {
-                row[k + j] = x;
+        let (k, n) = (self.len, rays.len());
+        // A column at a time, each a slice bounds-checked once.
+        let [ox, oy, oz, dx, dy, dz, oe, tm] = &mut self.rows;
+        let columns: [(&mut Vec<f32>, fn(&Ray) -> f32); 8] = [
+            (ox, |r| r.o.x),
+            (oy, |r| r.o.y),
+            (oz, |r| r.o.z),
+            (dx, |r| r.d.x),
+            (dy, |r| r.d.y),
+            (dz, |r| r.d.z),
+            (oe, |r| r.o_err),
+            (tm, |r| r.t_max),
+        ];
+        for (column, value) in columns {
+            for (x, r) in column[k..k + n].iter_mut().zip(rays) {
+                *x = value(r);
             }
-            self.nodes[k + j] = node + j as u32;
         }
-        self.len += rays.len();
+        for (j, slot) in self.nodes[k..k + n].iter_mut().enumerate() {
+            *slot = node + j as u32;
+        }
+        self.len += n;
     }
 
     /// `L::LANES` values of column `row` from ray `k` on.
@@ -512,7 +525,7 @@ unsafe fn chunk<L: Floats>(
         let i = bits.trailing_zeros() as usize;
         bits &= bits - 1;
         let child = first + 2 * r as u32;
-        s.nodes[nodes[i] as usize].children = Some(child);
+        s.kids[nodes[i] as usize] = child;
         for c in 0..2 {
             let b = if lambert & (1 << i) != 0 {
                 Vec3A::new(weights[c][0][i], weights[c][1][i], weights[c][2][i])
@@ -524,7 +537,7 @@ unsafe fn chunk<L: Floats>(
                 let w = Vec3A::new(dirs[c][0][i], dirs[c][1][i], dirs[c][2][i]);
                 beta[i] * reflectance(tr.model, &phong, w, wo, n) / (4.0 * PI)
             };
-            s.nodes.push(Node::new(b));
+            s.add_node(b);
             s.next.nodes[at + c * n_parents + r] = child + c as u32;
         }
         r += 1;
