@@ -37,6 +37,9 @@ const DX: usize = 3;
 const OE: usize = 6;
 const TM: usize = 7;
 
+/// One number of a ray: what a column of [`Columns`] holds.
+type RayField = fn(&Ray) -> f32;
+
 /// Rays waiting to be traced, with their nodes, a column per coordinate (structure of
 /// arrays). Each column holds at least [`MAX_LANES`] values past the last ray, so that a chunk of
 /// lanes loads whole and a left-packing store has room (values past the last ray are left
@@ -75,7 +78,7 @@ impl Columns {
         let (k, n) = (self.len, rays.len());
         // A column at a time, each a slice bounds-checked once.
         let [ox, oy, oz, dx, dy, dz, oe, tm] = &mut self.rows;
-        let columns: [(&mut Vec<f32>, fn(&Ray) -> f32); 8] = [
+        let columns: [(&mut Vec<f32>, RayField); 8] = [
             (ox, |r| r.o.x),
             (oy, |r| r.o.y),
             (oz, |r| r.o.z),
