@@ -340,6 +340,10 @@ fn out_of_range_arguments_are_refused_with_their_range() {
             &["bench", "--section", "disks"][..],
             "possible values: all, cornell, effects, meshes",
         ),
+        (
+            &["render", "--isa", "sse"][..],
+            "possible values: auto, baseline, avx2, avx512",
+        ),
     ] {
         let o = rtis(args);
         let e = stderr(&o);

@@ -94,6 +94,65 @@ fn same_pixels(scene: &str, native: &[u32], old: &[u32]) {
     }
 }
 
+/// `rtis render scene` into `dir/name` (with `--isa isa` unless `isa` is empty), natively or
+/// emulated: the pixels, to the bit (the file's compressed bytes may differ: the compressor
+/// picks its own code path by CPU), and the log.
+fn render_in(
+    dir: &Path,
+    emulated: Option<(&Path, &str)>,
+    scene: &str,
+    name: &str,
+    isa: &str,
+) -> (Vec<u32>, String) {
+    let scene = format!("{}/scenes/{scene}", env!("CARGO_MANIFEST_DIR"));
+    let path = dir.join(name);
+    let mut args = vec![
+        "render",
+        &scene,
+        "--width",
+        "96",
+        "--threads",
+        "2",
+        "-o",
+        path.to_str().unwrap(),
+    ];
+    if !isa.is_empty() {
+        args.extend(["--isa", isa]);
+    }
+    let out = rtis(emulated, &args);
+    assert!(
+        out.status.success(),
+        "{name}: {:?}\n{}",
+        out.status,
+        stderr(&out)
+    );
+    let image = image::open(&path).unwrap().into_rgba32f();
+    let bits: Vec<u32> = image.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect();
+    (bits, stderr(&out))
+}
+
+/// The log names `isa` as the instruction set of the batches.
+fn says(log: &str, isa: rtis::accel::Isa) {
+    let simd = format!("SIMD: {}, {} rays per batch", isa.name(), isa.lanes());
+    assert!(log.contains(&simd), "{simd}?\n{log}");
+}
+
+/// Natively, `render --isa` picks each instruction set this CPU runs (no emulator needed), and
+/// each renders the course's box to the same pixels.
+#[test]
+fn each_native_instruction_set_renders_the_same_image() {
+    rtis::accel::require_all_isas();
+    let tmp = TempDir::new();
+    let (auto, log) = render_in(&tmp.0, None, "cornell-two-bounce.ron", "auto.exr", "");
+    says(&log, rtis::accel::Isa::detect());
+    for isa in rtis::accel::Isa::all_available() {
+        let name = format!("{}.exr", isa.name());
+        let (chosen, log) = render_in(&tmp.0, None, "cornell-two-bounce.ron", &name, isa.name());
+        says(&log, isa);
+        same_pixels(&format!("--isa {}", isa.name()), &auto, &chosen);
+    }
+}
+
 #[test]
 fn older_cpus_render_the_same_images_in_their_own_instruction_sets() {
     // The native run must be the other instruction set where CI asks for it.
@@ -101,54 +160,13 @@ fn older_cpus_render_the_same_images_in_their_own_instruction_sets() {
     let Some(qemu) = qemu() else { return };
     let tmp = TempDir::new();
     let dir = &tmp.0;
-    // `rtis render scene` (with `--isa isa` where given) into `name`: the pixels and the log.
-    let render_isa = |emulated: Option<(&Path, &str)>, scene: &str, name: &str, isa: &str| {
-        let scene = format!("{}/scenes/{scene}", env!("CARGO_MANIFEST_DIR"));
-        let path = dir.join(name);
-        let mut args = vec![
-            "render",
-            &scene,
-            "--width",
-            "96",
-            "--threads",
-            "2",
-            "-o",
-            path.to_str().unwrap(),
-        ];
-        if !isa.is_empty() {
-            args.extend(["--isa", isa]);
-        }
-        let out = rtis(emulated, &args);
-        assert!(
-            out.status.success(),
-            "{name}: {:?}\n{}",
-            out.status,
-            stderr(&out)
-        );
-        // The pixels, to the bit (the file's compressed bytes may differ: the compressor
-        // picks its own code path by CPU).
-        let image = image::open(&path).unwrap().into_rgba32f();
-        let bits: Vec<u32> = image.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect();
-        (bits, stderr(&out))
-    };
-    let render = |emulated, scene: &str, name: &str| render_isa(emulated, scene, name, "");
+    let render = |emulated, scene: &str, name: &str| render_in(dir, emulated, scene, name, "");
     let native_isa = rtis::accel::Isa::detect();
     let (mesh, mesh_log) = render(None, "mesh.ron", "native.exr");
     let (cornell, cornell_log) = render(None, "cornell-two-bounce.ron", "box-native.exr");
-    let says = |log: &str, isa: rtis::accel::Isa| {
-        let simd = format!("SIMD: {}, {} rays per batch", isa.name(), isa.lanes());
-        assert!(log.contains(&simd), "{simd}?\n{log}");
-    };
     says(&cornell_log, native_isa);
     let node = format!("node test in {}", native_isa.node_test().name());
     assert!(mesh_log.contains(&node), "{node}?\n{mesh_log}");
-    // Natively, `--isa` picks each instruction set this CPU runs, to the same pixels.
-    for isa in rtis::accel::Isa::all_available() {
-        let name = format!("box-{}.exr", isa.name());
-        let (chosen, log) = render_isa(None, "cornell-two-bounce.ron", &name, isa.name());
-        says(&log, isa);
-        same_pixels(&format!("--isa {}", isa.name()), &cornell, &chosen);
-    }
     for (cpu, isa, lacks) in [
         ("qemu64", rtis::accel::Isa::Baseline, "avx2"),
         ("Haswell", rtis::accel::Isa::Avx2, "avx512"),
@@ -197,6 +215,12 @@ fn older_cpus_render_the_same_images_in_their_own_instruction_sets() {
         let refused = rtis(emulated, &args);
         assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
         assert!(stderr(&refused).contains(&message), "{}", stderr(&refused));
+        // Refused before the scene is read: no estimate, no file.
+        assert!(
+            !stderr(&refused).contains("estimate"),
+            "{}",
+            stderr(&refused)
+        );
         assert!(!out.exists(), "a refused render wrote {out:?}");
     }
 }

@@ -122,7 +122,7 @@ fn unsampled_emitter_seen(name: &str, rs: &RenderScene) {
     agree_with(name, rs, &g);
 }
 
-/// The course's box under every depth from 1 to 6, with glass and mirror chains, and with
+/// The course's box under every depth from 1 to 8, with glass and mirror chains, and with
 /// each effect switched off in turn.
 #[test]
 fn waves_give_the_depth_first_bits_in_the_course_box() {

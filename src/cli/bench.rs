@@ -1,6 +1,6 @@
 //! `rtis bench`: speed figures, printed, never asserted.
 
-use super::CliError;
+use super::{CliError, runnable};
 use clap::Args;
 use glam::{Vec3, Vec3A};
 use rtis::RenderScene;
@@ -84,11 +84,7 @@ impl IsaArg {
             IsaArg::Avx2 => Isa::Avx2,
             IsaArg::Avx512 => Isa::Avx512,
         };
-        if isa.available() {
-            Ok(vec![isa.node_test()])
-        } else {
-            Err(format!("--isa {}: this CPU does not run it", isa.name()).into())
-        }
+        runnable(isa).map(|isa| vec![isa.node_test()])
     }
 }
 

@@ -66,6 +66,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
+/// `isa`, or the error of `--isa` naming it if this CPU does not run it.
+pub fn runnable(isa: rtis::accel::Isa) -> Result<rtis::accel::Isa, CliError> {
+    match isa.available() {
+        true => Ok(isa),
+        false => Err(format!("--isa {}: this CPU does not run it", isa.name()).into()),
+    }
+}
+
 /// Load the scene at `path`, or the embedded Cornell box when there is none.
 pub fn load(path: Option<&Path>) -> Result<Scene, SceneError> {
     match path {

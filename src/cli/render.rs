@@ -1,7 +1,7 @@
 //! `rtis render`.
 
 use super::interrupt::{self, Graceful};
-use super::{CliError, Interrupted, load};
+use super::{CliError, Interrupted, load, runnable};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rtis::accel::Isa;
@@ -70,15 +70,11 @@ pub enum IsaChoice {
 impl IsaChoice {
     /// The instruction set meant, or an error if this CPU does not run it.
     fn isa(self) -> Result<Isa, CliError> {
-        let isa = match self {
-            IsaChoice::Auto => return Ok(Isa::detect()),
-            IsaChoice::Baseline => Isa::Baseline,
-            IsaChoice::Avx2 => Isa::Avx2,
-            IsaChoice::Avx512 => Isa::Avx512,
-        };
-        match isa.available() {
-            true => Ok(isa),
-            false => Err(format!("--isa {}: this CPU does not run it", isa.name()).into()),
+        match self {
+            IsaChoice::Auto => Ok(Isa::detect()),
+            IsaChoice::Baseline => runnable(Isa::Baseline),
+            IsaChoice::Avx2 => runnable(Isa::Avx2),
+            IsaChoice::Avx512 => runnable(Isa::Avx512),
         }
     }
 }
@@ -115,7 +111,8 @@ pub fn thread_count(asked: Option<usize>) -> Result<usize, CliError> {
         Some(t) if t > THREADS_PER_CORE * cores => {
             let cap = THREADS_PER_CORE * cores;
             eprintln!(
-                "warning: --threads {t} is more than {THREADS_PER_CORE} per core on this                  machine's {cores} cores; using {cap}"
+                "warning: --threads {t} is more than {THREADS_PER_CORE} per core on this \
+                 machine's {cores} cores; using {cap}"
             );
             Ok(cap)
         }
@@ -144,6 +141,8 @@ fn parse_transfer(s: &str) -> Result<Transfer, String> {
 
 /// Run `rtis render`.
 pub fn run(a: RenderArgs) -> Result<(), CliError> {
+    // Refused before the scene is read.
+    let isa = a.isa.isa()?;
     let mut scene = load(a.scene.as_deref())?;
     let film = &mut scene.settings.film;
     let (width, height) = film_size((film.width, film.height), a.width, a.height);
@@ -194,7 +193,6 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         eprintln!("warning: {w}");
     }
 
-    let isa = a.isa.isa()?;
     let mut prepared = rtis::extract(&scene);
     assert!(
         prepared.geometry.bvh.set_isa(isa),

@@ -378,6 +378,17 @@ mod tests {
                     .enumerate()
                     .fold(0, |acc, (k, &m)| acc | m << (4 * k))
             };
+            // `all` and `any` on every lane: all set, then each lane clear in turn.
+            let (one, zero) = (L::splat(1.0), L::splat(0.0));
+            assert!(L::all(one.cmpgt(zero)) && L::any(one.cmpgt(zero)));
+            assert!(!L::any(one.cmplt(zero)) && !L::all(one.cmplt(zero)));
+            for lane in 0..L::LANES {
+                let mut v = [1.0f32; MAX_LANES];
+                v[lane] = -1.0;
+                let m = L::from_array(v).cmpgt(zero);
+                assert!(!L::all(m) && L::any(m), "lane {lane}");
+                assert_eq!(L::bitmask(m), ((1u32 << L::LANES) - 1) & !(1 << lane));
+            }
             for a in 0..n {
                 for b in 0..n {
                     let (x, y) = (lanes(a), lanes(b));
@@ -454,17 +465,6 @@ mod tests {
                             .collect()
                     };
                     assert_eq!(lane_bits(L::from_array(x)), exact(&x));
-                    // `all` and `any` on every lane: all set, then each lane clear in turn.
-                    let (one, zero) = (L::splat(1.0), L::splat(0.0));
-                    assert!(L::all(one.cmpgt(zero)) && L::any(one.cmpgt(zero)));
-                    assert!(!L::any(one.cmplt(zero)) && !L::all(one.cmplt(zero)));
-                    for lane in 0..L::LANES {
-                        let mut v = [1.0f32; MAX_LANES];
-                        v[lane] = -1.0;
-                        let m = L::from_array(v).cmpgt(zero);
-                        assert!(!L::all(m) && L::any(m), "lane {lane}");
-                        assert_eq!(L::bitmask(m), ((1u32 << L::LANES) - 1) & !(1 << lane));
-                    }
                     assert_eq!(lane_bits(L::splat(x[3])), exact(&[x[3]; MAX_LANES]));
                 }
             }

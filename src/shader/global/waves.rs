@@ -253,11 +253,13 @@ pub fn incident(tr: &mut Tracer, g: &Global, rays: &[Ray]) -> Vec<Vec3A> {
 
 /// The depth-first sum of the tree at `root`: a node, its normal's subtree, its reflection's.
 ///
-/// The pending subtrees wait in a local array (the sum stays in a register): a tree has at
-/// most [`MAX_NODES`] nodes, so it is at most 8 levels deep and at most 9 subtrees wait at once.
+/// The pending subtrees wait in a local array (the sum stays in a register): nodes have
+/// children only above depth `D`, so a tree is at most `D` levels deep and at most `D`
+/// subtrees wait at once; the waves take `D <= 8` ([`applies`]), and no shader has more than
+/// [`super::MAX_DEPTH`].
 fn sum_tree(nodes: &[Node], kids: &[u32], root: u32) -> Vec3A {
     let mut l = Vec3A::ZERO;
-    let (mut stack, mut sp) = ([0u32; 16], 1);
+    let (mut stack, mut sp) = ([0u32; super::MAX_DEPTH as usize], 1);
     stack[0] = root;
     while sp > 0 {
         sp -= 1;
