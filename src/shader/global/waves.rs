@@ -214,9 +214,8 @@ impl Scratch {
 #[derive(Default)]
 struct Scratch {
     nodes: Vec<Node>,
-    /// Each node's first child (the normal's ray; the reflection's follows), or [`NO_KIDS`]:
-    /// apart from the nodes, so that the sum's walk from node to node reads 4 bytes a step
-    /// and the nodes' loads do not wait on one another.
+    /// Each node's first child (the normal's ray; the reflection's follows), or [`NO_KIDS`],
+    /// kept apart from the nodes: the sum's walk from node to node reads 4 bytes a step.
     kids: Vec<u32>,
     /// The rays traced now, the chains' next rays (same depth), the children (next depth):
     /// the queues of scenes with a BVH (the lanes kernel has its own, `queue` and `next`).
