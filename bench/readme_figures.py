@@ -276,6 +276,11 @@ def embree(_runs):
         "brackets)")])
 
 
+# Rounds of the `commits` block: on a shared machine a round's ratio can be 10-15% off, and
+# the median of 11 is steadier than that of 5.
+COMMIT_ROUNDS = 11
+
+
 def commits(_runs):
     lines = [
         "| scene | size | earlier commit | seconds | this commit | seconds | speed-up [range] | same pixels |",
@@ -284,7 +289,7 @@ def commits(_runs):
     for scene, width in [("scenes/cornell-n-bounce.ron", 360), ("scenes/cornell-two-bounce.ron", 360)]:
         out = subprocess.run(
             [sys.executable, "bench/commit_compare.py", "--base", COMPARE_BASE, "--scene", scene,
-             "--width", str(width), "--rounds", "5"],
+             "--width", str(width), "--rounds", str(COMMIT_ROUNDS)],
             cwd=ROOT, check=True, stdout=subprocess.PIPE, text=True,
         ).stdout
         r = json.loads([l for l in out.splitlines() if l.startswith("{")][-1])
@@ -293,7 +298,7 @@ def commits(_runs):
             f"| `{scene}` | {width} px wide | {r['base']} | {r['base_s']:.2f} | {r['head']} | {r['head_s']:.2f} | "
             f"{r['ratio']:.2f}x [{lo:.2f}-{hi:.2f}] | {'yes' if r['same_pixels'] else 'no'} |"
         )
-    return "\n".join(lines + ["", stamp("`bench/commit_compare.py` (5 rounds, one thread each, the two binaries side by side; medians)")])
+    return "\n".join(lines + ["", stamp(f"`bench/commit_compare.py` ({COMMIT_ROUNDS} rounds, one thread each, the two binaries side by side; medians)")])
 
 
 def mitsuba(_runs):
