@@ -1,18 +1,17 @@
 //! Ray queries in batches: a ray per SIMD lane, tested against one primitive at a time.
 //!
-//! A shader that holds many rays at once (the Global shader's tree of indirect rays) hands
-//! them over together, or builds them in lanes itself (the shadow rays of its hits,
-//! [`Geometry::occluded_lanes`]). Where every primitive is packed (planes,
-//! and the spheres of small scenes), the rays fill the lanes (sixteen with AVX-512, eight
-//! with AVX2, four with SSE) and each primitive is splatted across them ([`Geometry::sphere_each`],
-//! [`Geometry::plane_each`]): no lane holds a padding primitive (only a batch's last chunk
-//! may repeat its last ray), no closest-lane search runs per ray, and each ray's constants are
-//! computed once. Each lane runs the arithmetic the one-ray query runs for
-//! its pair, in the same order of primitives and with the same tie rule, and keeps the
-//! parameters of the primitive it hits, so that the hit records are computed in the lanes too
-//! ([`Geometry::nearest_lanes`], which the Global shader's waves use as well); the answers are
-//! bit-identical to [`Geometry::intersect`] and [`Geometry::occluded`] in every instruction
-//! set. Scenes with a BVH answer ray by ray.
+//! A shader that holds many rays at once (the Global shader's tree of indirect rays) hands them
+//! over together, or builds them in lanes itself (the shadow rays of its hits,
+//! [`Geometry::occluded_lanes`]). Where every primitive is packed (planes, and the spheres of small
+//! scenes), the rays fill the lanes (sixteen with AVX-512, eight with AVX2, four with SSE) and each
+//! primitive is splatted across them ([`Geometry::sphere_each`], [`Geometry::plane_each`]): no lane
+//! holds a padding primitive (only a batch's last chunk may repeat its last ray), no closest-lane
+//! search runs per ray, and each ray's constants are computed once. Each lane runs the arithmetic
+//! the one-ray query runs for its pair, in the same order of primitives and with the same tie rule,
+//! and keeps the parameters of the primitive it hits, so that the hit records are computed in the
+//! lanes too ([`Geometry::nearest_lanes`], which the Global shader's waves use as well); the
+//! answers are bit-identical to [`Geometry::intersect`] and [`Geometry::occluded`] in every
+//! instruction set. Scenes with a BVH answer ray by ray.
 //!
 //! The instruction set is the BVH's ([`super::WideBvh::isa`]): AVX-512 or AVX2 where the CPU
 //! has it. Their copies are `#[target_feature]` functions around the generic code, which has

@@ -7,8 +7,8 @@
 //! The same tests run the other way round: a ray per lane ([`RayLanes::gather`]) against one
 //! primitive in all of them ([`SphereLanes::splat`]), as a batch of rays needs, four lanes in
 //! SSE, eight in AVX2 or sixteen in AVX-512 (the tests are written once over the `Floats`
-//! lane type). Each lane computes what
-//! the scalar test computes for its pair, so every layout gives the same bits.
+//! lane type). Each lane computes what the scalar test computes for its pair, so every layout
+//! gives the same bits.
 
 use super::simd::{Floats, MAX_LANES};
 use crate::geometry::{Ray, gamma};

@@ -351,8 +351,12 @@ mod tests {
     fn lane_bits<L: Floats>(v: L) -> Vec<u32> {
         let mut out = [0.0; MAX_LANES];
         v.write_to(&mut out);
-        out[..L::LANES]
-            .iter()
+        nan_as_one(&out[..L::LANES])
+    }
+
+    /// The bits of `v`, every NaN as one (see [`lane_bits`]).
+    fn nan_as_one(v: &[f32]) -> Vec<u32> {
+        v.iter()
             .map(|x| if x.is_nan() { u32::MAX } else { x.to_bits() })
             .collect()
     }
@@ -458,14 +462,9 @@ mod tests {
                         L::bitmask(m | xv.cmpne(yv)),
                         quarter_masks(&|k| (mq[k] | xq[k].cmpne(yq[k])).bitmask())
                     );
-                    let exact = |v: &[f32]| -> Vec<u32> {
-                        v[..L::LANES]
-                            .iter()
-                            .map(|x| if x.is_nan() { u32::MAX } else { x.to_bits() })
-                            .collect()
-                    };
-                    assert_eq!(lane_bits(L::from_array(x)), exact(&x));
-                    assert_eq!(lane_bits(L::splat(x[3])), exact(&[x[3]; MAX_LANES]));
+                    assert_eq!(lane_bits(L::from_array(x)), nan_as_one(&x[..L::LANES]));
+                    let splat = [x[3]; MAX_LANES];
+                    assert_eq!(lane_bits(L::splat(x[3])), nan_as_one(&splat[..L::LANES]));
                 }
             }
             // The transposition: lane i holds vector i's coordinates.

@@ -3,21 +3,20 @@
 //! ([`Columns`]) so that a chunk loads with one load per coordinate and the children are
 //! written with one left-packing store per coordinate ([`crate::accel::Floats::compress`]).
 //!
-//! A wave's rays are one stream: a mirror or glass bounce is queued behind the rays of its
-//! depth and traced in a later chunk of the same wave, so that most chunks fill their lanes
-//! (a chunk that reaches the queue's end before the bounces of earlier chunks join it does
-//! not). The nearest hits come with their records in lanes
-//! ([`crate::accel::Geometry::nearest_lanes`], which `intersect_batch` runs too); the
-//! interaction (orientation, the origins and their error bound), the light pass
-//! ([`super::point_sums`]), each Phong node's sum and the two rays of task 2 with their
-//! weights run in lanes. What each primitive's material is comes from a table built once per
+//! A wave's rays are one stream: a mirror or glass bounce is queued behind the rays of its depth
+//! and traced in a later chunk of the same wave, so that most chunks fill their lanes (a chunk that
+//! reaches the queue's end before the bounces of earlier chunks join it does not). The nearest hits
+//! come with their records in lanes ([`crate::accel::Geometry::nearest_lanes`], which
+//! `intersect_batch` runs too); the interaction (orientation, the origins and their error bound),
+//! the light pass ([`super::point_sums`]), each Phong node's sum and the two rays of task 2 with
+//! their weights run in lanes. What each primitive's material is comes from a table built once per
 //! call ([`Slot`]). Scalar, lane by lane: the tree's bookkeeping (storing a node's sum, its
-//! children's nodes), the mirror and glass bounces, the light emitted by a surface a chain meets, and
-//! every reflectance but the course's diffuse one (a specular lobe, the Physical model), in
-//! the light terms and the children's weights. Every lane computes what the scalar code
-//! computes for its ray, operation for operation (`Geometry::intersect`'s order and tie rule,
-//! `Sphere::surface`, `Plane::surface`, `Interaction::new`, `Origins`, `reflect`,
-//! `course_reflectance`), so the result is the depth-first walk's to the bit.
+//! children's nodes), the mirror and glass bounces, the light emitted by a surface a chain meets,
+//! and every reflectance but the course's diffuse one (a specular lobe, the Physical model), in the
+//! light terms and the children's weights. Every lane computes what the scalar code computes for
+//! its ray, operation for operation (`Geometry::intersect`'s order and tie rule, `Sphere::surface`,
+//! `Plane::surface`, `Interaction::new`, `Origins`, `reflect`, `course_reflectance`), so the result
+//! is the depth-first walk's to the bit.
 
 use super::{LightLanes, Scratch, point_sums};
 use crate::accel::lanes::{RayLanes, abs_max, dot};
@@ -37,12 +36,21 @@ const DX: usize = 3;
 const OE: usize = 6;
 const TM: usize = 7;
 
-/// One number of a ray: what a column of [`Columns`] holds.
-type RayField = fn(&Ray) -> f32;
+/// What each column of a [`Columns`] queue holds of a ray, in the columns' order.
+const FIELDS: [fn(&Ray) -> f32; 8] = [
+    |r| r.o.x,
+    |r| r.o.y,
+    |r| r.o.z,
+    |r| r.d.x,
+    |r| r.d.y,
+    |r| r.d.z,
+    |r| r.o_err,
+    |r| r.t_max,
+];
 
 /// Rays waiting to be traced, with their nodes, a column per coordinate (structure of
-/// arrays). Each column holds at least [`MAX_LANES`] values past the last ray, so that a chunk of
-/// lanes loads whole and a left-packing store has room (values past the last ray are left
+/// arrays). Each column holds at least [`MAX_LANES`] values past the last ray, so that a
+/// chunk of lanes loads whole and a left-packing store has room (values past the last ray are left
 /// over from earlier rays, or zero, and only ever fill lanes that are dropped).
 #[derive(Default)]
 pub(super) struct Columns {
@@ -77,18 +85,7 @@ impl Columns {
         self.reserve(rays.len());
         let (k, n) = (self.len, rays.len());
         // A column at a time, each a slice bounds-checked once.
-        let [ox, oy, oz, dx, dy, dz, oe, tm] = &mut self.rows;
-        let columns: [(&mut Vec<f32>, RayField); 8] = [
-            (ox, |r| r.o.x),
-            (oy, |r| r.o.y),
-            (oz, |r| r.o.z),
-            (dx, |r| r.d.x),
-            (dy, |r| r.d.y),
-            (dz, |r| r.d.z),
-            (oe, |r| r.o_err),
-            (tm, |r| r.t_max),
-        ];
-        for (column, value) in columns {
+        for (column, value) in self.rows.iter_mut().zip(FIELDS) {
             for (x, r) in column[k..k + n].iter_mut().zip(rays) {
                 *x = value(r);
             }
@@ -105,8 +102,8 @@ impl Columns {
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
     unsafe fn load<L: Floats>(&self, row: usize, k: usize) -> L {
-        // SAFETY: the caller vouches for the instruction set; the column holds `MAX_LANES` values
-        // past `len` (`reserve`).
+        // SAFETY: the caller vouches for the instruction set; the column holds `MAX_LANES`
+        // values past `len` (`reserve`).
         unsafe { L::from_slice(&self.rows[row][k..]) }
     }
 }
