@@ -61,6 +61,26 @@ impl Attrs {
     };
 }
 
+/// The leaf tests' constants of one query's ray ([`BvhRay::sheared`] and [`BlockRay`]),
+/// computed when it reaches its first leaf: most rays of an incoherent set leave the tree
+/// before that, and the box tests need only `1 / d`.
+#[derive(Default)]
+struct LeafRay(Option<(BvhRay, BlockRay)>);
+
+impl LeafRay {
+    /// The ray `r` of the traversal (box constants only, its `t_max` the current one) with the
+    /// triangle test's constants if `triangles`, and in lanes.
+    #[inline(always)]
+    fn get(&mut self, r: &BvhRay, triangles: bool) -> (&BvhRay, &BlockRay) {
+        let (full, lanes) = self.0.get_or_insert_with(|| {
+            let full = if triangles { r.sheared() } else { *r };
+            (full, BlockRay::new(&full))
+        });
+        full.ray.t_max = r.t_max;
+        (full, lanes)
+    }
+}
+
 /// All of a scene's primitives, ready for ray queries.
 ///
 /// A primitive's index (what [`Hit::prim`] holds) below `4 * blocks.len()` is a lane of a BVH
@@ -365,10 +385,11 @@ impl Geometry {
                 .closest(lanes, &mut t_max, &mut best, SphereLanes::hit);
         }
         if !self.bvh.nodes.is_empty() {
-            let r = ray.for_bvh(t_max, self.has_triangles);
-            let br = BlockRay::new(&r);
+            let r = ray.for_bvh(t_max, false);
+            let mut leaf_ray = LeafRay::default();
             let leaf = |b: u32, r: &BvhRay| {
-                let hit = self.blocks[b as usize].closest(&self.others, &br, r);
+                let (r, br) = leaf_ray.get(r, self.has_triangles);
+                let hit = self.blocks[b as usize].closest(&self.others, br, r);
                 hit.map(|(lane, t)| (4 * b + lane, t))
             };
             let touch = |b: u32| wide::prefetch(&self.blocks[b as usize]);
@@ -420,10 +441,12 @@ impl Geometry {
             self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
                 || (planes && self.planes.any(&lanes, ray.t_max, PlaneLanes::hit))
         }) || (!self.bvh.nodes.is_empty() && {
-            let r = ray.for_bvh(ray.t_max, self.has_triangles);
-            let br = BlockRay::new(&r);
-            self.bvh
-                .any(&r, |b, r| self.blocks[b as usize].any(&self.others, &br, r))
+            let r = ray.for_bvh(ray.t_max, false);
+            let mut leaf_ray = LeafRay::default();
+            self.bvh.any(&r, |b, r| {
+                let (r, br) = leaf_ray.get(r, self.has_triangles);
+                self.blocks[b as usize].any(&self.others, br, r)
+            })
         })
     }
 }

@@ -78,7 +78,27 @@ impl BvhRay {
     /// `ray` with every constant: `1 / d`, and the axes and shear of the triangle test.
     #[inline]
     pub fn new(ray: Ray) -> Self {
-        let d = ray.d;
+        Self::boxes(ray).sheared()
+    }
+
+    /// `ray` with the box tests' constant, `1 / d`; the triangle test's are left unset
+    /// (`[0, 1, 2]` and zeros) until [`BvhRay::sheared`] adds them.
+    #[inline]
+    pub fn boxes(ray: Ray) -> Self {
+        BvhRay {
+            inv_d: ray.d.recip(),
+            ray,
+            k: [0, 1, 2],
+            shear: [0.0; 3],
+        }
+    }
+
+    /// This ray with the axes and shear of the watertight triangle test, from its `1 / d`:
+    /// what [`BvhRay::new`] gives. A query computes them when it first reaches a triangle
+    /// (most rays of an incoherent set leave the tree before that).
+    #[inline]
+    pub fn sheared(&self) -> Self {
+        let d = self.ray.d;
         // The axes by selects and array reads, not branches: an incoherent ray's axis and
         // sign are a coin toss to the branch predictor (about one misprediction a ray).
         // `kz` is `d.abs().max_position()` (the first of equal largest).
@@ -91,14 +111,12 @@ impl BvhRay {
         let [x, y] = NEXT[kz];
         let down = (da[kz] < 0.0) as usize;
         let (kx, ky) = ([x, y][down], [y, x][down]);
-        let inv_d = d.recip();
-        // `1 / d[kz]`, the same division.
-        let sz = inv_d.to_array()[kz];
+        // `1 / d[kz]`, the box tests' division.
+        let sz = self.inv_d.to_array()[kz];
         BvhRay {
-            ray,
-            inv_d,
             k: [kx, ky, kz],
             shear: [da[kx] * sz, da[ky] * sz, sz],
+            ..*self
         }
     }
 }
@@ -134,17 +152,8 @@ impl Ray {
     /// they stay unset: `[0, 1, 2]` and zeros).
     #[inline]
     pub fn for_bvh(&self, t_max: f32, triangles: bool) -> BvhRay {
-        let ray = Ray { t_max, ..*self };
-        if triangles {
-            BvhRay::new(ray)
-        } else {
-            BvhRay {
-                ray,
-                inv_d: self.d.recip(),
-                k: [0, 1, 2],
-                shear: [0.0; 3],
-            }
-        }
+        let ray = BvhRay::boxes(Ray { t_max, ..*self });
+        if triangles { ray.sheared() } else { ray }
     }
 
     /// The point at distance `t`.
