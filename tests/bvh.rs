@@ -222,17 +222,18 @@ fn wide_tree_holds_the_binary_leaves_in_boxes_that_contain_them() {
     let mut leaves = 0;
     // (wide node, the binary boxes of its children are checked through the leaves and the
     // nesting of their contents).
-    let mut stack = vec![0usize];
+    let mut stack = vec![wide.root()];
+    let mut top_nodes = 0;
     while let Some(i) = stack.pop() {
-        let n = &wide.nodes[i];
+        let (child, boxes, step) = wide.child_boxes(i);
+        top_nodes += (i & wide::TOP != 0) as usize;
         for slot in 0..wide::WIDTH {
-            let c = n.child[slot];
-            let Some((lo, hi)) = n.child_box(slot) else {
+            let c = child[slot];
+            let Some((lo, hi)) = boxes[slot] else {
                 assert_eq!(c, wide::EMPTY);
                 continue;
             };
-            let step = Vec3::from_array(n.step);
-            // Everything below this slot must lie in its decoded box.
+            // Everything below this slot must lie in its box.
             let mut below = vec![c];
             let (mut tight_lo, mut tight_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
             while let Some(d) = below.pop() {
@@ -244,18 +245,14 @@ fn wide_tree_holds_the_binary_leaves_in_boxes_that_contain_them() {
                         tight_hi = tight_hi.max(b);
                     }
                 } else {
-                    below.extend(
-                        wide.nodes[d as usize]
-                            .child
-                            .iter()
-                            .filter(|&&x| x != wide::EMPTY),
-                    );
+                    below.extend(wide.child_boxes(d).0.iter().filter(|&&x| x != wide::EMPTY));
                 }
             }
             assert!(
                 tight_lo.cmpge(lo).all() && tight_hi.cmple(hi).all(),
                 "contents {tight_lo}..{tight_hi} outside the decoded box {lo}..{hi}"
             );
+            // A top node's boxes are exact (a step of 0).
             assert!(
                 (tight_lo - lo).cmple(step * 1.001).all()
                     && (hi - tight_hi).cmple(step * 1.001).all(),
@@ -268,10 +265,12 @@ fn wide_tree_holds_the_binary_leaves_in_boxes_that_contain_them() {
                     *s += 1;
                 }
             } else {
-                stack.push(c as usize);
+                stack.push(c);
             }
         }
     }
+    // The top levels are full over 20k triangles: 1 + 8 + 64 nodes.
+    assert_eq!((top_nodes, wide.top.len()), (73, 73));
     assert!(
         seen.iter().all(|&s| s == 1),
         "a primitive missing or repeated"
@@ -283,14 +282,23 @@ fn wide_tree_holds_the_binary_leaves_in_boxes_that_contain_them() {
     // where both children are leaves; one that never opened a child would replace one each.
     let interior = g.bvh.nodes.len() - binary_leaves;
     assert!(
-        wide.nodes.len() * 100 < interior * 27,
+        wide.node_count() * 100 < interior * 27,
         "{} wide nodes for {interior} binary interior nodes",
-        wide.nodes.len()
+        wide.node_count()
     );
     assert_eq!(
         std::mem::size_of::<rtis::accel::WideNode>(),
         128,
         "two cache lines"
+    );
+    assert_eq!(
+        std::mem::size_of::<rtis::accel::wide::TopNode>(),
+        256,
+        "four cache lines"
+    );
+    assert_eq!(
+        wide.node_bytes(),
+        128 * wide.nodes.len() + 256 * wide.top.len()
     );
 }
 
@@ -450,15 +458,15 @@ fn every_instruction_set_visits_the_same_leaves() {
     );
 }
 
-/// A tree of one leaf is a root with one child, and an empty set gives an empty tree that no
-/// ray hits.
+/// A tree of one leaf is a root (a top node) with one child, and an empty set gives an empty
+/// tree that no ray hits.
 #[test]
 fn small_wide_trees() {
     let t = Triangle::new(Vec3A::ZERO, Vec3A::X, Vec3A::Y).unwrap();
     let g = build(vec![Prim::flat(Shape::Triangle(t)); 3]);
     let (wide, ranges) = collapse(&g.bvh);
-    assert_eq!(wide.nodes.len(), 1);
-    assert_eq!(wide.nodes[0].child[1..], [wide::EMPTY; wide::WIDTH - 1]);
+    assert_eq!((wide.top.len(), wide.nodes.len()), (1, 0), "a top node");
+    assert_eq!(wide.top[0].child[1..], [wide::EMPTY; wide::WIDTH - 1]);
     assert_eq!(ranges, [(0, 3)], "the one leaf holds all three");
     let down = BvhRay::new(Ray::new(Vec3A::new(0.2, 0.2, 1.0), -Vec3A::Z));
     let hit = wide.closest(&down, |b, _| Some((b, 1.0)), |_| {});

@@ -67,7 +67,7 @@ impl Geometry {
     /// True if the batched queries can put rays in the lanes: every primitive is packed.
     #[inline]
     fn all_packed(&self) -> bool {
-        self.bvh.nodes.is_empty()
+        self.bvh.is_empty()
     }
 
     /// The nearest hit of each ray of `rays`, as [`Geometry::intersect`] finds it, into `hits`

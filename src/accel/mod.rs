@@ -384,7 +384,7 @@ impl Geometry {
             self.spheres
                 .closest(lanes, &mut t_max, &mut best, SphereLanes::hit);
         }
-        if !self.bvh.nodes.is_empty() {
+        if !self.bvh.is_empty() {
             let r = ray.for_bvh(t_max, false);
             let mut leaf_ray = LeafRay::default();
             let leaf = |b: u32, r: &BvhRay| {
@@ -392,7 +392,7 @@ impl Geometry {
                 let hit = self.blocks[b as usize].closest(&self.others, br, r);
                 hit.map(|(lane, t)| (4 * b + lane, t))
             };
-            let touch = |b: u32| wide::prefetch(&self.blocks[b as usize]);
+            let touch = |b: u32| wide::prefetch(self.blocks.as_ptr().wrapping_add(b as usize));
             if let Some((i, t)) = self.bvh.closest(&r, leaf, touch) {
                 t_max = t;
                 best = Some(i);
@@ -440,7 +440,7 @@ impl Geometry {
             let lanes = RayLanes::new(ray);
             self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
                 || (planes && self.planes.any(&lanes, ray.t_max, PlaneLanes::hit))
-        }) || (!self.bvh.nodes.is_empty() && {
+        }) || (!self.bvh.is_empty() && {
             let r = ray.for_bvh(ray.t_max, false);
             let mut leaf_ray = LeafRay::default();
             self.bvh.any(&r, |b, r| {

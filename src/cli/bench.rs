@@ -5,7 +5,7 @@ use clap::Args;
 use glam::{Vec3, Vec3A};
 use rtis::RenderScene;
 use rtis::accel::block::Block;
-use rtis::accel::{Attrs, Geometry, Isa, Prim, WideNode};
+use rtis::accel::{Attrs, Geometry, Isa, Prim};
 use rtis::converge::{reference_shader, with_settings};
 use rtis::geometry::Ray;
 use rtis::mesh::displaced_sphere;
@@ -323,13 +323,13 @@ struct BuiltOnce(Geometry);
 
 impl PartialEq for BuiltOnce {
     fn eq(&self, other: &Self) -> bool {
-        self.0.bvh.nodes.len() == other.0.bvh.nodes.len()
+        self.0.bvh.node_count() == other.0.bvh.node_count()
     }
 }
 
 impl std::fmt::Debug for BuiltOnce {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        write!(f, "{} wide nodes", self.0.bvh.nodes.len())
+        write!(f, "{} wide nodes", self.0.bvh.node_count())
     }
 }
 
@@ -383,10 +383,9 @@ fn meshes_section(
             (start.elapsed().as_secs_f64(), BuiltOnce(g))
         });
         let mut g = g.0;
-        let nodes = g.bvh.nodes.len();
-        // The tree's nodes and its leaves' blocks of lanes.
-        let bvh_bytes = (nodes * std::mem::size_of::<WideNode>()
-            + g.blocks.len() * std::mem::size_of::<Block>()) as f64
+        let nodes = g.bvh.node_count();
+        // The tree's nodes of both kinds and its leaves' blocks of lanes.
+        let bvh_bytes = (g.bvh.node_bytes() + g.blocks.len() * std::mem::size_of::<Block>()) as f64
             / count as f64;
         // Camera rays: a pinhole at z = -3 through a 1000 x 1000 grid covering the sphere.
         let eye = Vec3A::new(0.0, 0.0, -3.0);

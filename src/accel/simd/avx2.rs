@@ -31,6 +31,11 @@ impl Lanes8 for Avx2 {
         }
     }
     #[inline(always)]
+    unsafe fn load(x: &[f32; 8]) -> Self {
+        // The load reads the 32 bytes of `x`.
+        Avx2(unsafe { _mm256_loadu_ps(x.as_ptr()) })
+    }
+    #[inline(always)]
     unsafe fn add(self, b: Self) -> Self {
         Avx2(unsafe { _mm256_add_ps(self.0, b.0) })
     }

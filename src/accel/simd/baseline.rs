@@ -153,6 +153,10 @@ impl Lanes8 for Halves {
         ])
     }
     #[inline(always)]
+    unsafe fn load(x: &[f32; 8]) -> Self {
+        Halves([Vec4::from_slice(&x[..4]), Vec4::from_slice(&x[4..])])
+    }
+    #[inline(always)]
     unsafe fn add(self, b: Self) -> Self {
         self.zip(b, |x, y| x + y)
     }

@@ -120,6 +120,8 @@ pub trait Lanes8: Copy {
     unsafe fn splat(x: f32) -> Self;
     /// Eight grid coordinates as floats (exact: a byte fits a float's significand).
     unsafe fn widen(q: &[u8; 8]) -> Self;
+    /// Eight floats, lane `k` from `x[k]`.
+    unsafe fn load(x: &[f32; 8]) -> Self;
     /// Lane-wise `self + b`.
     unsafe fn add(self, b: Self) -> Self;
     /// Lane-wise `self - b`.

@@ -286,7 +286,7 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         s.add_node(Vec3A::ONE);
         tr.stats.count(RayKind::Indirect);
     }
-    if tr.geometry.bvh.nodes.is_empty() {
+    if tr.geometry.bvh.is_empty() {
         // Every primitive packed: each wave traced and shaded in lanes.
         lanes::trace(tr, g, roots, s);
         return;
