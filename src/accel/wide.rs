@@ -637,80 +637,59 @@ impl WideBvh {
         // SAFETY: the caller's.
         let rb = unsafe { RayBox::<L>::new(ray.o, ray.inv_d) };
         let mut best = None;
-        // Test leaf `c`; a hit shortens the ray and becomes the best so far.
-        let mut leaf = |c: u32, r: &mut BvhRay, best: &mut Option<(u32, f32)>| {
-            if let Some((p, t)) = test(c & !LEAF, r) {
-                r.ray.t_max = t;
-                *best = Some((p, t));
-            }
-        };
         let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
         let mut sp = 0usize;
-        let mut node = self.root();
+        // The node or leaf visited next: the nearest child entered, or the nearest entry on
+        // the stack; the farther children wait on the stack.
+        let mut cur = self.root();
         loop {
-            // SAFETY: the caller's.
-            let (near, mut mask, child) = unsafe { self.visit(node, &rb, r.t_max) };
-            // One child entered (the common case for coherent rays): no ordering to do.
-            if mask != 0 && mask & (mask - 1) == 0 {
-                let c = child[mask.trailing_zeros() as usize];
-                if c & LEAF == 0 {
-                    node = c;
+            if cur & LEAF != 0 {
+                // One place tests leaves: a hit shortens the ray and becomes the best so far.
+                if let Some((p, t)) = test(cur & !LEAF, &r) {
+                    r.ray.t_max = t;
+                    best = Some((p, t));
+                }
+            } else {
+                // SAFETY: the caller's.
+                let (near, mut mask, child) = unsafe { self.visit(cur, &rb, r.t_max) };
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    // One child entered (the common case for coherent rays): no ordering to do.
+                    if mask == 0 {
+                        cur = child[first];
+                        continue;
+                    }
+                    // SAFETY: the caller's.
+                    let near = unsafe { near.to_array() };
+                    // The children entered, farthest first (insertion into at most eight; of
+                    // equal distances, the later slot goes nearer the end, and is visited
+                    // first). Each is asked for now, so that their cache misses overlap.
+                    let mut next: [(u32, f32); WIDTH] = [(0, 0.0); WIDTH];
+                    next[0] = (child[first], near[first]);
+                    self.ask(child[first], &touch);
+                    let mut k = 1;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        self.ask(child[i], &touch);
+                        let mut j = k;
+                        while j > 0 && next[j - 1].1 < near[i] {
+                            next[j] = next[j - 1];
+                            j -= 1;
+                        }
+                        next[j] = (child[i], near[i]);
+                        k += 1;
+                    }
+                    for &entry in &next[..k - 1] {
+                        stack[sp].write(entry);
+                        sp += 1;
+                    }
+                    cur = next[k - 1].0;
                     continue;
                 }
-                leaf(c, &mut r, &mut best);
-                mask = 0;
             }
-            // SAFETY: the caller's.
-            let near = unsafe { near.to_array() };
-            // The hit children, farthest first (insertion into at most eight).
-            let mut next: [(u32, f32); WIDTH] = [(0, 0.0); WIDTH];
-            let mut k = 0;
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let c = child[i];
-                if c & LEAF != 0 {
-                    touch(c & !LEAF);
-                } else if c & TOP == 0 {
-                    // (Top nodes are few, and every ray reads them: they stay cached.)
-                    prefetch(self.nodes.as_ptr().wrapping_add(c as usize));
-                }
-                let mut j = k;
-                while j > 0 && next[j - 1].1 < near[i] {
-                    next[j] = next[j - 1];
-                    j -= 1;
-                }
-                next[j] = (c, near[i]);
-                k += 1;
-            }
-            // In distance order: leaves are tested until the nearest interior child, which is
-            // visited next; the farther children wait on the stack.
-            let mut go = None;
-            while k > 0 {
-                k -= 1;
-                let (c, t) = next[k];
-                if t > r.t_max {
-                    k = 0;
-                    break;
-                }
-                if c & LEAF == 0 {
-                    go = Some(c);
-                    break;
-                }
-                leaf(c, &mut r, &mut best);
-            }
-            for &entry in &next[..k] {
-                if entry.1 <= r.t_max {
-                    stack[sp].write(entry);
-                    sp += 1;
-                }
-            }
-            if let Some(c) = go {
-                node = c;
-                continue;
-            }
-            // Pop: test leaves, skip what a closer hit found meanwhile has made irrelevant,
-            // visit the first interior node left.
+            // Pop, skipping what a closer hit found meanwhile has made irrelevant.
             loop {
                 if sp == 0 {
                     return best;
@@ -718,15 +697,23 @@ impl WideBvh {
                 sp -= 1;
                 // SAFETY: entries below `sp` were written before `sp` was raised past them.
                 let (c, t) = unsafe { stack[sp].assume_init() };
-                if t > r.t_max {
-                    continue;
-                }
-                if c & LEAF == 0 {
-                    node = c;
+                if t <= r.t_max {
+                    cur = c;
                     break;
                 }
-                leaf(c, &mut r, &mut best);
             }
+        }
+    }
+
+    /// Ask for child `c`'s data ahead of its visit: a leaf's through `touch`, an interior
+    /// node's by [`prefetch`] (but a top node's: they are few, and every ray reads them, so
+    /// they stay cached).
+    #[inline(always)]
+    fn ask(&self, c: ChildRef, touch: &impl Fn(u32)) {
+        if c & LEAF != 0 {
+            touch(c & !LEAF);
+        } else if c & TOP == 0 {
+            prefetch(self.nodes.as_ptr().wrapping_add(c as usize));
         }
     }
 
