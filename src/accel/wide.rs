@@ -662,6 +662,21 @@ impl WideBvh {
                     }
                     // SAFETY: the caller's.
                     let near = unsafe { near.to_array() };
+                    let second = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    // Two (the common case of several): the farther waits, the later slot of
+                    // two at one distance is visited first, as the insertion below orders them.
+                    if mask == 0 {
+                        let (a, b) = ((child[first], near[first]), (child[second], near[second]));
+                        let (go, wait) = if a.1 < b.1 { (a, b) } else { (b, a) };
+                        self.ask(wait.0, &touch);
+                        stack[sp].write(wait);
+                        sp += 1;
+                        cur = go.0;
+                        continue;
+                    }
+                    // Restore the second child for the general case.
+                    mask |= 1 << second;
                     // The children entered, farthest first (insertion into at most eight; of
                     // equal distances, the later slot goes nearer the end, and is visited
                     // first). Each is asked for now, so that their cache misses overlap.
