@@ -298,6 +298,10 @@ pub fn prefetch<T>(x: *const T) {
 struct RayBox<L> {
     o: [L; 3],
     inv_d: [L; 3],
+    /// `inv_d` raised by `1 + 4 eps` in magnitude (and kept finite): the exit distances it
+    /// gives exceed the exact ones, whatever the rounding of the three operations that make
+    /// them, so the test never drops a box the ray grazes.
+    inv_exit: [L; 3],
     /// `back[axis]` is 1 if the ray runs towards smaller coordinates on that axis (the sign
     /// bit of its reciprocal direction): it then enters a slab by its largest side, else 0.
     back: [usize; 3],
@@ -314,12 +318,19 @@ impl<L: Lanes8> RayBox<L> {
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
     unsafe fn new(o: Vec3A, inv_d: Vec3A) -> Self {
-        let inv_d = inv_d.clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX));
-        // SAFETY: the caller's.
+        let finite = |v: Vec3A| v.clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX));
+        let inv_exit = finite(inv_d * (1.0 + 4.0 * f32::EPSILON));
+        let inv_d = finite(inv_d);
+        // SAFETY: the caller's. (No closure for the splats, as in `Planes::hit`.)
         unsafe {
             RayBox {
                 o: [L::splat(o.x), L::splat(o.y), L::splat(o.z)],
                 inv_d: [L::splat(inv_d.x), L::splat(inv_d.y), L::splat(inv_d.z)],
+                inv_exit: [
+                    L::splat(inv_exit.x),
+                    L::splat(inv_exit.y),
+                    L::splat(inv_exit.z),
+                ],
                 back: {
                     let m = inv_d.is_negative_bitmask() as usize;
                     [m & 1, (m >> 1) & 1, m >> 2]
@@ -327,6 +338,15 @@ impl<L: Lanes8> RayBox<L> {
             }
         }
     }
+}
+
+/// `t` raised by `1 + 4 eps`: the reach the node test compares a computed entry distance with.
+/// An entry distance is computed with a relative error below that margin, so a box that the
+/// ray enters before `t` in exact arithmetic is kept even where its computed entry comes out a
+/// few ulps beyond `t`, as at a vertex shared by triangles whose hits differ by an ulp.
+#[inline(always)]
+fn grown(t: f32) -> f32 {
+    t * (1.0 + 4.0 * f32::EPSILON)
 }
 
 /// Traversal stack size: a wide level leaves at most seven more entries on the stack than it
@@ -348,11 +368,14 @@ trait Planes {
     unsafe fn planes<L: Lanes8>(&self, axis: usize, side: usize) -> L;
 
     /// Entry distances of the eight children and the lanes whose box the ray enters within
-    /// `(0, t_max]`.
+    /// `(0, t_max]`, `t_max` [`grown`] by the margin for rounding.
     ///
     /// The slab test of [`Aabb::hit`](crate::geometry::Aabb::hit) with each slab's entry and
     /// exit sides chosen by the sign of the direction (as Embree does) instead of a min and max
-    /// of both. No NaN arises: [`RayBox::new`] keeps the reciprocal direction finite.
+    /// of both, and the exits' margin for rounding in their reciprocal ([`RayBox::inv_exit`])
+    /// rather than in a product after the minimum, so that the chain of operations from the
+    /// node's load to the mask is short: the traversal of an incoherent ray waits on it at every
+    /// node. No NaN arises: [`RayBox::new`] keeps the reciprocal direction finite.
     ///
     /// # Safety
     /// The CPU must run `L`'s instruction set.
@@ -366,17 +389,15 @@ trait Planes {
                 self.side(r, 1, false),
                 self.side(r, 2, false),
             );
-            let near = x.max(y.max(z.max(L::splat(0.0))));
+            // (Pairs, then the pairs' results: two steps of latency instead of three.)
+            let near = x.max(y).max(z.max(L::splat(0.0)));
             let (x, y, z) = (
                 self.side(r, 0, true),
                 self.side(r, 1, true),
                 self.side(r, 2, true),
             );
-            let far = x
-                .min(y.min(z.min(L::splat(f32::INFINITY))))
-                .mul(L::splat(1.0 + 4.0 * f32::EPSILON));
-            let ok = near.le(far) & near.le(L::splat(t_max));
-            (near, ok & L::ne_u32(self.children(), EMPTY))
+            let far = x.min(y).min(z.min(L::splat(grown(t_max))));
+            (near, near.le(far) & L::ne_u32(self.children(), EMPTY))
         }
     }
 
@@ -388,10 +409,16 @@ trait Planes {
     #[inline(always)]
     unsafe fn side<L: Lanes8>(&self, r: &RayBox<L>, axis: usize, exit: bool) -> L {
         // SAFETY: the caller's.
+        let inv = if exit {
+            &r.inv_exit[axis]
+        } else {
+            &r.inv_d[axis]
+        };
+        // SAFETY: the caller's.
         unsafe {
             self.planes::<L>(axis, r.back[axis] ^ exit as usize)
                 .sub(r.o[axis])
-                .mul(r.inv_d[axis])
+                .mul(*inv)
         }
     }
 }
@@ -715,7 +742,7 @@ impl WideBvh {
                 sp -= 1;
                 // SAFETY: entries below `sp` were written before `sp` was raised past them.
                 let (c, t) = unsafe { stack[sp].assume_init() };
-                if t <= t_max {
+                if t <= grown(t_max) {
                     cur = c;
                     break;
                 }
