@@ -7,7 +7,7 @@ use glam::{Vec3, Vec3A};
 use obvhs::{BvhBuildParams, cwbvh::builder::build_cwbvh_from_tris, ray::RayHit};
 use rayon::prelude::*;
 use rtis::accel::block::Block;
-use rtis::accel::{Attrs, Geometry, Prim, WideNode};
+use rtis::accel::{Attrs, Geometry, Prim};
 use rtis::geometry::Ray;
 use rtis::mesh::displaced_sphere;
 use rtis::sampling::{Sampler, hemisphere};
@@ -52,12 +52,12 @@ fn main() {
         let t = Instant::now();
         let g = Geometry::build(prims, Vec::new());
         let build = t.elapsed().as_secs_f64();
-        let bytes = (g.bvh.nodes.len() * std::mem::size_of::<WideNode>()
+        let bytes = (g.bvh.node_bytes()
             + g.blocks.len() * std::mem::size_of::<Block>()
             + g.attrs.len() * std::mem::size_of::<Attrs>()) as f64
             / count as f64;
         let (r, hits) = rate(&rays, |o, d| g.intersect(&Ray::new(o, d)).is_some());
-        line(count, "rtis BVH8, quantised", build, bytes, r, hits);
+        line(count, "rtis BVH8, float top, quantised", build, bytes, r, hits);
         // obvhs.
         let otris: Vec<obvhs::triangle::Triangle> = tris
             .iter()
