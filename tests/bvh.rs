@@ -211,8 +211,8 @@ fn each_isa(wide: &WideBvh) -> Vec<WideBvh> {
 }
 
 /// The eight-wide tree holds every primitive of the binary one once, in the same leaves; each
-/// decoded child box contains the binary subtree's exact box and is at most a grid step (1/255
-/// of the parent's extent) larger on each side.
+/// child box contains the binary subtree's exact box: a top node's is that box, a quantised
+/// node's decoded box is at most a grid step (1/255 of the parent's extent) larger on each side.
 #[test]
 fn wide_tree_holds_the_binary_leaves_in_boxes_that_contain_them() {
     let g = build(mesh_prims(20_000));
@@ -304,7 +304,8 @@ fn wide_tree_holds_the_binary_leaves_in_boxes_that_contain_them() {
 
 /// Boxes far from the origin, tiny, huge and flat keep containing what they hold after
 /// quantisation: a wide tree over a mesh scaled by 1e-6 to 1e9 and moved up to 1e12 away
-/// (every triangle keeping a non-zero area in single precision).
+/// (every triangle keeping a non-zero area in single precision). Every leaf slot of both kinds
+/// of node is checked; most hang off quantised nodes (the top levels hold at most 73 nodes).
 #[test]
 fn quantised_boxes_contain_their_triangles_at_every_scale() {
     for (scale, offset) in [
@@ -314,7 +315,7 @@ fn quantised_boxes_contain_their_triangles_at_every_scale() {
         (1e9, 0.0),
         (1e9, -1e12),
     ] {
-        let prims: Vec<Prim> = mesh_prims(2_000)
+        let prims: Vec<Prim> = mesh_prims(20_000)
             .iter()
             .filter_map(|p| {
                 let Shape::Triangle(t) = p.shape else {
@@ -325,18 +326,22 @@ fn quantised_boxes_contain_their_triangles_at_every_scale() {
             })
             .collect();
         assert!(
-            prims.len() > 1_500,
+            prims.len() > 15_000,
             "{scale} {offset}: {} triangles",
             prims.len()
         );
         let g = build(prims);
         let (wide, ranges) = collapse(&g.bvh);
-        for n in &wide.nodes {
+        let refs = (0..wide.top.len() as u32).map(|i| wide::TOP | i);
+        let mut quantised = 0;
+        for r in refs.chain(0..wide.nodes.len() as u32) {
+            let (child, boxes, _) = wide.child_boxes(r);
             for slot in 0..wide::WIDTH {
-                let (Some((lo, hi)), c) = (n.child_box(slot), n.child[slot]) else {
+                let (Some((lo, hi)), c) = (boxes[slot], child[slot]) else {
                     continue;
                 };
                 if c & wide::LEAF != 0 {
+                    quantised += (r & wide::TOP == 0) as usize;
                     let (first, count) = ranges[(c & !wide::LEAF) as usize];
                     for p in &g.prims[first..first + count] {
                         let (a, b) = tri_box(p);
@@ -348,6 +353,10 @@ fn quantised_boxes_contain_their_triangles_at_every_scale() {
                 }
             }
         }
+        assert!(
+            quantised > 3_000,
+            "{quantised} leaves under quantised nodes"
+        );
     }
 }
 
@@ -394,9 +403,10 @@ fn wide_tree_finds_what_the_binary_tree_finds() {
 
 /// Rays aimed at the triangles' vertices, which lie on the corners and edges of the leaves'
 /// boxes, where a ray's entry into a box and its exit are the same distance in exact arithmetic:
-/// the node test's margin for rounding ([`wide`]'s exit reciprocal, raised by `1 + 4 eps`) keeps
-/// every such box, so the wide tree finds what testing every triangle finds. (Without the
-/// margin, some of these rays lose their hit.)
+/// the node test's margins for rounding ([`wide`]'s exit reciprocal raised by `1 + 4 eps`, and
+/// the reach a computed entry is compared with, raised alike) keep every such box, so the wide
+/// tree finds what testing every triangle finds. (Without either margin, some of these rays
+/// lose their hit or find one an ulp farther.)
 #[test]
 fn rays_aimed_at_vertices_find_what_every_triangle_finds() {
     let g = build(mesh_prims(2_000));

@@ -8,12 +8,11 @@
 //! grid spanning the node's box (Embree's compressed nodes, Ylitie et al. 2017), so a node is
 //! 128 bytes, two cache lines, about half of what full-precision boxes take. The top levels'
 //! nodes ([`TopNode`], at most 73 of them) keep their children's boxes in floats: every ray
-//! tests the root, and most rays of an incoherent set leave the tree within these levels, so
-//! their test skips the decoding for the price of a few kilobytes. The grid rounds every box outwards, with each
-//! coordinate checked after rounding against the decoding the traversal does (`origin + q *
-//! step`, the same two operations), so a decoded box always contains the exact one: a ray can
-//! visit a few
-//! more nodes, never miss one. The slab test on the decoded boxes is
+//! tests the root, and an incoherent ray makes most of its visits within these levels, so their
+//! test skips the decoding for the price of a few kilobytes. The grid rounds every box
+//! outwards, with each coordinate checked after rounding against the decoding the traversal
+//! does (`origin + q * step`, the same two operations), so a decoded box always contains the
+//! exact one: a ray can visit a few more nodes, never miss one. The slab test on the boxes is
 //! [`Aabb::hit`](crate::geometry::Aabb::hit)'s, lane by lane (entry and exit sides chosen by the
 //! direction's sign), with the reciprocal direction kept finite.
 
@@ -284,8 +283,9 @@ pub fn prefetch<T>(x: *const T) {
             line(at);
             at += 64;
         }
-        // Not needed where every `T` starts a line and fills whole ones (the nodes).
-        if !size.is_multiple_of(64) || !std::mem::align_of::<T>().is_multiple_of(64) {
+        // Not needed where every `T` starts a line and fills whole ones (the nodes), nor for a
+        // `T` of no bytes.
+        if size > 0 && (!size.is_multiple_of(64) || !std::mem::align_of::<T>().is_multiple_of(64)) {
             line(size - 1);
         }
     }
@@ -298,9 +298,11 @@ pub fn prefetch<T>(x: *const T) {
 struct RayBox<L> {
     o: [L; 3],
     inv_d: [L; 3],
-    /// `inv_d` raised by `1 + 4 eps` in magnitude (and kept finite): the exit distances it
-    /// gives exceed the exact ones, whatever the rounding of the three operations that make
-    /// them, so the test never drops a box the ray grazes.
+    /// `inv_d` raised by `1 + 4 eps` in magnitude (and kept finite): a positive exit distance
+    /// it gives is not below the exact one, whatever the rounding of the four operations that
+    /// make it (`1 / d`, the raise, the subtraction, the product), so the test never drops a
+    /// box the ray grazes. (Where `|1 / d|` is within 4 ulps of `f32::MAX`, the clamp takes
+    /// the margin back: a direction component below 3e-39, whose exits lie beyond 1e38 anyway.)
     inv_exit: [L; 3],
     /// `back[axis]` is 1 if the ray runs towards smaller coordinates on that axis (the sign
     /// bit of its reciprocal direction): it then enters a slab by its largest side, else 0.
@@ -408,7 +410,6 @@ trait Planes {
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
     unsafe fn side<L: Lanes8>(&self, r: &RayBox<L>, axis: usize, exit: bool) -> L {
-        // SAFETY: the caller's.
         let inv = if exit {
             &r.inv_exit[axis]
         } else {
@@ -493,7 +494,8 @@ impl WideBvh {
         self.top.is_empty()
     }
 
-    /// The root's reference (a [`TOP`] one), for walks of the tree.
+    /// The root's reference (a [`TOP`] one), for walks of the tree; only a tree that is not
+    /// [empty](WideBvh::is_empty) has a root.
     pub fn root(&self) -> ChildRef {
         TOP
     }
@@ -532,9 +534,10 @@ impl WideBvh {
     /// Nearest primitive hit: its index and distance. `test(leaf, ray)` is the nearest hit in
     /// `(0, ray.t_max]` among the primitives of the leaf with payload `leaf`.
     ///
-    /// Every child whose box the ray enters is prefetched as soon as the node test finds it:
-    /// interior nodes here, leaves by `touch(leaf)` (which [`prefetch`]es the leaf's data, or
-    /// does nothing), so that the cache misses of an incoherent ray overlap instead of
+    /// The nearest child a node test finds is visited next; every other child it finds is
+    /// asked for as soon as it is found: interior nodes here (but top
+    /// nodes, which stay cached), leaves by `touch(leaf)` (which [`prefetch`]es the leaf's
+    /// data, or does nothing), so that the cache misses of an incoherent ray overlap instead of
     /// following one another. Any-hit traversal ([`WideBvh::any`]) does not prefetch: it
     /// measured no faster with it.
     #[inline]
@@ -751,7 +754,7 @@ impl WideBvh {
     }
 
     /// Ask for child `c`'s data ahead of its visit: a leaf's through `touch`, an interior
-    /// node's by [`prefetch`] (but a top node's: they are few, and every ray reads them, so
+    /// node's by [`prefetch`], except a top node's (they are few, and every ray reads them, so
     /// they stay cached).
     #[inline(always)]
     fn ask(&self, c: ChildRef, touch: &impl Fn(u32)) {
@@ -911,16 +914,16 @@ impl Part {
     /// A reference to a new node of the kind that depth `depth` takes, its contents to be set
     /// by [`Part::set`] once its children are known.
     fn reserve(&mut self, depth: u32) -> ChildRef {
-        let r = if depth < TOP_LEVELS {
+        let (index, kind) = if depth < TOP_LEVELS {
             self.top.push(TopNode::from_children(&[], &[], &[]));
-            TOP | (self.top.len() - 1) as u32
+            (self.top.len() - 1, TOP)
         } else {
             self.nodes.push(WideNode::from_children(&[], &[], &[]));
-            (self.nodes.len() - 1) as u32
+            (self.nodes.len() - 1, 0)
         };
         // Below `TOP`, so that no node reference has `TOP` or `LEAF` set by its index.
-        assert!(r & !TOP < TOP, "at most 2^30 nodes of each kind");
-        r
+        assert!(index < TOP as usize, "at most 2^30 nodes of each kind");
+        kind | index as u32
     }
 
     /// Set node `r`, reserved by [`Part::reserve`], to the node over binary nodes `kids`

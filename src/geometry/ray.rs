@@ -49,7 +49,8 @@ pub struct Ray {
 const _: () = assert!(std::mem::size_of::<Ray>() == 48);
 
 /// A ray with the constants of the BVH's box tests and of the watertight triangle test,
-/// computed once per query ([`Ray::for_bvh`]) and read by every node and triangle it meets.
+/// computed once per query ([`Ray::for_bvh`]; a mesh query adds the triangle test's at its first
+/// leaf, [`BvhRay::sheared`]) and read by every node and triangle it meets.
 /// It reads as its [`Ray`] (`Deref`), so it also passes where a `&Ray` is asked: a triangle
 /// test must be given it as a `BvhRay` (the shapes' `intersect_prepared`), or the shapes'
 /// `intersect` computes the constants again.
