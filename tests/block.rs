@@ -21,7 +21,7 @@ fn scalar(prims: &[Prim], r: &Ray) -> Option<(u32, f32)> {
 
 /// Check one ray against the block of all of `prims` (at most four); returns whether it hit.
 fn agree(prims: &[Prim], ray: &Ray) -> bool {
-    let r = ray.for_bvh(ray.t_max, true);
+    let r = ray.for_bvh(ray.t_max).sheared();
     let (block, others) = block_of(prims);
     let br = BlockRay::new(&r);
     let expect = scalar(prims, &r);
@@ -130,7 +130,7 @@ fn blocks_agree_with_the_scalar_loop_on_aimed_and_spawned_rays() {
                 if agree(prims, &ray) {
                     hits += 1;
                     // A ray leaving the hit point, in any direction.
-                    let r = ray.for_bvh(ray.t_max, true);
+                    let r = ray.for_bvh(ray.t_max).sheared();
                     let (i, t) = scalar(prims, &r).unwrap();
                     let surf = prims[i as usize].shape.surface(&r, t);
                     let hit = Hit {
@@ -214,7 +214,9 @@ fn blocks_mixing_spheres_and_triangles() {
         }
     }
     // Coincident triangles: the later lane wins the tie, as in the loop.
-    let r = Ray::new(Vec3A::new(0.1, 0.0, 5.0), -Vec3A::Z).for_bvh(f32::INFINITY, true);
+    let r = Ray::new(Vec3A::new(0.1, 0.0, 5.0), -Vec3A::Z)
+        .for_bvh(f32::INFINITY)
+        .sheared();
     let (block, others) = block_of(&orders[3]);
     assert_eq!(
         block.closest(&others, &BlockRay::new(&r), &r),

@@ -232,8 +232,8 @@ pub struct BlockRay {
 }
 
 impl BlockRay {
-    /// Splat `ray` (which carries the shear constants: [`BvhRay::sheared`], or
-    /// [`Ray::for_bvh`] with triangles).
+    /// Splat `ray` (which carries the shear constants: [`BvhRay::new`] or
+    /// [`BvhRay::sheared`]).
     #[inline(always)]
     pub fn new(ray: &BvhRay) -> Self {
         let splat = |v: glam::Vec3A| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];

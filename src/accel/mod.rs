@@ -385,7 +385,7 @@ impl Geometry {
                 .closest(lanes, &mut t_max, &mut best, SphereLanes::hit);
         }
         if !self.bvh.is_empty() {
-            let r = ray.for_bvh(t_max, false);
+            let r = ray.for_bvh(t_max);
             let mut leaf_ray = LeafRay::default();
             let leaf = |b: u32, r: &BvhRay| {
                 let (r, br) = leaf_ray.get(r, self.has_triangles);
@@ -441,7 +441,7 @@ impl Geometry {
             self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
                 || (planes && self.planes.any(&lanes, ray.t_max, PlaneLanes::hit))
         }) || (!self.bvh.is_empty() && {
-            let r = ray.for_bvh(ray.t_max, false);
+            let r = ray.for_bvh(ray.t_max);
             let mut leaf_ray = LeafRay::default();
             self.bvh.any(&r, |b, r| {
                 let (r, br) = leaf_ray.get(r, self.has_triangles);

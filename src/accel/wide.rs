@@ -517,12 +517,7 @@ impl WideBvh {
         assert!(r & LEAF == 0, "{r:#x} is a leaf");
         if r & TOP != 0 {
             let n = &self.top[(r & !TOP) as usize];
-            let boxes = std::array::from_fn(|slot| {
-                let corner = |side: usize| {
-                    glam::Vec3::from_array([0, 1, 2].map(|axis| n.sides[axis][side][slot]))
-                };
-                (n.child[slot] != EMPTY).then(|| (corner(0), corner(1)))
-            });
+            let boxes = std::array::from_fn(|slot| n.child_box(slot));
             (n.child, boxes, glam::Vec3::ZERO)
         } else {
             let n = &self.nodes[r as usize];
@@ -695,11 +690,10 @@ impl WideBvh {
                     }
                     // SAFETY: the caller's.
                     let near = unsafe { near.to_array() };
-                    let second = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
                     // Two (the common case of several): the farther waits, the later slot of
                     // two at one distance is visited first, as the insertion below orders them.
-                    if mask == 0 {
+                    if mask & (mask - 1) == 0 {
+                        let second = mask.trailing_zeros() as usize;
                         let (a, b) = ((child[first], near[first]), (child[second], near[second]));
                         let (go, wait) = if a.1 < b.1 { (a, b) } else { (b, a) };
                         self.ask(wait.0, &touch);
@@ -708,8 +702,6 @@ impl WideBvh {
                         cur = go.0;
                         continue;
                     }
-                    // Restore the second child for the general case.
-                    mask |= 1 << second;
                     // The children entered, farthest first (insertion into at most eight; of
                     // equal distances, the later slot goes nearer the end, and is visited
                     // first). Each is asked for now, so that their cache misses overlap.
@@ -847,7 +839,7 @@ impl WideNode {
     }
 
     /// The decoded box of child `slot` (what the traversal tests), or `None` if unused.
-    pub fn child_box(&self, slot: usize) -> Option<(glam::Vec3, glam::Vec3)> {
+    pub fn child_box(&self, slot: usize) -> ChildBox {
         (self.child[slot] != EMPTY).then(|| {
             let decode = |side: usize| {
                 glam::Vec3::from_array(
@@ -861,6 +853,13 @@ impl WideNode {
 }
 
 impl TopNode {
+    /// The box of child `slot` (exact: what the traversal tests), or `None` if unused.
+    pub fn child_box(&self, slot: usize) -> ChildBox {
+        let corner =
+            |side: usize| glam::Vec3::from_array([0, 1, 2].map(|a| self.sides[a][side][slot]));
+        (self.child[slot] != EMPTY).then(|| (corner(0), corner(1)))
+    }
+
     /// The node over binary nodes `kids` with references `refs`: their exact boxes.
     fn from_children(binary: &[Node], kids: &[usize], refs: &[ChildRef]) -> TopNode {
         // Unused slots: an empty box (their lanes are masked out by `EMPTY` as well).
@@ -937,8 +936,9 @@ impl Part {
     }
 
     /// Append `sub`, with its references shifted by what precedes it; returns the reference
-    /// of its root.
-    fn append(&mut self, sub: Part, top_root: bool) -> ChildRef {
+    /// of its root (a top node if it has any: a part below the top levels has none).
+    fn append(&mut self, sub: Part) -> ChildRef {
+        let top_root = !sub.top.is_empty();
         // Within the bounds `reserve` and `leaf` check for one part, now for the join.
         assert!(
             self.top.len() + sub.top.len() < TOP as usize
@@ -1032,7 +1032,7 @@ fn collapse_part(binary: &[Node], i: usize, depth: u32, levels: u32) -> Part {
     for ((r, &k), sub) in refs.iter_mut().zip(&kids[..n]).zip(subs) {
         *r = match sub {
             None => part.leaf((binary[k].index as usize, binary[k].count as usize)),
-            Some(sub) => part.append(sub, depth + 1 < TOP_LEVELS),
+            Some(sub) => part.append(sub),
         };
     }
     part.set(me, binary, &kids[..n], &refs[..n]);
@@ -1070,7 +1070,8 @@ mod tests {
         let mesh = displaced_sphere(20_000, glam::Vec3::ZERO, 1.0, 0.05);
         let (bvh, _) = Bvh::build(Prim::flat_triangles(&mesh));
         let show = |p: &Part| (format!("{:?} {:?}", p.top, p.nodes), p.leaves.clone());
-        let sequential = show(&collapse_part(&bvh.nodes, 0, 0, 0));
+        let whole = collapse_part(&bvh.nodes, 0, 0, 0);
+        let sequential = show(&whole);
         // Fewer, as many and more parallel levels than top levels.
         for levels in [1, 2, 3, 4, 5] {
             assert!(
@@ -1079,9 +1080,8 @@ mod tests {
             );
         }
         assert!(sequential.1.len() > 1_000);
-        let part = collapse_part(&bvh.nodes, 0, 0, 0);
         assert_eq!(
-            part.top.len(),
+            whole.top.len(),
             73,
             "three full top levels over 20k triangles"
         );

@@ -49,8 +49,8 @@ pub struct Ray {
 const _: () = assert!(std::mem::size_of::<Ray>() == 48);
 
 /// A ray with the constants of the BVH's box tests and of the watertight triangle test,
-/// computed once per query ([`Ray::for_bvh`]; a mesh query adds the triangle test's at its first
-/// leaf, [`BvhRay::sheared`]) and read by every node and triangle it meets.
+/// computed once per query ([`Ray::for_bvh`], then [`BvhRay::sheared`] at its first leaf) and
+/// read by every node and triangle it meets.
 /// It reads as its [`Ray`] (`Deref`), so it also passes where a `&Ray` is asked: a triangle
 /// test must be given it as a `BvhRay` (the shapes' `intersect_prepared`), or the shapes'
 /// `intersect` computes the constants again.
@@ -148,13 +148,12 @@ impl Ray {
         Origins::new(hit).ray(w, t_max)
     }
 
-    /// This ray, limited to `t_max`, with the reciprocal direction for box tests and, if
-    /// `triangles`, the axes and shear constants of the watertight triangle test (without,
-    /// they stay unset: `[0, 1, 2]` and zeros).
+    /// This ray, limited to `t_max`, with the reciprocal direction for box tests
+    /// ([`BvhRay::boxes`]); a query adds the triangle test's constants ([`BvhRay::sheared`])
+    /// when it first reaches a triangle.
     #[inline]
-    pub fn for_bvh(&self, t_max: f32, triangles: bool) -> BvhRay {
-        let ray = BvhRay::boxes(Ray { t_max, ..*self });
-        if triangles { ray.sheared() } else { ray }
+    pub fn for_bvh(&self, t_max: f32) -> BvhRay {
+        BvhRay::boxes(Ray { t_max, ..*self })
     }
 
     /// The point at distance `t`.

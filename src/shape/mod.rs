@@ -173,7 +173,7 @@ impl Shape {
     }
 
     /// [`Shape::intersect`] for a ray that carries the triangle test's constants
-    /// ([`BvhRay::new`], or [`Ray::for_bvh`] with triangles; not without, whose constants are
+    /// ([`BvhRay::new`] or [`BvhRay::sheared`]; not [`BvhRay::boxes`], whose constants are
     /// placeholders).
     #[inline(always)]
     pub fn intersect_prepared(&self, ray: &BvhRay) -> Option<f32> {

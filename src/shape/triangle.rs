@@ -39,8 +39,8 @@ impl Triangle {
     /// function that is exactly zero is decided by a top-left rule, so a ray through an edge
     /// shared by two triangles hits exactly one of them, and never falls through the crack.
     ///
-    /// `ray` must carry the test's axes and shear: from [`BvhRay::new`] or [`Ray::for_bvh`]
-    /// with triangles (without, they are placeholders and the answer is wrong).
+    /// `ray` must carry the test's axes and shear: from [`BvhRay::new`] or [`BvhRay::sheared`]
+    /// (without, they are placeholders and the answer is wrong).
     #[inline]
     pub fn intersect(&self, ray: &BvhRay) -> Option<f32> {
         let [kx, ky, kz] = ray.k;
