@@ -493,12 +493,11 @@ fn best_split(order: &mut [Item], cb: &Aabb, axis: usize, area: f32) -> Option<C
 }
 
 /// The SAH cost of splitting a node whose box has surface `area` into sides with the given
-/// item boxes and counts: a visit, plus each side's blocks weighted by the chance that a ray
+/// item boxes' surfaces and counts: a visit, plus each side's blocks weighted by the chance that a ray
 /// through the node enters that side's box.
 #[inline]
-fn split_cost((left, nl): (Aabb, usize), (right, nr): (Aabb, usize), area: f32) -> f32 {
-    TRAVERSAL_COST
-        + (left.area() * blocks(nl) + right.area() * blocks(nr)) / area.max(f32::MIN_POSITIVE)
+fn split_cost((left, nl): (f32, usize), (right, nr): (f32, usize), area: f32) -> f32 {
+    TRAVERSAL_COST + (left * blocks(nl) + right * blocks(nr)) / area.max(f32::MIN_POSITIVE)
 }
 
 /// The SAH's choice among the splits between `bins` of a node whose box has surface `area`:
@@ -518,27 +517,35 @@ fn sweep(bins: &Bins, area: f32) -> Option<Chosen> {
             m += 1;
         }
     }
-    // Sweep from the right for every right side (`right[i]`: the full bins from the `i`th
-    // on), then from the left over the splits after each full bin but the last.
-    let mut right = [((Aabb::EMPTY, Aabb::EMPTY), 0usize); BINS];
-    let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
+    // Sweep from the right for every right side's surface and count (`right[i]`: the full
+    // bins from the `i`th on), then from the left over the splits after each full bin but the
+    // last; only the chosen split's right boxes are built again, at the end, in the same order
+    // of unions.
+    let mut right = [(0.0f32, 0usize); BINS];
+    let mut acc = (Aabb::EMPTY, 0);
     for i in (1..m).rev() {
         let b = &bins[full[i]];
-        acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
-        right[i] = ((acc.0, acc.1), acc.2);
+        acc = (acc.0.union(b.0), acc.1 + b.2);
+        right[i] = (acc.0.area(), acc.1);
     }
     let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
-    let mut best: (f32, Option<Chosen>) = (f32::INFINITY, None);
+    // The least cost so far, and the position among the full bins, the bin and the left
+    // side's boxes of its split.
+    let (mut least, mut best) = (f32::INFINITY, None);
     for i in 0..m.saturating_sub(1) {
         let (k, b) = (full[i], &bins[full[i]]);
         acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
-        let (rb, rc) = right[i + 1];
-        let cost = split_cost((acc.0, acc.2), (rb.0, rc), area);
-        if cost < best.0 {
-            best = (cost, Some((k, (acc.0, acc.1), rb)));
+        let cost = split_cost((acc.0.area(), acc.2), right[i + 1], area);
+        if cost < least {
+            (least, best) = (cost, Some((i, k, (acc.0, acc.1))));
         }
     }
-    best.1
+    let (i, k, left) = best?;
+    let mut rb = (Aabb::EMPTY, Aabb::EMPTY);
+    for &j in full[i + 1..m].iter().rev() {
+        rb = (rb.0.union(bins[j].0), rb.1.union(bins[j].1));
+    }
+    Some((k, left, rb))
 }
 
 /// Moves the elements for which `pred` holds to the front; returns how many there are.
@@ -617,7 +624,7 @@ mod tests {
             if acc.2 == 0 || rc == 0 {
                 continue;
             }
-            let cost = split_cost((acc.0, acc.2), (rb.0, rc), area);
+            let cost = split_cost((acc.0.area(), acc.2), (rb.0.area(), rc), area);
             if cost < best.0 {
                 best = (cost, Some((k, (acc.0, acc.1), rb)));
             }
@@ -668,7 +675,7 @@ mod tests {
                             .fold((Aabb::EMPTY, 0), |(a, n), b| (a.union(b.0), n + b.2))
                     };
                     let ((la, ln), (ra, rn)) = (side(l), side(r));
-                    (ln > 0 && rn > 0).then(|| split_cost((la, ln), (ra, rn), area))
+                    (ln > 0 && rn > 0).then(|| split_cost((la.area(), ln), (ra.area(), rn), area))
                 })
                 .collect();
             let least = costs.iter().copied().fold(f32::INFINITY, f32::min);

