@@ -25,7 +25,11 @@ fn agree(prims: &[Prim], ray: &Ray) -> bool {
     let (block, others) = block_of(prims);
     let br = BlockRay::new(&r);
     let expect = scalar(prims, &r);
-    assert_eq!(block.closest(&others, &br, &r), expect, "{r:?} {prims:?}");
+    assert_eq!(
+        block.closest(&others, &br, &r, r.t_max),
+        expect,
+        "{r:?} {prims:?}"
+    );
     assert_eq!(block.any(&others, &br, &r), expect.is_some(), "{r:?}");
     expect.is_some()
 }
@@ -219,7 +223,7 @@ fn blocks_mixing_spheres_and_triangles() {
         .sheared();
     let (block, others) = block_of(&orders[3]);
     assert_eq!(
-        block.closest(&others, &BlockRay::new(&r), &r),
+        block.closest(&others, &BlockRay::new(&r), &r, r.t_max),
         Some((1, 3.0))
     );
 }

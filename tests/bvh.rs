@@ -360,6 +360,14 @@ fn quantised_boxes_contain_their_triangles_at_every_scale() {
     }
 }
 
+/// `r` with its reach `t_max` (what the wide tree's traversal gives a leaf test).
+fn reach(r: &BvhRay, t_max: f32) -> BvhRay {
+    BvhRay {
+        ray: Ray { t_max, ..r.ray },
+        ..*r
+    }
+}
+
 /// The nearest hit among `prims[first..first + count]` by the scalar loop (a later primitive
 /// wins at equal distance).
 fn scalar_leaf(prims: &[Prim], first: usize, count: usize, r: &Ray) -> Option<(u32, f32)> {
@@ -385,7 +393,7 @@ fn wide_tree_finds_what_the_binary_tree_finds() {
         let occluded = g.bvh.any(&g.prims, &r);
         for wide in &trees {
             assert_eq!(
-                wide.closest(&r, leaf, |_| {}),
+                wide.closest(&r, |b, t| leaf(b, &reach(&r, t)), |_| {}),
                 expect,
                 "{:?} {r:?}",
                 wide.isa()
@@ -430,7 +438,7 @@ fn rays_aimed_at_vertices_find_what_every_triangle_finds() {
         for wide in &trees {
             // The distance; of the triangles meeting at a vertex, two can claim it at the
             // same distance, and the tree's order of leaves decides which one it names.
-            let found = wide.closest(&r, leaf, |_| {});
+            let found = wide.closest(&r, |b, t| leaf(b, &reach(&r, t)), |_| {});
             let t = |hit: Option<(u32, f32)>| hit.map(|(_, t)| t.to_bits());
             assert_eq!(t(found), t(expect), "{:?} {r:?}", wide.isa());
             if let Some((p, d)) = found {
@@ -488,7 +496,11 @@ fn every_instruction_set_visits_the_same_leaves() {
                 let (first, count) = ranges[b as usize];
                 scalar_leaf(&g.prims, first, count, r)
             };
-            let hit = wide.closest(r, leaf, |b| log.borrow_mut().push(b | 1 << 31));
+            let hit = wide.closest(
+                r,
+                |b, t| leaf(b, &reach(r, t)),
+                |b| log.borrow_mut().push(b | 1 << 31),
+            );
             let blocked = wide.any(r, |b, r| {
                 log.borrow_mut().push(b | 1 << 30);
                 leaf(b, r).is_some()
@@ -569,7 +581,11 @@ fn axis_parallel_rays_on_box_sides_agree() {
                 let expect = scalar_leaf(&g.prims, 0, g.prims.len(), &r);
                 assert_eq!(g.bvh.closest(&g.prims, &r), expect, "{r:?}");
                 for wide in each_isa(&wide) {
-                    assert_eq!(wide.closest(&r, leaf, |_| {}), expect, "{r:?}");
+                    assert_eq!(
+                        wide.closest(&r, |b, t| leaf(b, &reach(&r, t)), |_| {}),
+                        expect,
+                        "{r:?}"
+                    );
                     assert_eq!(wide.any(&r, |b, r| leaf(b, r).is_some()), expect.is_some());
                 }
                 hits += expect.is_some() as usize;

@@ -145,15 +145,20 @@ impl Block {
         (t, hits & off_start, scalar)
     }
 
-    /// Nearest hit among the block's primitives within `(0, ray.t_max]`: its lane and
-    /// distance, with the scalar loop's tie rule (a later lane at equal distance wins).
-    /// `others` holds the shapes of the scalar lanes from [`Block::other`] on.
+    /// Nearest hit among the block's primitives within `(0, t_max]` (`ray`'s own `t_max` is
+    /// not read): its lane and distance, with the scalar loop's tie rule (a later lane at equal
+    /// distance wins). `others` holds the shapes of the scalar lanes from [`Block::other`] on.
     #[inline(always)]
-    pub fn closest(&self, others: &[Prim], br: &BlockRay, ray: &BvhRay) -> Option<(u32, f32)> {
-        let (t, exact, mut scalar) = self.test(br, ray.t_max);
+    pub fn closest(
+        &self,
+        others: &[Prim],
+        br: &BlockRay,
+        ray: &BvhRay,
+        mut t_max: f32,
+    ) -> Option<(u32, f32)> {
+        let (t, exact, mut scalar) = self.test(br, t_max);
         let t = t.to_array();
         let mut best: Option<(u32, f32)> = None;
-        let mut t_max = ray.t_max;
         let mut mask = exact | scalar;
         while mask != 0 {
             let i = mask.trailing_zeros();

@@ -68,15 +68,14 @@ impl Attrs {
 struct LeafRay(Option<(BvhRay, BlockRay)>);
 
 impl LeafRay {
-    /// The ray `r` of the traversal (box constants only, its `t_max` the current one) with the
-    /// triangle test's constants if `triangles`, and in lanes.
+    /// The ray `r` of the traversal (box constants only) with the triangle test's constants if
+    /// `triangles`, and in lanes.
     #[inline(always)]
     fn get(&mut self, r: &BvhRay, triangles: bool) -> (&BvhRay, &BlockRay) {
         let (full, lanes) = self.0.get_or_insert_with(|| {
             let full = if triangles { r.sheared() } else { *r };
             (full, BlockRay::new(&full))
         });
-        full.ray.t_max = r.t_max;
         (full, lanes)
     }
 }
@@ -397,9 +396,9 @@ impl Geometry {
         if !self.bvh.is_empty() {
             let r = ray.for_bvh(t_max);
             let mut leaf_ray = LeafRay::default();
-            let leaf = |b: u32, r: &BvhRay| {
-                let (r, br) = leaf_ray.get(r, self.has_triangles);
-                let hit = self.blocks[b as usize].closest(&self.others, br, r);
+            let leaf = |b: u32, t_max: f32| {
+                let (r, br) = leaf_ray.get(&r, self.has_triangles);
+                let hit = self.blocks[b as usize].closest(&self.others, br, r, t_max);
                 hit.map(|(lane, t)| (4 * b + lane, t))
             };
             let touch = |b: u32| wide::prefetch(self.blocks.as_ptr().wrapping_add(b as usize));

@@ -18,7 +18,7 @@
 
 use super::bvh::Node;
 use super::simd::{Isa, Lanes8, baseline::Halves};
-use crate::geometry::{BvhRay, Ray};
+use crate::geometry::BvhRay;
 use glam::Vec3A;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -526,8 +526,10 @@ impl WideBvh {
         }
     }
 
-    /// Nearest primitive hit: its index and distance. `test(leaf, ray)` is the nearest hit in
-    /// `(0, ray.t_max]` among the primitives of the leaf with payload `leaf`.
+    /// Nearest primitive hit: its index and distance. `test(leaf, t_max)` is the nearest hit
+    /// of `ray` in `(0, t_max]` among the primitives of the leaf with payload `leaf`: the
+    /// traversal gives the reach, shortened by each hit, and the caller keeps the ray (and what
+    /// its leaf tests need of it), so no copy of the ray is made per leaf.
     ///
     /// The nearest child a node test finds is visited next; every other child it finds is
     /// asked for as soon as it is found: interior nodes here (but top
@@ -539,7 +541,7 @@ impl WideBvh {
     pub fn closest(
         &self,
         ray: &BvhRay,
-        test: impl FnMut(u32, &BvhRay) -> Option<(u32, f32)>,
+        test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
         debug_assert!(self.isa.available());
@@ -595,7 +597,7 @@ impl WideBvh {
     unsafe fn closest_avx2(
         &self,
         ray: &BvhRay,
-        test: impl FnMut(u32, &BvhRay) -> Option<(u32, f32)>,
+        test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
         // SAFETY: the caller's.
@@ -648,7 +650,7 @@ impl WideBvh {
     unsafe fn closest_in<L: Lanes8>(
         &self,
         ray: &BvhRay,
-        mut test: impl FnMut(u32, &BvhRay) -> Option<(u32, f32)>,
+        mut test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
         if self.is_empty() {
@@ -669,11 +671,7 @@ impl WideBvh {
         loop {
             if cur & LEAF != 0 {
                 // One place tests leaves: a hit shortens the ray and becomes the best so far.
-                let r = BvhRay {
-                    ray: Ray { t_max, ..ray.ray },
-                    ..*ray
-                };
-                if let Some((p, t)) = test(cur & !LEAF, &r) {
+                if let Some((p, t)) = test(cur & !LEAF, t_max) {
                     t_max = t;
                     best = Some((p, t));
                 }
