@@ -30,6 +30,19 @@ fn agree(prims: &[Prim], ray: &Ray) -> bool {
         expect,
         "{r:?} {prims:?}"
     );
+    // The reach comes from the argument alone, for triangle and scalar lanes: the ray's own
+    // `t_max` (the query's first reach, in the renderer) is not read.
+    for own in [f32::INFINITY, f32::MIN_POSITIVE] {
+        let other = rtis::geometry::BvhRay {
+            ray: Ray {
+                t_max: own,
+                ..r.ray
+            },
+            ..r
+        };
+        let found = block.closest(&others, &BlockRay::new(&other), &other, r.t_max);
+        assert_eq!(found, expect, "own t_max {own}: {r:?} {prims:?}");
+    }
     assert_eq!(block.any(&others, &br, &r), expect.is_some(), "{r:?}");
     expect.is_some()
 }

@@ -493,8 +493,8 @@ fn best_split(order: &mut [Item], cb: &Aabb, axis: usize, area: f32) -> Option<C
 }
 
 /// The SAH cost of splitting a node whose box has surface `area` into sides with the given
-/// item boxes' surfaces and counts: a visit, plus each side's blocks weighted by the chance that a ray
-/// through the node enters that side's box.
+/// item boxes' surfaces and counts: a visit, plus each side's blocks weighted by the chance that
+/// a ray through the node enters that side's box.
 #[inline]
 fn split_cost((left, nl): (f32, usize), (right, nr): (f32, usize), area: f32) -> f32 {
     TRAVERSAL_COST + (left * blocks(nl) + right * blocks(nr)) / area.max(f32::MIN_POSITIVE)

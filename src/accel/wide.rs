@@ -670,7 +670,7 @@ impl WideBvh {
         let mut cur = self.root();
         loop {
             if cur & LEAF != 0 {
-                // One place tests leaves: a hit shortens the ray and becomes the best so far.
+                // One place tests leaves: a hit shortens the reach and becomes the best so far.
                 if let Some((p, t)) = test(cur & !LEAF, t_max) {
                     t_max = t;
                     best = Some((p, t));
