@@ -239,7 +239,7 @@ def venv_script(args):
 
 # Rounds of bench/embree_compare.py: the machine's drift moves single rounds' ratios by tens
 # of percent, so the medians need a few more rounds than the other blocks' figures.
-EMBREE_ROUNDS = 9
+EMBREE_ROUNDS = 15
 
 
 def embree(_runs):
