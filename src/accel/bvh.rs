@@ -1,9 +1,9 @@
 //! A binary bounding volume hierarchy built with the binned surface-area heuristic (costs in
 //! blocks of four primitives) into an array of 32-byte nodes, the root first and each interior
-//! node's first child after it. The renderer collapses the sparse array the build writes
-//! ([`Bvh::build_sparse`]) into the eight-wide tree of [`super::wide`]; [`Bvh::build`]
-//! compacts it in depth-first order, and its `closest` and `any` traversals are the reference
-//! the wide tree is tested against.
+//! node's first child after it, in depth-first order. The renderer collapses the nodes
+//! ([`Bvh::build_nodes`]) into the eight-wide tree of [`super::wide`]; [`Bvh::build`] keeps
+//! them, and its `closest` and `any` traversals are the reference the wide tree is tested
+//! against.
 
 use super::prim::Prim;
 use crate::geometry::{Aabb, BvhRay};
@@ -123,32 +123,27 @@ impl Item {
 impl Bvh {
     /// Build over `prims` (all bounded); returns the BVH and the primitives reordered to match.
     pub fn build(prims: Vec<Prim>) -> (Bvh, Vec<Prim>) {
-        let (sparse, order) = Bvh::build_sparse(&prims);
-        let nodes = if sparse.is_empty() {
-            Vec::new()
-        } else {
-            compact(&sparse)
-        };
+        let (nodes, order) = Bvh::build_nodes(&prims);
         let sorted = order.par_iter().map(|&i| prims[i as usize]).collect();
         (Bvh { nodes }, sorted)
     }
 
-    /// Build over `prims` (all bounded) without moving them: the nodes in the layout of
-    /// [`Bvh::nodes`] but with unused slots between them (the root first, an interior node's
-    /// first child after it, its second at `index`), and the order of the primitives that
-    /// leaves' `index..index + count` ranges refer to.
-    pub fn build_sparse(prims: &[Prim]) -> (Vec<Node>, Vec<u32>) {
+    /// Build over `prims` (all bounded) without moving them: the nodes of [`Bvh::nodes`] (the
+    /// root first, then depth-first, an interior node's first child after it and its second at
+    /// `index`), and the order of the primitives that leaves' `index..index + count` ranges
+    /// refer to.
+    pub fn build_nodes(prims: &[Prim]) -> (Vec<Node>, Vec<u32>) {
         if prims.is_empty() {
             return (Vec::new(), Vec::new());
         }
         let mut items: Vec<Item> = prims.par_iter().enumerate().map(Item::new).collect();
-        let mut sparse = zeroed_nodes(2 * prims.len() - 1);
         let bounds = items.par_chunks(PARALLEL_MIN).map(fold_bounds).reduce(
             || (Aabb::EMPTY, Aabb::EMPTY),
             |a, b| (a.0.union(b.0), a.1.union(b.1)),
         );
-        build_node(&mut items, 0, 0, &mut sparse, 0, bounds);
-        (sparse, items.par_iter().map(|it| it.prim).collect())
+        let mut pieces = Pieces::for_items(items.len());
+        build_node(&mut items, 0, 0, &mut pieces, bounds);
+        (pieces.join(), items.par_iter().map(|it| it.prim).collect())
     }
 
     /// Nearest primitive hit: its index in `prims` and distance.
@@ -262,31 +257,88 @@ impl Bvh {
     }
 }
 
-/// `n` nodes of zeros (an empty leaf at the origin), from zeroed memory: the system hands out
-/// fresh pages already zero, so the slots the build never writes cost nothing, and the others
-/// are touched first by the threads that write them.
-fn zeroed_nodes(n: usize) -> Vec<Node> {
-    let layout = std::alloc::Layout::array::<Node>(n).expect("node array size");
-    // SAFETY: `Node` is `repr(C)` of `f32` and `u32` fields, for which all-zero bits are a
-    // valid value; the memory comes from the global allocator with `Vec<Node>`'s layout for
-    // capacity `n`, and all `n` elements are initialised (to zero).
-    unsafe {
-        let p = std::alloc::alloc_zeroed(layout) as *mut Node;
-        if p.is_null() {
-            std::alloc::handle_alloc_error(layout);
+/// A tree's nodes in depth-first order, held in pieces built apart (one per subtree built in
+/// parallel, and the nodes above them) and joined once at the end, so that no array sized for
+/// the worst case is written and no subtree is copied at each level. While the nodes are in
+/// pieces, an interior node's `index` is the distance from it to its second child (one more
+/// than the size of its first subtree), which joining does not change.
+struct Pieces {
+    pieces: Vec<Vec<Node>>,
+    /// Nodes in all the pieces.
+    len: usize,
+}
+
+impl Pieces {
+    /// No nodes yet, with room in a first piece for a subtree over `items` items (a tree with
+    /// leaves of up to [`MAX_LEAF`] primitives has fewer nodes than items, but for small
+    /// leaves, which the piece grows for).
+    fn for_items(items: usize) -> Pieces {
+        Pieces {
+            pieces: vec![Vec::with_capacity(items.min(2 * PARALLEL_MIN))],
+            len: 0,
         }
-        Vec::from_raw_parts(p, n, n)
+    }
+
+    /// Append `node`; returns its place: its piece and its index there, and its position in
+    /// the joined array.
+    fn push(&mut self, node: Node) -> (usize, usize, usize) {
+        let last = self.pieces.len() - 1;
+        let piece = &mut self.pieces[last];
+        piece.push(node);
+        self.len += 1;
+        (last, piece.len() - 1, self.len - 1)
+    }
+
+    /// Make the node at `(piece, slot, at)` ([`Pieces::push`]) interior, its second child the
+    /// next node to come.
+    fn link(&mut self, (piece, slot, at): (usize, usize, usize)) {
+        let n = &mut self.pieces[piece][slot];
+        n.index = u32::try_from(self.len - at).expect("at most 2^32 nodes");
+        n.count = 0;
+    }
+
+    /// Append the nodes of `other`, in order; the next push goes to a new piece.
+    fn append(&mut self, other: Pieces) {
+        self.len += other.len;
+        self.pieces
+            .extend(other.pieces.into_iter().filter(|p| !p.is_empty()));
+        self.pieces.push(Vec::new());
+    }
+
+    /// The nodes in one array, each interior node's `index` made the position of its second
+    /// child; the pieces are copied in parallel.
+    fn join(self) -> Vec<Node> {
+        let mut out = Vec::with_capacity(self.len);
+        let mut rest = &mut out.spare_capacity_mut()[..self.len];
+        let mut jobs = Vec::with_capacity(self.pieces.len());
+        let mut start = 0;
+        for piece in &self.pieces {
+            let (dst, after) = rest.split_at_mut(piece.len());
+            jobs.push((dst, piece, start));
+            rest = after;
+            start += piece.len();
+        }
+        jobs.into_par_iter().for_each(|(dst, piece, start)| {
+            for (k, (d, &n)) in dst.iter_mut().zip(piece).enumerate() {
+                let index = match n.count {
+                    0 => n.index + (start + k) as u32,
+                    _ => n.index,
+                };
+                d.write(Node { index, ..n });
+            }
+        });
+        // SAFETY: the jobs wrote every one of the first `self.len` elements: the pieces hold
+        // `self.len` nodes in all, and each was given its own part of them, in order.
+        unsafe { out.set_len(self.len) };
+        out
     }
 }
 
 /// Subtrees over more primitives than this are built in parallel.
 const PARALLEL_MIN: usize = 4096;
 
-/// Build the subtree over `order` (indices into `items`) into `slots`, which has room for
-/// `2 * order.len() - 1` nodes (more than a tree with multi-primitive leaves needs; unused slots
-/// stay zero, and nothing reaches them from the root). `offset` is where `order` starts in the final primitive
-/// array, `base` the index of `slots[0]` in the sparse array. The node is written to
-/// `slots[0]`; its left child is `base + 1`, its right child `base + 2 * left.len()`.
+/// Append the subtree over `order` to `out`, in depth-first order: the node, then its first
+/// subtree, then its second. `offset` is where `order` starts in the final primitive array.
 ///
 /// `(bounds, cbounds)` are the boxes of the items and of their centroids, passed down from the
 /// split that made this subtree so no pass over the items recomputes them.
@@ -294,16 +346,15 @@ fn build_node(
     order: &mut [Item],
     offset: usize,
     depth: usize,
-    slots: &mut [Node],
-    base: usize,
+    out: &mut Pieces,
     (bounds, cbounds): (Aabb, Aabb),
 ) {
-    slots[0] = Node {
+    let me = out.push(Node {
         min: bounds.min.into(),
         index: offset as u32,
         max: bounds.max.into(),
         count: order.len() as u32,
-    };
+    });
     if order.len() <= 1 {
         return;
     }
@@ -320,8 +371,8 @@ fn build_node(
     let (mid, sides) = match split {
         Some((bin, left, right)) => {
             // Each item's bin, as binning found it.
-            let mid = partition(order, |it| it.bin as usize <= bin);
-            (mid, Some((left, right)))
+            let (mid, lc, rc) = partition(order, bin as u32);
+            (mid, Some(((left, lc), (right, rc))))
         }
         // A leaf's worth, a flat centroid box, the depth limit, or every item in one bin:
         // keep a leaf if it is small enough, else split the middle.
@@ -339,64 +390,24 @@ fn build_node(
     };
     let (left_bounds, right_bounds) =
         sides.unwrap_or_else(|| (fold_bounds(&order[..mid]), fold_bounds(&order[mid..])));
-    let right_at = 2 * mid;
-    slots[0].index = (base + right_at) as u32;
-    slots[0].count = 0;
     let parallel = order.len() > PARALLEL_MIN;
+    let n = order.len();
     let (left_order, right_order) = order.split_at_mut(mid);
-    let (left_slots, right_slots) = slots[1..].split_at_mut(right_at - 1);
-    let mut left = move || {
-        build_node(
-            left_order,
-            offset,
-            depth + 1,
-            left_slots,
-            base + 1,
-            left_bounds,
-        )
-    };
-    let mut right = move || {
-        let at = base + right_at;
-        build_node(
-            right_order,
-            offset + mid,
-            depth + 1,
-            right_slots,
-            at,
-            right_bounds,
-        )
-    };
+    let mut left = |out: &mut Pieces| build_node(left_order, offset, depth + 1, out, left_bounds);
+    let mut right =
+        |out: &mut Pieces| build_node(right_order, offset + mid, depth + 1, out, right_bounds);
     if parallel {
-        rayon::join(left, right);
+        // Each side into pieces of its own, joined in order.
+        let (mut l, mut r) = (Pieces::for_items(mid), Pieces::for_items(n - mid));
+        rayon::join(|| left(&mut l), || right(&mut r));
+        out.append(l);
+        out.link(me);
+        out.append(r);
     } else {
-        left();
-        right();
+        left(out);
+        out.link(me);
+        right(out);
     }
-}
-
-/// Copy the reachable nodes of the sparse array into depth-first order, first child next to
-/// its parent.
-fn compact(sparse: &[Node]) -> Vec<Node> {
-    let mut out = Vec::with_capacity(sparse.len() / 2 + 1);
-    // (sparse index, index of the parent whose right child this is)
-    let mut stack = vec![(0usize, usize::MAX)];
-    while let Some((i, parent)) = stack.pop() {
-        let me = out.len();
-        if parent != usize::MAX {
-            out[parent] = Node {
-                index: me as u32,
-                ..out[parent]
-            };
-        }
-        let n = sparse[i];
-        out.push(n);
-        if n.count == 0 {
-            // Right child later (it patches our index), left child next.
-            stack.push((n.index as usize, me));
-            stack.push((i + 1, usize::MAX));
-        }
-    }
-    out
 }
 
 /// The bin of centroid coordinate `c` on `BINS` bins from `lo`, `scale` bins per unit: the
@@ -439,25 +450,27 @@ fn fold_bounds(items: &[Item]) -> (Aabb, Aabb) {
 /// Nodes over more items than this bin them in parallel.
 const PARALLEL_BINNING_MIN: usize = 1 << 16;
 
-/// Per bin: the box of the items, the box of their centroids, and their count.
-type Bins = [(Aabb, Aabb, usize); BINS];
+/// Per bin: the box of the items and their count. (Not the box of their centroids: the
+/// partition gathers those for the sides it makes, so that binning, the build's larger part,
+/// loads and stores one box per item instead of two: at 1M triangles, a sixth off the whole
+/// build's time, measured.)
+type Bins = [(Aabb, usize); BINS];
 
-/// A split the SAH chose: the bin after which it falls, then the item and centroid boxes of
-/// the left side and of the right side.
-type Chosen = (usize, (Aabb, Aabb), (Aabb, Aabb));
+/// A split the SAH chose: the bin after which it falls, then the box of the left side's items
+/// and that of the right side's.
+type Chosen = (usize, Aabb, Aabb);
 
 /// The bins of `items` along `axis`, the first from `lo`, `scale` bins per unit; each item
 /// keeps its bin in `Item::bin`.
 fn bin_items(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
-    let mut bins = [(Aabb::EMPTY, Aabb::EMPTY, 0usize); BINS];
+    let mut bins = [(Aabb::EMPTY, 0usize); BINS];
     for it in items {
         let ib = it.bounds();
         let bin = bin_of(it.centroid(axis), lo, scale);
         it.bin = bin as u32;
         let b = &mut bins[bin];
         b.0 = b.0.union(ib);
-        b.1 = b.1.grow(ib.centroid());
-        b.2 += 1;
+        b.1 += 1;
     }
     bins
 }
@@ -473,18 +486,18 @@ fn bins_of(items: &mut [Item], axis: usize, lo: f32, scale: f32) -> Bins {
         return fill(items);
     }
     let merge = |a: Bins, b: Bins| -> Bins {
-        std::array::from_fn(|k| (a[k].0.union(b[k].0), a[k].1.union(b[k].1), a[k].2 + b[k].2))
+        std::array::from_fn(|k| (a[k].0.union(b[k].0), a[k].1 + b[k].1))
     };
     // At least four chunks per node binned in parallel: enough to share among the threads,
     // few enough that merging costs nothing.
     items
         .par_chunks_mut(PARALLEL_BINNING_MIN / 4)
         .map(fill)
-        .reduce(|| [(Aabb::EMPTY, Aabb::EMPTY, 0); BINS], merge)
+        .reduce(|| [(Aabb::EMPTY, 0); BINS], merge)
 }
 
 /// The bin after which to split more than a leaf's worth of items along `axis` at the least
-/// SAH cost, with the item and centroid boxes of both sides; `None` if every item falls in one
+/// SAH cost, with the items' boxes of both sides; `None` if every item falls in one
 /// bin. (A leaf's worth never gets here: see `build_node`.) Each item keeps its bin in
 /// `Item::bin` for the partition.
 fn best_split(order: &mut [Item], cb: &Aabb, axis: usize, area: f32) -> Option<Chosen> {
@@ -501,8 +514,8 @@ fn split_cost((left, nl): (f32, usize), (right, nr): (f32, usize), area: f32) ->
 }
 
 /// The SAH's choice among the splits between `bins` of a node whose box has surface `area`:
-/// the bin after which to split, and the item and centroid boxes of both sides; `None` if
-/// every item falls in one bin. Of equal costs the first is kept.
+/// the bin after which to split, and the items' boxes of both sides; `None` if every item
+/// falls in one bin. Of equal costs the first is kept.
 fn sweep(bins: &Bins, area: f32) -> Option<Chosen> {
     // The bins that hold items, in order. On NaN-free boxes an empty bin changes no union and
     // no count, and the split after it has the same sides as the split after the last full
@@ -512,7 +525,7 @@ fn sweep(bins: &Bins, area: f32) -> Option<Chosen> {
     let mut full = [0usize; BINS];
     let mut m = 0;
     for (k, bin) in bins.iter().enumerate() {
-        if bin.2 > 0 {
+        if bin.1 > 0 {
             full[m] = k;
             m += 1;
         }
@@ -525,39 +538,45 @@ fn sweep(bins: &Bins, area: f32) -> Option<Chosen> {
     let mut acc = (Aabb::EMPTY, 0);
     for i in (1..m).rev() {
         let b = &bins[full[i]];
-        acc = (acc.0.union(b.0), acc.1 + b.2);
+        acc = (acc.0.union(b.0), acc.1 + b.1);
         right[i] = (acc.0.area(), acc.1);
     }
-    let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
+    let mut acc = (Aabb::EMPTY, 0);
     // The least cost so far, and the position among the full bins, the bin and the left
     // side's boxes of its split.
     let (mut least, mut best) = (f32::INFINITY, None);
     for i in 0..m.saturating_sub(1) {
         let (k, b) = (full[i], &bins[full[i]]);
-        acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
-        let cost = split_cost((acc.0.area(), acc.2), right[i + 1], area);
+        acc = (acc.0.union(b.0), acc.1 + b.1);
+        let cost = split_cost((acc.0.area(), acc.1), right[i + 1], area);
         if cost < least {
-            (least, best) = (cost, Some((i, k, (acc.0, acc.1))));
+            (least, best) = (cost, Some((i, k, acc.0)));
         }
     }
     let (i, k, left) = best?;
-    let mut rb = (Aabb::EMPTY, Aabb::EMPTY);
+    let mut rb = Aabb::EMPTY;
     for &j in full[i + 1..m].iter().rev() {
-        rb = (rb.0.union(bins[j].0), rb.1.union(bins[j].1));
+        rb = rb.union(bins[j].0);
     }
     Some((k, left, rb))
 }
 
-/// Moves the elements for which `pred` holds to the front; returns how many there are.
-fn partition(v: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
+/// Moves the items binned in `bin` or before to the front; returns how many there are, and
+/// the boxes of the centroids of those and of the others.
+fn partition(v: &mut [Item], bin: u32) -> (usize, Aabb, Aabb) {
     let mut i = 0;
+    let (mut lc, mut rc) = (Aabb::EMPTY, Aabb::EMPTY);
     for j in 0..v.len() {
-        if pred(&v[j]) {
+        let c = v[j].bounds().centroid();
+        if v[j].bin <= bin {
+            lc = lc.grow(c);
             v.swap(i, j);
             i += 1;
+        } else {
+            rc = rc.grow(c);
         }
     }
-    i
+    (i, lc, rc)
 }
 
 #[cfg(test)]
@@ -573,8 +592,8 @@ mod tests {
     }
 
     /// Bins' boxes and counts as bits.
-    fn bin_bits(bins: &Bins) -> Vec<([u32; 6], [u32; 6], usize)> {
-        bins.iter().map(|b| (bits(&b.0), bits(&b.1), b.2)).collect()
+    fn bin_bits(bins: &Bins) -> Vec<([u32; 6], usize)> {
+        bins.iter().map(|b| (bits(&b.0), b.1)).collect()
     }
 
     /// Binning by chunks in parallel fills the bins one pass fills, to the bit (signed zeros
@@ -600,7 +619,7 @@ mod tests {
         assert_eq!(bin_bits(&parallel), bin_bits(&one));
         assert!(items.iter().zip(&again).all(|(a, b)| a.bin == b.bin));
         assert!(
-            one.iter().filter(|b| b.2 > 0).count() == BINS,
+            one.iter().filter(|b| b.1 > 0).count() == BINS,
             "every bin filled"
         );
     }
@@ -608,25 +627,25 @@ mod tests {
     /// The SAH sweep as it was before it skipped empty bins: every split after bins 0 to
     /// 14 with two non-empty sides costed in turn.
     fn sweep_every_bin(bins: &Bins, area: f32) -> Option<Chosen> {
-        let mut right = [((Aabb::EMPTY, Aabb::EMPTY), 0usize); BINS];
-        let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
+        let mut right = [(Aabb::EMPTY, 0usize); BINS];
+        let mut acc = (Aabb::EMPTY, 0);
         for k in (1..BINS).rev() {
             let b = &bins[k];
-            acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
-            right[k] = ((acc.0, acc.1), acc.2);
+            acc = (acc.0.union(b.0), acc.1 + b.1);
+            right[k] = acc;
         }
-        let mut acc = (Aabb::EMPTY, Aabb::EMPTY, 0);
+        let mut acc = (Aabb::EMPTY, 0);
         let mut best = (f32::INFINITY, None);
         for k in 0..BINS - 1 {
             let b = &bins[k];
-            acc = (acc.0.union(b.0), acc.1.union(b.1), acc.2 + b.2);
+            acc = (acc.0.union(b.0), acc.1 + b.1);
             let (rb, rc) = right[k + 1];
-            if acc.2 == 0 || rc == 0 {
+            if acc.1 == 0 || rc == 0 {
                 continue;
             }
-            let cost = split_cost((acc.0.area(), acc.2), (rb.0.area(), rc), area);
+            let cost = split_cost((acc.0.area(), acc.1), (rb.area(), rc), area);
             if cost < best.0 {
-                best = (cost, Some((k, (acc.0, acc.1), rb)));
+                best = (cost, Some((k, acc.0, rb)));
             }
         }
         best.1
@@ -651,18 +670,16 @@ mod tests {
             let empty = [0.3, 0.6, 0.9][case % 3];
             let bins: Bins = std::array::from_fn(|_| {
                 if s.next_f32() < empty {
-                    return (Aabb::EMPTY, Aabb::EMPTY, 0);
+                    return (Aabb::EMPTY, 0);
                 }
                 let a = Vec3A::new(corner(&mut s), corner(&mut s), corner(&mut s));
                 let b = Vec3A::new(corner(&mut s), corner(&mut s), corner(&mut s));
                 let bounds = Aabb::EMPTY.grow(a).grow(b);
                 let count = 1 + (s.next_f32() * 9.0) as usize;
-                (bounds, Aabb::EMPTY.grow(bounds.centroid()), count)
+                (bounds, count)
             });
             let area = bins.iter().fold(Aabb::EMPTY, |a, b| a.union(b.0)).area();
-            let show = |c: Option<Chosen>| {
-                c.map(|(k, l, r)| (k, bits(&l.0), bits(&l.1), bits(&r.0), bits(&r.1)))
-            };
+            let show = |c: Option<Chosen>| c.map(|(k, l, r)| (k, bits(&l), bits(&r)));
             let (new, old) = (sweep(&bins, area), sweep_every_bin(&bins, area));
             assert_eq!(show(new), show(old), "case {case}");
             splits += new.is_some() as usize;
@@ -670,9 +687,9 @@ mod tests {
             let costs: Vec<f32> = (0..BINS - 1)
                 .filter_map(|k| {
                     let (l, r) = bins.split_at(k + 1);
-                    let side = |b: &[(Aabb, Aabb, usize)]| {
+                    let side = |b: &[(Aabb, usize)]| {
                         b.iter()
-                            .fold((Aabb::EMPTY, 0), |(a, n), b| (a.union(b.0), n + b.2))
+                            .fold((Aabb::EMPTY, 0), |(a, n), b| (a.union(b.0), n + b.1))
                     };
                     let ((la, ln), (ra, rn)) = (side(l), side(r));
                     (ln > 0 && rn > 0).then(|| split_cost((la.area(), ln), (ra.area(), rn), area))

@@ -162,7 +162,7 @@ impl Geometry {
         let has_triangles = for_bvh
             .iter()
             .any(|p| p.shape.kind() == ShapeKind::Triangle);
-        let (binary, order) = Bvh::build_sparse(&for_bvh);
+        let (binary, order) = Bvh::build_nodes(&for_bvh);
         // The wide tree first, each leaf named by its rank; then the leaves' blocks and
         // attributes in parallel, in that order (the reads of the primitives, in leaf order,
         // are most of the work).

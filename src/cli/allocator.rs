@@ -1,8 +1,8 @@
 //! The binary's memory allocator: the system's, asking Linux for transparent huge pages on
 //! large blocks.
 //!
-//! A BVH build over a million triangles writes about 200 MB of fresh memory (primitive boxes,
-//! the sparse binary tree, leaf blocks). With 4 KiB pages that is some 50,000 page faults, a
+//! A BVH build over a million triangles writes over 100 MB of fresh memory (primitive boxes,
+//! the binary tree's nodes, leaf blocks). With 4 KiB pages that is some 50,000 page faults, a
 //! fifth of the build's time on the machines measured; with 2 MiB pages it is a few hundred.
 //! Linux's default (`/sys/kernel/mm/transparent_hugepage/enabled` set to `madvise`) gives huge
 //! pages only to memory that asks for them, which this allocator does for every block of at
