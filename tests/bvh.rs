@@ -687,6 +687,14 @@ fn mixed_leaves_of_spheres_and_triangles() {
             (Some((t, shape)), Some(h)) => {
                 assert_eq!(h.t, t, "{r:?}");
                 assert_eq!(format!("{:?}", g.prim(h.prim).shape), format!("{shape:?}"));
+                // The record is the shape's surface there, to the bit, whether the lane test
+                // handed over its normal or the primitive was rebuilt.
+                let s = shape.surface(&r, t);
+                assert_eq!(
+                    format!("{:?}", (s.p, s.n, s.err, s.err_along)),
+                    format!("{:?}", (h.p, h.n, h.err, h.err_along)),
+                    "{r:?}"
+                );
                 hits += 1;
             }
             (b, h) => panic!("brute force {b:?}, geometry {h:?} for {r:?}"),

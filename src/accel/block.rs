@@ -75,9 +75,25 @@ impl Block {
         if !self.has_triangle(lane) {
             return None;
         }
-        let vertex =
-            |j: usize| Vec3A::new(self.v[j][0][lane], self.v[j][1][lane], self.v[j][2][lane]);
-        Triangle::new(vertex(0), vertex(1), vertex(2))
+        let [a, b, c] = self.vertices(lane);
+        Triangle::new(a, b, c)
+    }
+
+    /// The triangle in lane `lane`, which holds one, whose unit normal [`Block::closest`]
+    /// returned as `n`: [`Block::triangle`]'s, without computing the normal again.
+    #[inline]
+    pub fn triangle_with_normal(&self, lane: usize, n: Vec3A) -> Triangle {
+        debug_assert!(self.has_triangle(lane));
+        Triangle {
+            v: self.vertices(lane),
+            n,
+        }
+    }
+
+    /// The vertices in lane `lane`.
+    #[inline(always)]
+    fn vertices(&self, lane: usize) -> [Vec3A; 3] {
+        [0, 1, 2].map(|j| Vec3A::new(self.v[j][0][lane], self.v[j][1][lane], self.v[j][2][lane]))
     }
 
     /// The lanes' unit normals, `[x, y, z]`: `Triangle::new`'s operations, lane by lane, so
@@ -102,9 +118,10 @@ impl Block {
     }
 
     /// The lanes' distances, the lanes (bits) that certainly hit at those distances within
-    /// `(0, t_max]`, and the lanes only the scalar test can decide.
+    /// `(0, t_max]`, the lanes only the scalar test can decide, and the lanes' unit normals
+    /// ([`Block::normals`]), computed only when some lane certainly hits (zeros otherwise).
     #[inline(always)]
-    fn test(&self, r: &BlockRay, t_max: f32) -> (Vec4, u32, u32) {
+    fn test(&self, r: &BlockRay, t_max: f32) -> (Vec4, u32, u32, [Vec4; 3]) {
         let [kx, ky, kz] = r.k;
         let [sx, sy, sz] = r.shear;
         // Vertices relative to the origin, sheared so the ray runs along +z.
@@ -130,7 +147,7 @@ impl Block {
         let scalar = (on_edge.bitmask() | self.scalar) & lanes;
         let hits = (!on_edge & !outside & in_range).bitmask() & lanes & !self.scalar;
         if hits == 0 {
-            return (t, 0, scalar);
+            return (t, 0, scalar, [zero; 3]);
         }
         // A ray starting on the triangle's plane (within the error band of the origin's signed
         // distance) does not meet it at its start. Few tests get here, so the normal is
@@ -142,12 +159,14 @@ impl Block {
             + (an[0] + an[1] + an[2]) * r.o_err;
         let along = (n[0] * r.d[0] + n[1] * r.d[1] + n[2] * r.d[2]).abs();
         let off_start = (t * along).cmpgt(band).bitmask();
-        (t, hits & off_start, scalar)
+        (t, hits & off_start, scalar, n)
     }
 
     /// Nearest hit among the block's primitives within `(0, t_max]` (`ray`'s own `t_max` is
     /// not read): its lane and distance, with the scalar loop's tie rule (a later lane at equal
-    /// distance wins). `others` holds the shapes of the scalar lanes from [`Block::other`] on.
+    /// distance wins), and, if the lane test decided it, the lane's triangle's unit normal
+    /// (the one [`Block::triangle`] gives it, to the bit), so that the hit's record need not
+    /// compute it again. `others` holds the shapes of the scalar lanes from [`Block::other`] on.
     #[inline(always)]
     pub fn closest(
         &self,
@@ -155,8 +174,8 @@ impl Block {
         br: &BlockRay,
         ray: &BvhRay,
         mut t_max: f32,
-    ) -> Option<(u32, f32)> {
-        let (t, exact, mut scalar) = self.test(br, t_max);
+    ) -> Option<(u32, f32, Option<Vec3A>)> {
+        let (t, exact, mut scalar, n) = self.test(br, t_max);
         let t = t.to_array();
         let mut best: Option<(u32, f32)> = None;
         let mut mask = exact | scalar;
@@ -181,13 +200,18 @@ impl Block {
                 best = Some((i, t));
             }
         }
-        best
+        let (lane, t) = best?;
+        let normal = (exact & (1 << lane) != 0).then(|| {
+            let (i, [x, y, z]) = (lane as usize, n);
+            Vec3A::new(x[i], y[i], z[i])
+        });
+        Some((lane, t, normal))
     }
 
     /// True if any of the block's primitives is hit within `(0, ray.t_max]`.
     #[inline(always)]
     pub fn any(&self, others: &[Prim], br: &BlockRay, ray: &BvhRay) -> bool {
-        let (_, exact, mut scalar) = self.test(br, ray.t_max);
+        let (_, exact, mut scalar, _) = self.test(br, ray.t_max);
         if exact != 0 {
             return true;
         }

@@ -19,7 +19,7 @@ pub use simd::{Floats, Isa, MAX_LANES, require_all_isas};
 pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::{BvhRay, Hit, Ray};
-use crate::shape::{Shape, ShapeKind};
+use crate::shape::{Shape, ShapeKind, Surface};
 use block::{Block, BlockRay};
 use lanes::{Lanes, PlaneLanes, RayLanes, SphereLanes};
 use rayon::prelude::*;
@@ -59,6 +59,19 @@ impl Attrs {
         material: !SMOOTH,
         light: crate::light::NO_LIGHT,
     };
+}
+
+/// The hit on primitive `prim` at distance `t` whose surface there is `s`.
+#[inline(always)]
+fn hit_on(s: Surface, prim: u32, t: f32) -> Hit {
+    Hit {
+        t,
+        p: s.p,
+        n: s.n,
+        err: s.err,
+        err_along: s.err_along,
+        prim,
+    }
 }
 
 /// The leaf tests' constants of one query's ray ([`BvhRay::sheared`] and [`BlockRay`]),
@@ -389,6 +402,8 @@ impl Geometry {
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut t_max = ray.t_max;
         let mut best: Option<u32> = None;
+        // The BVH's nearest hit, and its unit normal if a block's lane test found it.
+        let (mut bvh_best, mut lane_normal) = (None, None);
         // The ray in lanes only for scenes with packets (a mesh scene has none).
         let lanes = self.has_packets().then(|| RayLanes::new(ray));
         if let Some(lanes) = &lanes {
@@ -401,33 +416,40 @@ impl Geometry {
             let leaf = |b: u32, t_max: f32| {
                 let (r, br) = leaf_ray.get(&r, self.has_triangles);
                 let hit = self.blocks[b as usize].closest(&self.others, br, r, t_max);
-                hit.map(|(lane, t)| (4 * b + lane, t))
+                hit.map(|(lane, t, n)| {
+                    // The last hit a leaf reports is the nearest: keep its normal.
+                    lane_normal = n;
+                    (4 * b + lane, t)
+                })
             };
             let touch = |b: u32| wide::prefetch(self.blocks.as_ptr().wrapping_add(b as usize));
             if let Some((i, t)) = self.bvh.closest(&r, leaf, touch) {
                 t_max = t;
                 best = Some(i);
+                bvh_best = best;
             }
         }
         if let Some(lanes) = &lanes {
             self.planes
                 .closest(lanes, &mut t_max, &mut best, PlaneLanes::hit);
         }
-        Some(self.hit_record(ray, best?, t_max))
+        let prim = best?;
+        Some(match lane_normal.filter(|_| best == bvh_best) {
+            // A lane triangle whose normal the lane test computed: its record without
+            // rebuilding the triangle (a square root and a division on the ray's last steps).
+            Some(n) => {
+                let block = &self.blocks[prim as usize / 4];
+                let tri = block.triangle_with_normal(prim as usize % 4, n);
+                hit_on(tri.surface(ray, t_max), prim, t_max)
+            }
+            None => self.hit_record(ray, prim, t_max),
+        })
     }
 
     /// The hit of `ray` on primitive `prim` at distance `t`.
     #[inline]
     fn hit_record(&self, ray: &Ray, prim: u32, t: f32) -> Hit {
-        let s = self.prim(prim).shape.surface(ray, t);
-        Hit {
-            t,
-            p: s.p,
-            n: s.n,
-            err: s.err,
-            err_along: s.err_along,
-            prim,
-        }
+        hit_on(self.prim(prim).shape.surface(ray, t), prim, t)
     }
 
     /// True if anything blocks `ray` within `(0, ray.t_max]` (any-hit query for shadow rays).
