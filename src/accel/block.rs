@@ -14,6 +14,17 @@ use crate::geometry::{BvhRay, Ray, gamma};
 use crate::shape::{Shape, Triangle};
 use glam::{Vec3A, Vec4};
 
+/// The lane masks of each set of four bits (bit `k` for lane `k`).
+const LANES: [glam::BVec4A; 16] = {
+    let mut m = [glam::BVec4A::FALSE; 16];
+    let mut bits = 0;
+    while bits < 16 {
+        m[bits] = glam::BVec4A::new(bits & 1 != 0, bits & 2 != 0, bits & 4 != 0, bits & 8 != 0);
+        bits += 1;
+    }
+    m
+};
+
 /// Up to four consecutive primitives of a leaf; triangles' vertices in lanes.
 #[derive(Clone, Copy, Debug)]
 #[repr(C)]
@@ -176,6 +187,22 @@ impl Block {
         mut t_max: f32,
     ) -> Option<(u32, f32, Option<Vec3A>)> {
         let (t, exact, mut scalar, n) = self.test(br, t_max);
+        let normal = |lane: u32| {
+            let (i, [x, y, z]) = (lane as usize, n);
+            Vec3A::new(x[i], y[i], z[i])
+        };
+        if scalar == 0 {
+            // Lanes only (the common case): the nearest hit without a branch per lane, the
+            // later lane of equal distances, as the loop below keeps it.
+            if exact == 0 {
+                return None;
+            }
+            let t = Vec4::select(LANES[exact as usize], t, Vec4::INFINITY);
+            let nearest = t.min_element();
+            let ties = t.cmpeq(Vec4::splat(nearest)).bitmask() & exact;
+            let lane = 31 - ties.leading_zeros();
+            return Some((lane, nearest, Some(normal(lane))));
+        }
         let t = t.to_array();
         let mut best: Option<(u32, f32)> = None;
         let mut mask = exact | scalar;
@@ -201,11 +228,7 @@ impl Block {
             }
         }
         let (lane, t) = best?;
-        let normal = (exact & (1 << lane) != 0).then(|| {
-            let (i, [x, y, z]) = (lane as usize, n);
-            Vec3A::new(x[i], y[i], z[i])
-        });
-        Some((lane, t, normal))
+        Some((lane, t, (exact & (1 << lane) != 0).then(|| normal(lane))))
     }
 
     /// True if any of the block's primitives is hit within `(0, ray.t_max]`.
