@@ -8,7 +8,7 @@ mod common;
 use glam::{Vec3, Vec3A};
 use rtis::accel::Prim;
 use rtis::accel::block::{Block, BlockRay, lane_triangle};
-use rtis::geometry::{Hit, Ray};
+use rtis::geometry::{BvhRay, Hit, Ray};
 use rtis::mesh::displaced_sphere;
 use rtis::sampling::Sampler;
 use rtis::sampling::warp::uniform_sphere;
@@ -19,17 +19,23 @@ fn scalar(prims: &[Prim], r: &Ray) -> Option<(u32, f32)> {
     common::nearest(prims, r)
 }
 
-/// [`Block::closest`]'s lane and distance, after checking the normal it returns: present
-/// exactly when the lane holds a triangle that the lane test (not the scalar test) decided, and
-/// then [`Block::triangle`]'s normal to the bit. `scalar` names the lanes left to the scalar
-/// test on this ray.
-fn closest(
-    block: &Block,
-    others: &[Prim],
-    r: &rtis::geometry::BvhRay,
-    t_max: f32,
-) -> Option<(u32, f32)> {
+thread_local! {
+    /// Hits on lane triangles that [`closest`] saw, and how many came with their normal.
+    static LANE_HITS: std::cell::Cell<(usize, usize)> = const { std::cell::Cell::new((0, 0)) };
+}
+
+/// [`Block::closest`]'s lane and distance, after checking the normal it returns: present only
+/// for a lane that holds a triangle, and then [`Block::triangle`]'s normal to the bit; a lane
+/// triangle without one was decided by the scalar test, which must find the same distance.
+/// Counts both kinds in `LANE_HITS`.
+fn closest(block: &Block, others: &[Prim], r: &BvhRay, t_max: f32) -> Option<(u32, f32)> {
     let (lane, t, n) = block.closest(others, &BlockRay::new(r), r, t_max)?;
+    if block.has_triangle(lane as usize) {
+        LANE_HITS.with(|c| {
+            let (hits, normals) = c.get();
+            c.set((hits + 1, normals + n.is_some() as usize));
+        });
+    }
     if let Some(n) = n {
         let tri = block
             .triangle(lane as usize)
@@ -44,7 +50,7 @@ fn closest(
         // Left to the scalar test: a ray through an edge or a vertex of its triangle (an edge
         // function exactly zero there).
         let tri = block.triangle(lane as usize).unwrap();
-        let reach = rtis::geometry::BvhRay {
+        let reach = BvhRay {
             ray: Ray { t_max, ..r.ray },
             ..*r
         };
@@ -71,7 +77,7 @@ fn agree(prims: &[Prim], ray: &Ray) -> bool {
     // The reach comes from the argument alone, for triangle and scalar lanes: the ray's own
     // `t_max` (the query's first reach, in the renderer) is not read.
     for own in [f32::INFINITY, f32::MIN_POSITIVE] {
-        let other = rtis::geometry::BvhRay {
+        let other = BvhRay {
             ray: Ray {
                 t_max: own,
                 ..r.ray
@@ -159,6 +165,7 @@ fn blocks_agree_with_the_scalar_loop_on_aimed_and_spawned_rays() {
     let all = Prim::flat_triangles(&mesh);
     let mut s = Sampler::new(11, 0, 0);
     let (mut hits, mut spawned_hits, mut cases) = (0, 0, 0);
+    LANE_HITS.with(|c| c.set((0, 0)));
     for (n, chunk) in all.chunks(4).enumerate().take(800) {
         let prims = &chunk[..1 + n % chunk.len()];
         for _ in 0..8 {
@@ -207,6 +214,13 @@ fn blocks_agree_with_the_scalar_loop_on_aimed_and_spawned_rays() {
     // now and then.
     assert!(hits * 2 > cases, "{hits} of {cases}");
     assert!(spawned_hits > 0, "no spawned ray met a neighbour");
+    // The lane test decides most hits and hands over their normal (measured: 34,317 of
+    // 37,014; the others are rays aimed at vertices and edges, left to the scalar test).
+    let (lane_hits, normals) = LANE_HITS.with(|c| c.get());
+    assert!(
+        lane_hits > 30_000 && normals * 10 > lane_hits * 8,
+        "{normals} normals for {lane_hits} lane hits"
+    );
 }
 
 /// A ray through a vertex or edge shared by two triangles of a block hits exactly one of them

@@ -130,7 +130,8 @@ impl Block {
 
     /// The lanes' distances, the lanes (bits) that certainly hit at those distances within
     /// `(0, t_max]`, the lanes only the scalar test can decide, and the lanes' unit normals
-    /// ([`Block::normals`]), computed only when some lane certainly hits (zeros otherwise).
+    /// ([`Block::normals`]), computed when some lane passes the edge and range tests (so
+    /// whenever one certainly hits; zeros otherwise).
     #[inline(always)]
     fn test(&self, r: &BlockRay, t_max: f32) -> (Vec4, u32, u32, [Vec4; 3]) {
         let [kx, ky, kz] = r.k;

@@ -269,12 +269,14 @@ struct Pieces {
 }
 
 impl Pieces {
-    /// No nodes yet, with room in a first piece for a subtree over `items` items (a tree with
-    /// leaves of up to [`MAX_LEAF`] primitives has fewer nodes than items, but for small
-    /// leaves, which the piece grows for).
+    /// No nodes yet, with room in a first piece for what a subtree over `items` items puts
+    /// there: its root alone if it is built in parallel (its sides bring pieces of their
+    /// own), else all its nodes, which are fewer than its items unless its leaves are small
+    /// (the piece then grows).
     fn for_items(items: usize) -> Pieces {
+        let room = if items > PARALLEL_MIN { 1 } else { items };
         Pieces {
-            pieces: vec![Vec::with_capacity(items.min(2 * PARALLEL_MIN))],
+            pieces: vec![Vec::with_capacity(room)],
             len: 0,
         }
     }
@@ -318,6 +320,8 @@ impl Pieces {
             rest = after;
             start += piece.len();
         }
+        // What `push` and `append` keep: `len` counts the pieces' nodes.
+        assert_eq!(start, self.len, "the pieces' nodes against their count");
         jobs.into_par_iter().for_each(|(dst, piece, start)| {
             for (k, (d, &n)) in dst.iter_mut().zip(piece).enumerate() {
                 let index = match n.count {
@@ -328,7 +332,7 @@ impl Pieces {
             }
         });
         // SAFETY: the jobs wrote every one of the first `self.len` elements: the pieces hold
-        // `self.len` nodes in all, and each was given its own part of them, in order.
+        // `self.len` nodes in all (asserted above), and each was given its own part of them.
         unsafe { out.set_len(self.len) };
         out
     }
@@ -532,7 +536,7 @@ fn sweep(bins: &Bins, area: f32) -> Option<Chosen> {
     }
     // Sweep from the right for every right side's surface and count (`right[i]`: the full
     // bins from the `i`th on), then from the left over the splits after each full bin but the
-    // last; only the chosen split's right boxes are built again, at the end, in the same order
+    // last; only the chosen split's right box is built again, at the end, in the same order
     // of unions.
     let mut right = [(0.0f32, 0usize); BINS];
     let mut acc = (Aabb::EMPTY, 0);
@@ -543,7 +547,7 @@ fn sweep(bins: &Bins, area: f32) -> Option<Chosen> {
     }
     let mut acc = (Aabb::EMPTY, 0);
     // The least cost so far, and the position among the full bins, the bin and the left
-    // side's boxes of its split.
+    // side's box of its split.
     let (mut least, mut best) = (f32::INFINITY, None);
     for i in 0..m.saturating_sub(1) {
         let (k, b) = (full[i], &bins[full[i]]);

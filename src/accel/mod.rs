@@ -436,7 +436,8 @@ impl Geometry {
         let prim = best?;
         Some(match lane_normal.filter(|_| best == bvh_best) {
             // A lane triangle whose normal the lane test computed: its record without
-            // rebuilding the triangle (a square root and a division on the ray's last steps).
+            // rebuilding the triangle (a cross product, a square root and three divisions on
+            // the ray's last steps).
             Some(n) => {
                 let block = &self.blocks[prim as usize / 4];
                 let tri = block.triangle_with_normal(prim as usize % 4, n);

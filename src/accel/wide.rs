@@ -529,7 +529,9 @@ impl WideBvh {
     /// Nearest primitive hit: its index and distance. `test(leaf, t_max)` is the nearest hit
     /// of `ray` in `(0, t_max]` among the primitives of the leaf with payload `leaf`: the
     /// traversal gives the reach, shortened by each hit, and the caller keeps the ray (and what
-    /// its leaf tests need of it), so no copy of the ray is made per leaf.
+    /// its leaf tests need of it), so no copy of the ray is made per leaf. Every hit `test`
+    /// returns becomes the best so far, so the last one it returns is the answer (a caller
+    /// may keep what it computed for that hit).
     ///
     /// The nearest child a node test finds is visited next; every other child it finds is
     /// asked for as soon as it is found: interior nodes here (but top
