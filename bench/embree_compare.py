@@ -11,10 +11,13 @@ same rays, checks that both engines hit with the same rays, and prints one JSON 
 and size, then one line of ratios:
 
     {"engine": "rtis" | "embree", "triangles", "threads", "build_s", "bytes_per_triangle",
-     "incoherent_mrays", "coherent_mrays", ... extras: hit counts, versions}
+     "incoherent_mrays", "coherent_mrays", "incoherent_hit_mrays", "incoherent_miss_mrays",
+     ... extras: hit counts, versions}
     {"ratio": "rtis_vs_embree", "triangles", "threads",
      "embree_over_rtis_build_s",               > 1: rtis builds faster
      "rtis_over_embree_incoherent_mrays",      > 1: rtis traces incoherent rays faster
+     "rtis_over_embree_incoherent_hit_mrays",  the same for the incoherent rays that hit
+     "rtis_over_embree_incoherent_miss_mrays", and for those that miss
      "rtis_over_embree_coherent_mrays",        > 1: rtis traces camera rays faster
      "rtis_over_embree_bytes_per_triangle"}    > 1: rtis uses more memory per triangle
 
@@ -56,6 +59,10 @@ How each engine is measured:
   the same count. Rays are unbounded (rtis: t_max = inf; embreex: tfar = 1e37) and closest
   hit; Embree's scene is built with embreex's default RTC_SCENE_FLAG_ROBUST (rtis's triangle
   test is watertight too).
+- incoherent_hit_mrays, incoherent_miss_mrays: the incoherent rays that hit, and those that
+  miss, each set traced apart as above (each engine splits the rays by its own hits). A hit
+  costs leaf tests and a hit record, a miss mostly the top of the tree: the two rates show
+  where a gap between the engines lies.
 - hits: rays with a hit. They should agree with rtis's to a tiny fraction (edge and vertex
   hits may fall either way); a larger difference is reported on stderr.
 
@@ -293,8 +300,9 @@ def compare(n, rounds):
               f"rtis kept {r['triangles']} triangles", file=sys.stderr)
     ours = {"engine": "rtis"}
     for k in ("isa", "triangles", "threads", "build_s", "bytes_per_triangle", "incoherent_mrays",
-              "coherent_mrays", "coherent_hits", "incoherent_hits"):
-        ours[k] = r.get(k) if k == "isa" else r[k]  # older binaries print no isa
+              "coherent_mrays", "incoherent_hit_mrays", "incoherent_miss_mrays", "coherent_hits",
+              "incoherent_hits"):
+        ours[k] = r[k]
     ours["build_threads"] = r["threads"]  # rtis builds its BVH with rayon too
     for kind in ("coherent", "incoherent"):
         rays = e[f"{kind}_rays"]
@@ -310,6 +318,10 @@ def compare(n, rounds):
         "embree_over_rtis_build_s": lambda r, e: e["build_s"] / r["build_s"],
         "rtis_over_embree_incoherent_mrays":
             lambda r, e: r["incoherent_mrays"] / e["incoherent_mrays"],
+        "rtis_over_embree_incoherent_hit_mrays":
+            lambda r, e: r["incoherent_hit_mrays"] / e["incoherent_hit_mrays"],
+        "rtis_over_embree_incoherent_miss_mrays":
+            lambda r, e: r["incoherent_miss_mrays"] / e["incoherent_miss_mrays"],
         "rtis_over_embree_coherent_mrays": lambda r, e: r["coherent_mrays"] / e["coherent_mrays"],
         # Against the largest of Embree's readings (median_row), as its line reports.
         "rtis_over_embree_bytes_per_triangle":
@@ -398,9 +410,9 @@ def measure_embree(device, vertices, faces, rays, threads, pool, runs):
         grown.append(resident_bytes() - before)
         scenes.append(scene)
     scene = scenes[0]
-    mrays, hits = {}, {}
-    for kind in ("incoherent", "coherent"):
-        o, d = rays[kind]
+
+    def trace(o, d):
+        """The median rate of `runs` passes over the rays `o`, `d` (Mrays/s), and which hit."""
         chunks = [(o[i:i + CHUNK], d[i:i + CHUNK]) for i in range(0, len(o), CHUNK)]
         rates = []
         for _ in range(runs):
@@ -409,8 +421,17 @@ def measure_embree(device, vertices, faces, rays, threads, pool, runs):
             # parallel.
             ids = list(pool.map(lambda c: scene.run(c[0], c[1], query="INTERSECT"), chunks))
             rates.append(len(o) / (time.perf_counter() - t0) / 1e6)
-        mrays[kind] = median(rates)
-        hits[kind] = int(sum(int(np.count_nonzero(i != -1)) for i in ids))
+        return median(rates), np.concatenate(ids) != -1
+
+    mrays, hits = {}, {}
+    for kind in ("incoherent", "coherent"):
+        mrays[kind], hit = trace(*rays[kind])
+        hits[kind] = int(np.count_nonzero(hit))
+        if kind == "incoherent":
+            o, d = rays[kind]
+            for part, rows in (("hit", hit), ("miss", ~hit)):
+                sub = (np.ascontiguousarray(o[rows]), np.ascontiguousarray(d[rows]))
+                mrays[f"incoherent_{part}"] = trace(*sub)[0]
     del scene, scenes
     return {
         "engine": "embree",
@@ -420,6 +441,8 @@ def measure_embree(device, vertices, faces, rays, threads, pool, runs):
         "bytes_per_triangle": max(grown) / len(faces),
         "incoherent_mrays": mrays["incoherent"],
         "coherent_mrays": mrays["coherent"],
+        "incoherent_hit_mrays": mrays["incoherent_hit"],
+        "incoherent_miss_mrays": mrays["incoherent_miss"],
         "coherent_hits": hits["coherent"],
         "incoherent_hits": hits["incoherent"],
         # TBB's default pool: every hardware thread of the process's affinity mask.

@@ -247,8 +247,9 @@ def embree(_runs):
                        "--runs", str(EMBREE_ROUNDS)])
     rows = [json.loads(l) for l in out.splitlines() if l.startswith("{")]
     lines = [
-        "| triangles | engine | threads | build s | bytes/triangle | coherent Mrays/s | incoherent Mrays/s |",
-        "|---|---|---|---|---|---|---|",
+        "| triangles | engine | threads | build s | bytes/triangle | coherent Mrays/s | incoherent Mrays/s "
+        "| of which hits | of which misses |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     version = ""
     for r in rows:
@@ -257,7 +258,8 @@ def embree(_runs):
                 version = r.get("embree_version", "")
             lines.append(
                 f"| {r['triangles']:,} | {r['engine']} | {r['threads']} | {r['build_s']:.3f} | "
-                f"{r['bytes_per_triangle']:.1f} | {r['coherent_mrays']:.1f} | {r['incoherent_mrays']:.1f} |"
+                f"{r['bytes_per_triangle']:.1f} | {r['coherent_mrays']:.1f} | {r['incoherent_mrays']:.1f} | "
+                f"{r['incoherent_hit_mrays']:.1f} | {r['incoherent_miss_mrays']:.1f} |"
             )
         else:
             def spread(key, invert=False):
@@ -268,7 +270,9 @@ def embree(_runs):
                 f"{spread('embree_over_rtis_build_s', True)} | "
                 f"{r['rtis_over_embree_bytes_per_triangle']:.2f}x | "
                 f"{r['rtis_over_embree_coherent_mrays']:.2f}x {spread('rtis_over_embree_coherent_mrays')} | "
-                f"{r['rtis_over_embree_incoherent_mrays']:.2f}x {spread('rtis_over_embree_incoherent_mrays')} |"
+                f"{r['rtis_over_embree_incoherent_mrays']:.2f}x {spread('rtis_over_embree_incoherent_mrays')} | "
+                f"{r['rtis_over_embree_incoherent_hit_mrays']:.2f}x | "
+                f"{r['rtis_over_embree_incoherent_miss_mrays']:.2f}x |"
             )
     return "\n".join(lines + ["", stamp(
         f"`bench/embree_compare.py` (Embree {version}, embreex; {EMBREE_ROUNDS} rounds, the engines "

@@ -427,6 +427,13 @@ fn meshes_section(
             })
             .collect();
         let incoherent_rates = rates(&mut g, isas, &incoherent, runs, closest);
+        // The same rays split into those that hit and those that miss, each set traced apart:
+        // a hit costs the leaf tests and the record, a miss mostly the top of the tree, so
+        // the two rates show where a gap to another engine lies.
+        let (inc_hit, inc_miss): (Vec<Ray>, Vec<Ray>) =
+            incoherent.iter().partition(|r| g.intersect(r).is_some());
+        let hit_rates = rates(&mut g, isas, &inc_hit, runs, closest);
+        let miss_rates = rates(&mut g, isas, &inc_miss, runs, closest);
         // What shading needs besides the vertices: each lane's material, normals and light
         // (and whole primitives for shapes outside the blocks: none here).
         let prim_bytes = (g.attrs.len() * std::mem::size_of::<Attrs>()
@@ -438,6 +445,7 @@ fn meshes_section(
         for (k, isa) in isas.iter().map(|i| i.name()).enumerate() {
             let ((cam_rate, cam_hits), (shadow_rate, _), (inc_rate, inc_hits)) =
                 (camera_rates[k], shadow_rates[k], incoherent_rates[k]);
+            let (inc_hit_rate, inc_miss_rate) = (hit_rates[k].0, miss_rates[k].0);
             let row = serde_json::json!({
                 "section": "meshes", "engine": "rtis", "isa": isa, "triangles": count,
                 "build_s": build,
@@ -446,6 +454,7 @@ fn meshes_section(
                 "bytes_per_triangle": bvh_bytes + prim_bytes,
                 "camera_mrays": cam_rate, "coherent_mrays": cam_rate, "shadow_mrays": shadow_rate,
                 "incoherent_mrays": inc_rate, "coherent_hits": cam_hits,
+                "incoherent_hit_mrays": inc_hit_rate, "incoherent_miss_mrays": inc_miss_rate,
                 "incoherent_hits": inc_hits,
             });
             emit(json, row, || {
