@@ -51,8 +51,11 @@ How each engine is measured:
   mesh is measured in a fresh child process (so no earlier scene's pages are reused), and
   glibc's malloc_trim hands freed pages back before the first reading and after the build (so
   neither reused nor freed-but-kept build temporaries are miscounted); of three builds kept
-  alive side by side, the largest growth is reported (reused pages can only hide growth; the
-  three agree to a few percent except for such low outliers at 10k triangles). Linux only.
+  alive side by side, the largest growth is a round's reading (reused pages can only hide
+  growth; the three agree to a few percent except for such low outliers at 10k triangles),
+  and the median of the rounds' readings is reported (rounds can also read high: one run of
+  15 rounds read 119 and 117 B/triangle at 10k and 100k against 88-90 in others, cause not
+  found). Linux only.
 - Mrays/s: the rays of the file over the wall time of the query only. embreex's `run` loops
   rtcIntersect1 over its rays on one thread but releases the GIL, so the rays are split into
   chunks traced by --threads Python threads at once; rtis is run with RAYON_NUM_THREADS set to
@@ -278,14 +281,13 @@ def run_worker(dump, n, threads, runs):
 
 
 def median_row(rows):
-    """The first row with each numeric figure replaced by its median over `rows`, except the
-    byte counts, replaced by their largest (Embree's readings can only be low: see
-    measure_embree; rtis's are the same in every round)."""
+    """The first row with each numeric figure replaced by its median over `rows` (Embree's byte
+    counts included: each round's is already the largest of its builds, see measure_embree;
+    rtis's are the same in every round)."""
     out = dict(rows[0])
     for k, v in out.items():
         if isinstance(v, (int, float)) and not isinstance(v, bool):
-            values = [row[k] for row in rows]
-            out[k] = max(values) if k.endswith("bytes_per_triangle") else median(values)
+            out[k] = median([row[k] for row in rows])
     return out
 
 
@@ -323,7 +325,7 @@ def compare(n, rounds):
         "rtis_over_embree_incoherent_miss_mrays":
             lambda r, e: r["incoherent_miss_mrays"] / e["incoherent_miss_mrays"],
         "rtis_over_embree_coherent_mrays": lambda r, e: r["coherent_mrays"] / e["coherent_mrays"],
-        # Against the largest of Embree's readings (median_row), as its line reports.
+        # Against the median of Embree's readings (median_row), as its line reports.
         "rtis_over_embree_bytes_per_triangle":
             lambda r, _: r["bytes_per_triangle"] / embree_bytes,
     }
