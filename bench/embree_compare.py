@@ -280,6 +280,12 @@ def run_worker(dump, n, threads, runs):
         fail(f"the Embree measurement of mesh-{n} printed no JSON: {r.stdout!r}")
 
 
+def ratio_inputs(name):
+    """The figures a ratio line's entry is made of: `rtis_over_embree_X` and
+    `embree_over_rtis_X` divide the two engines' `X`."""
+    return [name.split("_over_", 1)[1].split("_", 1)[1]]
+
+
 def median_row(rows):
     """The first row with each numeric figure replaced by its median over `rows` (Embree's byte
     counts included: each round's is already the largest of its builds, see measure_embree;
@@ -304,7 +310,7 @@ def compare(n, rounds):
     for k in ("isa", "triangles", "threads", "build_s", "bytes_per_triangle", "incoherent_mrays",
               "coherent_mrays", "incoherent_hit_mrays", "incoherent_miss_mrays", "coherent_hits",
               "incoherent_hits"):
-        ours[k] = r[k]
+        ours[k] = r.get(k)  # an older binary (--rtis) prints no isa and no hit and miss rates
     ours["build_threads"] = r["threads"]  # rtis builds its BVH with rayon too
     for kind in ("coherent", "incoherent"):
         rays = e[f"{kind}_rays"]
@@ -336,6 +342,8 @@ def compare(n, rounds):
         "rounds": len(rounds),
     }
     for name, f in ratios.items():
+        if any(None in (r.get(k), e.get(k)) for r, e in rounds for k in ratio_inputs(name)):
+            continue
         each = [f(r, e) for r, e in rounds]
         line[name] = median(each)
         # The spread of the rounds' ratios: how far one round can be trusted.
