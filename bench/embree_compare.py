@@ -280,12 +280,6 @@ def run_worker(dump, n, threads, runs):
         fail(f"the Embree measurement of mesh-{n} printed no JSON: {r.stdout!r}")
 
 
-def ratio_inputs(name):
-    """The figures a ratio line's entry is made of: `rtis_over_embree_X` and
-    `embree_over_rtis_X` divide the two engines' `X`."""
-    return [name.split("_over_", 1)[1].split("_", 1)[1]]
-
-
 def median_row(rows):
     """The first row with each numeric figure replaced by its median over `rows` (Embree's byte
     counts included: each round's is already the largest of its builds, see measure_embree;
@@ -342,9 +336,10 @@ def compare(n, rounds):
         "rounds": len(rounds),
     }
     for name, f in ratios.items():
-        if any(None in (r.get(k), e.get(k)) for r, e in rounds for k in ratio_inputs(name)):
-            continue
-        each = [f(r, e) for r, e in rounds]
+        try:
+            each = [f(r, e) for r, e in rounds]
+        except KeyError:
+            continue  # a figure an older rtis binary (--rtis) does not print
         line[name] = median(each)
         # The spread of the rounds' ratios: how far one round can be trusted.
         line[name + "_range"] = [min(each), max(each)]

@@ -30,26 +30,26 @@ thread_local! {
 /// Counts both kinds in `LANE_HITS`.
 fn closest(block: &Block, others: &[Prim], r: &BvhRay, t_max: f32) -> Option<(u32, f32)> {
     let (lane, t, n) = block.closest(others, &BlockRay::new(r), r, t_max)?;
-    if block.has_triangle(lane as usize) {
-        LANE_HITS.with(|c| {
-            let (hits, normals) = c.get();
-            c.set((hits + 1, normals + n.is_some() as usize));
-        });
-    }
-    if let Some(n) = n {
-        let tri = block
-            .triangle(lane as usize)
-            .expect("a normal only for a lane triangle");
-        let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
-        assert_eq!(bits(n), bits(tri.n), "lane {lane}: {tri:?}");
-        assert_eq!(
-            bits(block.triangle_with_normal(lane as usize, n).n),
-            bits(tri.n)
+    let Some(tri) = block.triangle(lane as usize) else {
+        assert!(
+            n.is_none(),
+            "a normal for lane {lane}, which holds no triangle"
         );
-    } else if block.has_triangle(lane as usize) {
+        return Some((lane, t));
+    };
+    LANE_HITS.with(|c| {
+        let (hits, normals) = c.get();
+        c.set((hits + 1, normals + n.is_some() as usize));
+    });
+    if let Some(n) = n {
+        // The triangle rebuilt with the normal handed over is the lane's, to the bit.
+        let bits =
+            |t: Triangle| [t.v[0], t.v[1], t.v[2], t.n].map(|v| v.to_array().map(f32::to_bits));
+        let with = block.triangle_with_normal(lane as usize, n);
+        assert_eq!(bits(with), bits(tri), "lane {lane}: {tri:?}");
+    } else {
         // Left to the scalar test: a ray through an edge or a vertex of its triangle (an edge
         // function exactly zero there).
-        let tri = block.triangle(lane as usize).unwrap();
         let reach = BvhRay {
             ray: Ray { t_max, ..r.ray },
             ..*r
