@@ -289,3 +289,51 @@ fn blocks_mixing_spheres_and_triangles() {
     let (block, others) = block_of(&orders[3]);
     assert_eq!(closest(&block, &others, &r, r.t_max), Some((1, 3.0)));
 }
+
+/// A ray that starts on a lane's triangle (within its self-intersection band) meets it first,
+/// a hair away, and must go on to the next lane it meets: [`Block::closest`] picks the nearest
+/// lane met before checking the band, and falls back to the others when that lane fails it.
+/// Stacks of parallel triangles at z = 1000, 999 and 998, in several orders, seen from above
+/// and from starts 1.2e-4 above each (rounded to the float grid there, 6.1e-5 apart): the band there is about 6e-4 (it grows with the
+/// coordinates, `gamma(5)` times their sum), so each start is on the triangle below it.
+#[test]
+fn a_ray_starting_on_the_nearest_lane_goes_on_to_the_next() {
+    let at = |z: f32| {
+        tri(
+            Vec3A::new(-1., -1., z),
+            Vec3A::new(1., -1., z),
+            Vec3A::new(0., 1., z),
+        )
+    };
+    let stacks: [&[f32]; 4] = [
+        &[1000.0, 999.0],
+        &[999.0, 1000.0],
+        &[998.0, 1000.0, 999.0],
+        &[1000.0],
+    ];
+    let (mut fell_back, mut none) = (0, 0);
+    for zs in stacks {
+        let prims: Vec<Prim> = zs.iter().map(|&z| at(z)).collect();
+        let (block, others) = block_of(&prims);
+        for start in [1000.5, 1000.0 + 1.2e-4, 999.0 + 1.2e-4, 998.0 + 1.2e-4] {
+            let ray = Ray::new(Vec3A::new(0.05, 0.1, start), -Vec3A::Z);
+            agree(&prims, &ray);
+            // The lane by hand: the first triangle below the start by more than the band.
+            let r = ray.for_bvh(ray.t_max).sheared();
+            let below = zs
+                .iter()
+                .enumerate()
+                .filter(|&(_, &z)| z < start - 1e-3)
+                .max_by(|a, b| a.1.total_cmp(b.1))
+                .map(|(lane, _)| lane as u32);
+            let found = closest(&block, &others, &r, r.t_max);
+            assert_eq!(found.map(|f| f.0), below, "stack {zs:?}, start {start}");
+            let on = zs.iter().any(|&z| z < start && z > start - 1e-3);
+            fell_back += (on && below.is_some()) as usize;
+            none += (on && below.is_none()) as usize;
+        }
+    }
+    // The rays cover both ways on: a start on a triangle with another below it, and on the
+    // last one (4 and 4 of the 16).
+    assert_eq!((fell_back, none), (4, 4));
+}

@@ -128,12 +128,18 @@ impl Block {
         (self.other + (self.scalar & ((1 << lane) - 1)).count_ones()) as usize
     }
 
-    /// The lanes' distances, the lanes (bits) that certainly hit at those distances within
-    /// `(0, t_max]`, the lanes only the scalar test can decide, and the lanes' unit normals
-    /// ([`Block::normals`]), computed when some lane passes the edge and range tests (so
-    /// whenever one certainly hits; zeros otherwise).
+    /// The lanes' distances, the lanes (bits) whose triangle the ray meets at those distances
+    /// within `(0, t_max]`, the lanes among those that the ray does not start on (outside
+    /// the self-intersection band: a lane hits if it is in both masks), the lanes only the
+    /// scalar test can decide, and the lanes' unit normals ([`Block::normals`]), computed when
+    /// some lane passes the edge and range tests (zeros otherwise).
+    ///
+    /// The band is a mask of its own so that [`Block::closest`] can choose the nearest lane
+    /// without waiting for it and check the band on that lane alone, a branch that almost
+    /// always holds: the band needs the normals, a square root and a division after the
+    /// distances, and the traversal waits on the leaf's answer.
     #[inline(always)]
-    fn test(&self, r: &BlockRay, t_max: f32) -> (Vec4, u32, u32, [Vec4; 3]) {
+    fn test(&self, r: &BlockRay, t_max: f32) -> (Vec4, u32, u32, u32, [Vec4; 3]) {
         let [kx, ky, kz] = r.k;
         let [sx, sy, sz] = r.shear;
         // Vertices relative to the origin, sheared so the ray runs along +z.
@@ -159,7 +165,7 @@ impl Block {
         let scalar = (on_edge.bitmask() | self.scalar) & lanes;
         let hits = (!on_edge & !outside & in_range).bitmask() & lanes & !self.scalar;
         if hits == 0 {
-            return (t, 0, scalar, [zero; 3]);
+            return (t, 0, 0, scalar, [zero; 3]);
         }
         // A ray starting on the triangle's plane (within the error band of the origin's signed
         // distance) does not meet it at its start. Few tests get here, so the normal is
@@ -171,7 +177,7 @@ impl Block {
             + (an[0] + an[1] + an[2]) * r.o_err;
         let along = (n[0] * r.d[0] + n[1] * r.d[1] + n[2] * r.d[2]).abs();
         let off_start = (t * along).cmpgt(band).bitmask();
-        (t, hits & off_start, scalar, n)
+        (t, hits, off_start, scalar, n)
     }
 
     /// Nearest hit among the block's primitives within `(0, t_max]` (`ray`'s own `t_max` is
@@ -187,23 +193,36 @@ impl Block {
         ray: &BvhRay,
         mut t_max: f32,
     ) -> Option<(u32, f32, Option<Vec3A>)> {
-        let (t, exact, mut scalar, n) = self.test(br, t_max);
+        let (t, met, off_start, mut scalar, n) = self.test(br, t_max);
         let normal = |lane: u32| {
             let (i, [x, y, z]) = (lane as usize, n);
             Vec3A::new(x[i], y[i], z[i])
         };
         if scalar == 0 {
-            // Lanes only (the common case): the nearest hit without a branch per lane, the
-            // later lane of equal distances, as the loop below keeps it.
-            if exact == 0 {
+            // Lanes only (the common case): the nearest lane met, without a branch per lane,
+            // the later lane of equal distances, as the loop below keeps it.
+            let nearest = |lanes: u32| {
+                let t = Vec4::select(LANES[lanes as usize], t, Vec4::INFINITY);
+                let nearest = t.min_element();
+                let ties = t.cmpeq(Vec4::splat(nearest)).bitmask() & lanes;
+                (31 - ties.leading_zeros(), nearest)
+            };
+            if met == 0 {
                 return None;
             }
-            let t = Vec4::select(LANES[exact as usize], t, Vec4::INFINITY);
-            let nearest = t.min_element();
-            let ties = t.cmpeq(Vec4::splat(nearest)).bitmask() & exact;
-            let lane = 31 - ties.leading_zeros();
-            return Some((lane, nearest, Some(normal(lane))));
+            let (lane, t) = nearest(met);
+            // That is the nearest hit unless the ray starts on its triangle (rarely): then the
+            // nearest of the other lanes met that it does not start on.
+            if off_start & (1 << lane) != 0 {
+                return Some((lane, t, Some(normal(lane))));
+            }
+            let exact = met & off_start;
+            return (exact != 0).then(|| {
+                let (lane, t) = nearest(exact);
+                (lane, t, Some(normal(lane)))
+            });
         }
+        let exact = met & off_start;
         let t = t.to_array();
         let mut best: Option<(u32, f32)> = None;
         let mut mask = exact | scalar;
@@ -235,8 +254,8 @@ impl Block {
     /// True if any of the block's primitives is hit within `(0, ray.t_max]`.
     #[inline(always)]
     pub fn any(&self, others: &[Prim], br: &BlockRay, ray: &BvhRay) -> bool {
-        let (_, exact, mut scalar, _) = self.test(br, ray.t_max);
-        if exact != 0 {
+        let (_, met, off_start, mut scalar, _) = self.test(br, ray.t_max);
+        if met & off_start != 0 {
             return true;
         }
         while scalar != 0 {
