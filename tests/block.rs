@@ -294,8 +294,9 @@ fn blocks_mixing_spheres_and_triangles() {
 /// a hair away, and must go on to the next lane it meets: [`Block::closest`] picks the nearest
 /// lane met before checking the band, and falls back to the others when that lane fails it.
 /// Stacks of parallel triangles at z = 1000, 999 and 998, in several orders, seen from above
-/// and from starts 1.2e-4 above each (rounded to the float grid there, 6.1e-5 apart): the band there is about 6e-4 (it grows with the
-/// coordinates, `gamma(5)` times their sum), so each start is on the triangle below it.
+/// and from starts 1.2e-4 above each (rounded to the float grid there, 6.1e-5 apart): the band
+/// there is about 6e-4 (it grows with the coordinates, `gamma(5)` times their sum), so each
+/// start is on the triangle below it.
 #[test]
 fn a_ray_starting_on_the_nearest_lane_goes_on_to_the_next() {
     let at = |z: f32| {
