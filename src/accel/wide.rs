@@ -704,7 +704,9 @@ impl WideBvh {
         // them; it measured 7% of the traversal's time at 10k triangles.)
         let mut t_max = ray.t_max;
         let mut best = None;
-        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
+        // (One slot more than the stack can hold: `enter` writes the child it visits next at
+        // the slot above the ones it pushes.)
+        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK + 1];
         let mut sp = 0usize;
         loop {
             // The node test's outcome (`near`, `mask`, `child`) gives the child visited next:
@@ -737,7 +739,8 @@ impl WideBvh {
 
     /// The child to visit after a node test that found the children `mask` (not empty) at
     /// entry distances `near`: the nearest; the others are pushed on the stack, farthest
-    /// first, and asked for ([`WideBvh::ask`]) so that their cache misses overlap.
+    /// first, and asked for ([`WideBvh::ask`]) so that their cache misses overlap. Of equal
+    /// distances, the later slot is visited first.
     ///
     /// # Safety
     /// The CPU must run `L`'s instruction set.
@@ -745,54 +748,56 @@ impl WideBvh {
     unsafe fn enter<L: Lanes8>(
         &self,
         near: L,
-        mut mask: u32,
+        mask: u32,
         child: &[ChildRef; WIDTH],
-        stack: &mut [MaybeUninit<(u32, f32)>; STACK],
+        stack: &mut [MaybeUninit<(u32, f32)>; STACK + 1],
         sp: &mut usize,
         touch: &impl Fn(u32),
     ) -> ChildRef {
         let first = mask.trailing_zeros() as usize;
-        mask &= mask - 1;
+        let rest = mask & (mask - 1);
         // One child entered (the common case for coherent rays): no ordering to do.
-        if mask == 0 {
+        if rest == 0 {
             return child[first];
         }
         // SAFETY: the caller's.
-        let near = unsafe { near.to_array() };
-        // Two (the common case of several): the farther waits, the later slot of two at one
-        // distance is visited first, as the insertion below orders them.
-        if mask & (mask - 1) == 0 {
-            let second = mask.trailing_zeros() as usize;
-            let (a, b) = ((child[first], near[first]), (child[second], near[second]));
+        let dist = unsafe { near.to_array() };
+        // Two (the common case of several): the farther waits.
+        if rest & (rest - 1) == 0 {
+            let second = rest.trailing_zeros() as usize;
+            let (a, b) = ((child[first], dist[first]), (child[second], dist[second]));
             let (go, wait) = if a.1 < b.1 { (a, b) } else { (b, a) };
             self.ask(wait.0, touch);
             stack[*sp].write(wait);
             *sp += 1;
             return go.0;
         }
-        // More: insertion into at most eight, farthest first; of equal distances, the later
-        // slot goes nearer the end, and is visited first.
-        let mut next: [(u32, f32); WIDTH] = [(0, 0.0); WIDTH];
-        next[0] = (child[first], near[first]);
-        self.ask(child[first], touch);
-        let mut k = 1;
-        while mask != 0 {
-            let i = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
+        // More: each child's place among them, farthest first, counted from two comparisons
+        // of its distance with all eight lanes, so that no branch depends on the distances
+        // (the insertion sort it replaced measured 1-4% slower on hit rays). Each is written
+        // at its place above the stack; the nearest, last, is visited now and the stack keeps
+        // the others.
+        let k = mask.count_ones() as usize;
+        let mut go = EMPTY;
+        let mut m = mask;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            // SAFETY: the caller's.
+            let (nearer_or_level, farther_or_level) = unsafe {
+                let d = L::splat(dist[i]);
+                (near.le(d), d.le(near))
+            };
+            // Before child `i`: the farther children, and those as far in an earlier slot.
+            let earlier = (1 << i) - 1;
+            let place = mask & (!nearer_or_level | (farther_or_level & earlier));
+            let place = place.count_ones() as usize;
             self.ask(child[i], touch);
-            let mut j = k;
-            while j > 0 && next[j - 1].1 < near[i] {
-                next[j] = next[j - 1];
-                j -= 1;
-            }
-            next[j] = (child[i], near[i]);
-            k += 1;
+            stack[*sp + place].write((child[i], dist[i]));
+            go = if place == k - 1 { child[i] } else { go };
         }
-        for &entry in &next[..k - 1] {
-            stack[*sp].write(entry);
-            *sp += 1;
-        }
-        next[k - 1].0
+        *sp += k - 1;
+        go
     }
 
     /// Ask for child `c`'s data ahead of its visit: a leaf's through `touch`, an interior
@@ -1135,6 +1140,56 @@ mod tests {
             73,
             "three full top levels over 20k triangles"
         );
+    }
+
+    /// `enter` visits the nearest child entered and leaves the others on the stack farthest
+    /// first, the later slot of equal distances nearer the top: a stable sort by distance,
+    /// farthest first, with the earlier slot first among equals. Every non-empty mask of the
+    /// eight slots, with distances drawn from three values (so that most sets tie), in both
+    /// lane types.
+    #[test]
+    fn children_are_entered_nearest_first_the_later_slot_of_equals_first() {
+        fn check<L: Lanes8>() {
+            let bvh = WideBvh::default();
+            let child: [ChildRef; WIDTH] = std::array::from_fn(|i| 100 + i as u32);
+            let mut s = crate::sampling::Sampler::new(3, 0, 0);
+            for mask in 1u32..256 {
+                for _ in 0..20 {
+                    let dist: [f32; WIDTH] =
+                        std::array::from_fn(|_| [0.5, 1.0, 2.0][(s.next_f32() * 3.0) as usize % 3]);
+                    let mut order: Vec<usize> =
+                        (0..WIDTH).filter(|i| mask & (1 << i) != 0).collect();
+                    order.sort_by(|&a, &b| dist[b].total_cmp(&dist[a]));
+                    let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK + 1];
+                    // Entries below the ones pushed stay as they were.
+                    stack[0].write((7, 9.0));
+                    let mut sp = 1;
+                    // SAFETY: the lanes' instruction set is checked by the caller.
+                    let go = unsafe {
+                        bvh.enter(L::load(&dist), mask, &child, &mut stack, &mut sp, &|_| {})
+                    };
+                    let last = *order.last().unwrap();
+                    assert_eq!(go, child[last], "mask {mask:#b} {dist:?}");
+                    assert_eq!(sp, order.len(), "mask {mask:#b}");
+                    // SAFETY: `enter` wrote the entries below `sp`.
+                    let pushed: Vec<(u32, f32)> =
+                        (0..sp).map(|k| unsafe { stack[k].assume_init() }).collect();
+                    let expect: Vec<(u32, f32)> = std::iter::once((7, 9.0))
+                        .chain(
+                            order[..order.len() - 1]
+                                .iter()
+                                .map(|&i| (child[i], dist[i])),
+                        )
+                        .collect();
+                    assert_eq!(pushed, expect, "mask {mask:#b} {dist:?}");
+                }
+            }
+        }
+        check::<Halves>();
+        #[cfg(target_arch = "x86_64")]
+        if Isa::Avx2.available() {
+            check::<crate::accel::simd::avx2::Avx2>();
+        }
     }
 
     /// Quantisation gives the tightest grid coordinates that contain the interval, on grids
