@@ -129,10 +129,11 @@ impl Block {
     }
 
     /// The lanes' distances, the lanes (bits) whose triangle the ray meets at those distances
-    /// within `(0, t_max]`, the lanes among those that the ray does not start on (outside
-    /// the self-intersection band: a lane hits if it is in both masks), the lanes only the
-    /// scalar test can decide, and the lanes' unit normals ([`Block::normals`]), computed when
-    /// some lane passes the edge and range tests (zeros otherwise).
+    /// within `(0, t_max]`, the lanes whose distance lies beyond the self-intersection band
+    /// (the ray does not start on their triangle; a lane hits if it is in both masks, the
+    /// second means nothing outside the first), the lanes only the scalar test can decide,
+    /// and the lanes' unit normals ([`Block::normals`]), computed when some lane passes the
+    /// edge and range tests (zeros otherwise).
     ///
     /// The band is a mask of its own so that [`Block::closest`] can choose the nearest lane
     /// without waiting for it and check the band on that lane alone, a branch that almost
@@ -199,28 +200,28 @@ impl Block {
             Vec3A::new(x[i], y[i], z[i])
         };
         if scalar == 0 {
-            // Lanes only (the common case): the nearest lane met, without a branch per lane,
-            // the later lane of equal distances, as the loop below keeps it.
-            let nearest = |lanes: u32| {
-                let t = Vec4::select(LANES[lanes as usize], t, Vec4::INFINITY);
-                let nearest = t.min_element();
-                let ties = t.cmpeq(Vec4::splat(nearest)).bitmask() & lanes;
-                (31 - ties.leading_zeros(), nearest)
-            };
             if met == 0 {
                 return None;
             }
-            let (lane, t) = nearest(met);
-            // That is the nearest hit unless the ray starts on its triangle (rarely): then the
-            // nearest of the other lanes met that it does not start on.
-            if off_start & (1 << lane) != 0 {
-                return Some((lane, t, Some(normal(lane))));
+            // Lanes only (the common case): the nearest of `lanes`, without a branch per lane,
+            // the later lane of equal distances, as the loop below keeps it.
+            let nearest_of = |lanes: u32| {
+                let d = Vec4::select(LANES[lanes as usize], t, Vec4::INFINITY);
+                let least = d.min_element();
+                let ties = d.cmpeq(Vec4::splat(least)).bitmask() & lanes;
+                31 - ties.leading_zeros()
+            };
+            // The nearest lane met is the nearest hit unless the ray starts on its triangle
+            // (rarely): then the nearest of the other lanes met that it does not start on.
+            let mut lane = nearest_of(met);
+            if off_start & (1 << lane) == 0 {
+                let exact = met & off_start;
+                if exact == 0 {
+                    return None;
+                }
+                lane = nearest_of(exact);
             }
-            let exact = met & off_start;
-            return (exact != 0).then(|| {
-                let (lane, t) = nearest(exact);
-                (lane, t, Some(normal(lane)))
-            });
+            return Some((lane, t[lane as usize], Some(normal(lane))));
         }
         let exact = met & off_start;
         let t = t.to_array();

@@ -354,11 +354,14 @@ fn grown(t: f32) -> f32 {
 /// The nearest entry left on a nearest-hit traversal's stack (`stack[..sp]`) that a ray of
 /// reach `t_max` can still need, if any: entries a hit found meanwhile has put out of reach
 /// are skipped.
+///
+/// # Safety
+/// `stack[..*sp]` must be initialised.
 #[inline(always)]
-fn pop(stack: &[MaybeUninit<(u32, f32)>], sp: &mut usize, t_max: f32) -> Option<ChildRef> {
+unsafe fn pop(stack: &[MaybeUninit<(u32, f32)>], sp: &mut usize, t_max: f32) -> Option<ChildRef> {
     while *sp > 0 {
         *sp -= 1;
-        // SAFETY: entries below `sp` were written before `sp` was raised past them.
+        // SAFETY: the caller's.
         let (c, t) = unsafe { stack[*sp].assume_init() };
         if t <= grown(t_max) {
             return Some(c);
@@ -370,7 +373,8 @@ fn pop(stack: &[MaybeUninit<(u32, f32)>], sp: &mut usize, t_max: f32) -> Option<
 /// Traversal stack size: a wide level leaves at most seven more entries on the stack than it
 /// took (`closest` pushes seven of eight children and visits the eighth; `any` pops one and
 /// pushes eight), and the binary tree is at most 48 + 32 levels deep (`bvh::MEDIAN_DEPTH` plus
-/// log2 of a `u32` primitive count), so a wide tree at most 80.
+/// log2 of a `u32` primitive count), so a wide tree at most 80. (`closest`'s array has one slot
+/// more: `WideBvh::enter` writes the child it visits next in the slot above those it pushes.)
 const STACK: usize = (WIDTH - 1) * 80;
 
 /// A node as the node test reads it: its children and their boxes' sides.
@@ -716,7 +720,8 @@ impl WideBvh {
                 // SAFETY: the caller's.
                 Some(unsafe { self.enter(near, mask, child, &mut stack, &mut sp, &touch) })
             } else {
-                pop(&stack, &mut sp, t_max)
+                // SAFETY: entries below `sp` were written before `sp` was raised past them.
+                unsafe { pop(&stack, &mut sp, t_max) }
             };
             let Some(mut cur) = next else {
                 return best;
@@ -727,7 +732,8 @@ impl WideBvh {
                     t_max = t;
                     best = Some((p, t));
                 }
-                let Some(c) = pop(&stack, &mut sp, t_max) else {
+                // SAFETY: as above.
+                let Some(c) = (unsafe { pop(&stack, &mut sp, t_max) }) else {
                     return best;
                 };
                 cur = c;
@@ -743,7 +749,9 @@ impl WideBvh {
     /// distances, the later slot is visited first.
     ///
     /// # Safety
-    /// The CPU must run `L`'s instruction set.
+    /// The CPU must run `L`'s instruction set. `mask` must not be empty and its lanes of
+    /// `near` must not be NaN (the node test's distances never are): the places counted for
+    /// the children are then `0..k`, so every slot from `*sp` to the new `*sp` is written.
     #[inline(always)]
     unsafe fn enter<L: Lanes8>(
         &self,
