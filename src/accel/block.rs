@@ -203,25 +203,27 @@ impl Block {
             if met == 0 {
                 return None;
             }
-            // Lanes only (the common case): the nearest of `lanes`, without a branch per lane,
-            // the later lane of equal distances, as the loop below keeps it.
+            // Lanes only (the common case): the nearest of `lanes` and its distance, without a
+            // branch per lane, the later lane of equal distances, as the loop below keeps it.
+            // (The distance is the minimum itself: reading it back by the lane measured 4-6%
+            // slower on hit rays.)
             let nearest_of = |lanes: u32| {
                 let d = Vec4::select(LANES[lanes as usize], t, Vec4::INFINITY);
                 let least = d.min_element();
                 let ties = d.cmpeq(Vec4::splat(least)).bitmask() & lanes;
-                31 - ties.leading_zeros()
+                (31 - ties.leading_zeros(), least)
             };
             // The nearest lane met is the nearest hit unless the ray starts on its triangle
             // (rarely): then the nearest of the other lanes met that it does not start on.
-            let mut lane = nearest_of(met);
-            if off_start & (1 << lane) == 0 {
-                let exact = met & off_start;
-                if exact == 0 {
-                    return None;
-                }
-                lane = nearest_of(exact);
+            let (lane, t_hit) = nearest_of(met);
+            if off_start & (1 << lane) != 0 {
+                return Some((lane, t_hit, Some(normal(lane))));
             }
-            return Some((lane, t[lane as usize], Some(normal(lane))));
+            let exact = met & off_start;
+            return (exact != 0).then(|| {
+                let (lane, t_hit) = nearest_of(exact);
+                (lane, t_hit, Some(normal(lane)))
+            });
         }
         let exact = met & off_start;
         let t = t.to_array();
