@@ -695,7 +695,7 @@ impl WideBvh {
         let rb = unsafe { RayBox::<L>::new(ray.o, ray.inv_d) };
         // The root first: most rays that miss the scene enter none of its children (85% of
         // the misses of `rtis bench`'s incoherent rays at 10k triangles), and they leave
-        // before the traversal's state is set up (11% less time per miss, measured).
+        // before the traversal's state is set up (5-11% less time per miss, measured).
         let root = &self.top[0];
         // SAFETY: the caller's.
         let (mut near, mut mask) = unsafe { root.hit(&rb, ray.t_max) };
@@ -770,7 +770,8 @@ impl WideBvh {
         }
         // SAFETY: the caller's.
         let dist = unsafe { near.to_array() };
-        // Two (the common case of several): the farther waits.
+        // Two (the common case of several): the farther waits. (The placement below measured
+        // 0.5-1.2% slower on hit rays for two.)
         if rest & (rest - 1) == 0 {
             let second = rest.trailing_zeros() as usize;
             let (a, b) = ((child[first], dist[first]), (child[second], dist[second]));
