@@ -238,8 +238,9 @@ def venv_script(args):
 
 
 # Rounds of bench/embree_compare.py: the machine's drift moves single rounds' ratios by tens
-# of percent, so the medians need a few more rounds than the other blocks' figures.
-EMBREE_ROUNDS = 15
+# of percent, so the medians need more rounds than the other blocks' figures (at 25, the
+# median's 95% confidence interval runs from the 8th to the 18th of the rounds' ratios).
+EMBREE_ROUNDS = 25
 
 
 def embree(_runs):
@@ -263,7 +264,8 @@ def embree(_runs):
             )
         else:
             def spread(key, invert=False):
-                lo, hi = sorted(1 / x if invert else x for x in r[key + "_range"])
+                # The median's 95% confidence interval (embree_compare's median_ci).
+                lo, hi = sorted(1 / x if invert else x for x in r[key + "_ci95"])
                 return f"[{lo:.2f}-{hi:.2f}]"
             lines.append(
                 f"| | **rtis / Embree** | | {1 / r['embree_over_rtis_build_s']:.2f}x the time "
@@ -271,13 +273,15 @@ def embree(_runs):
                 f"{r['rtis_over_embree_bytes_per_triangle']:.2f}x | "
                 f"{r['rtis_over_embree_coherent_mrays']:.2f}x {spread('rtis_over_embree_coherent_mrays')} | "
                 f"{r['rtis_over_embree_incoherent_mrays']:.2f}x {spread('rtis_over_embree_incoherent_mrays')} | "
-                f"{r['rtis_over_embree_incoherent_hit_mrays']:.2f}x | "
-                f"{r['rtis_over_embree_incoherent_miss_mrays']:.2f}x |"
+                f"{r['rtis_over_embree_incoherent_hit_mrays']:.2f}x "
+                f"{spread('rtis_over_embree_incoherent_hit_mrays')} | "
+                f"{r['rtis_over_embree_incoherent_miss_mrays']:.2f}x "
+                f"{spread('rtis_over_embree_incoherent_miss_mrays')} |"
             )
     return "\n".join(lines + ["", stamp(
         f"`bench/embree_compare.py` (Embree {version}, embreex; {EMBREE_ROUNDS} rounds, the engines "
-        "taking turns: medians, and ratios the medians of the rounds' ratios, with their range in "
-        "brackets)")])
+        "taking turns: medians, and ratios the medians of the rounds' ratios, with the 95% "
+        "confidence interval of that median in brackets)")])
 
 
 # Rounds of the `commits` block: on a shared machine a round's ratio can be 10-15% off, and
