@@ -347,8 +347,9 @@ def compare(n, rounds):
         # The spread of the rounds' ratios: how far one round can be trusted.
         line[name + "_range"] = [min(each), max(each)]
         # How far the median can be trusted: its 95% confidence interval (none for fewer than
-        # six rounds). A target "no slower than Embree" is met at that confidence when the
-        # interval lies above 1.
+        # six rounds), if the rounds are independent draws (the engines take turns within
+        # each, so the machine's drift falls on both). For a speed ratio, "rtis no slower than
+        # Embree" holds at that confidence when the interval lies at or above 1.
         ci = median_ci(each)
         if ci is not None:
             line[name + "_ci95"] = ci

@@ -264,8 +264,9 @@ def embree(_runs):
             )
         else:
             def spread(key, invert=False):
-                # The median's 95% confidence interval (embree_compare's median_ci).
-                lo, hi = sorted(1 / x if invert else x for x in r[key + "_ci95"])
+                # The median's 95% confidence interval (embree_compare's median_ci; the rounds'
+                # range where there were too few of them for one).
+                lo, hi = sorted(1 / x if invert else x for x in r.get(key + "_ci95", r[key + "_range"]))
                 return f"[{lo:.2f}-{hi:.2f}]"
             lines.append(
                 f"| | **rtis / Embree** | | {1 / r['embree_over_rtis_build_s']:.2f}x the time "

@@ -1033,30 +1033,40 @@ impl Part {
     }
 }
 
-/// How the collapse groups the binary tree into wide nodes, chosen for the least sum of the
-/// wide nodes' box surfaces: the expected number of wide nodes a random line through the root
-/// box enters (the SAH's node term; the leaves' term is the same for every grouping, as the
-/// binary leaves are kept). Ylitie et al. (2017) collapse by the same dynamic programme.
+/// How the collapse groups the binary tree into wide nodes, chosen for the least expected
+/// number of wide nodes that a random line through the root's box enters: the sum of the wide
+/// nodes' box surfaces over the root's (the SAH's node term; the leaves' term is the same for
+/// every grouping, as the binary leaves are kept). A simplified form of the dynamic programme
+/// of Ylitie et al. (2017), which also chooses the leaves.
 ///
 /// For each binary node `n` and each `j` in `1..=8`, the least cost of covering `n`'s subtree
 /// with at most `j` entries of a parent's slots (leaves, or wide nodes with their subtrees):
-/// for a leaf, 0; for an interior node, either one entry, `n` made a wide node, at its surface
-/// plus the least cost of covering its two children with eight slots shared between them, or
-/// (for `j > 1`) its children covering `j` slots shared between them. Filled from the leaves
-/// up: a child's index is above its parent's in the binary layout. Over the displaced spheres
-/// of `rtis bench` (10k to 1M triangles), it makes 17-21% fewer wide nodes than the greedy
-/// collapse it replaced (which opened the largest children first), 1.4-1.8 fewer bytes per
-/// triangle, and 2.0-3.3% fewer expected visits; rays measured as fast as before (within 1%).
+/// for a leaf, 0; for an interior node, either one entry, `n` made a wide node, at its relative
+/// surface plus the least cost of covering its two children with eight slots shared between
+/// them, or (for `j > 1`) its children covering `j` slots shared between them. Filled from the
+/// leaves up: a child's index is above its parent's in the binary layout. Over the displaced
+/// spheres of `rtis bench` (10k to 1M triangles), it makes 17-21% fewer wide nodes than the
+/// greedy collapse it replaced (which opened the largest children first), 1.4-1.8 fewer bytes
+/// per triangle, and 2.0-3.3% fewer expected visits; rays measured as fast as before (within
+/// 1%).
 ///
 /// Entry `n` holds, for `j` in `2..=8`, four bits at `4 * (j - 2)`: the slots of the first
 /// child's share (`1..=7`, the second child taking the rest) in the low three, and in the
-/// fourth whether `n` is better kept as one entry (a wide node). Of equal costs, one entry and
-/// the smaller first share are kept.
+/// fourth whether `n` is kept as one entry (a wide node). Of equal costs, `n` is opened (one
+/// wide node fewer) and the smaller first share is kept.
 struct Plan(Vec<u32>);
 
 impl Plan {
     /// The grouping of `binary` (not empty).
     fn new(binary: &[Node]) -> Plan {
+        // Surfaces in doubles, relative to the root's: each at most 1 (a child's box lies in
+        // its parent's), so no sum of them overflows, whatever the scene's extent.
+        let surface = |n: &Node| {
+            let d = n.max.as_dvec3() - n.min.as_dvec3();
+            d.x * d.y + d.y * d.z + d.z * d.x
+        };
+        let root = surface(&binary[0]);
+        let scale = if root > 0.0 { 1.0 / root } else { 1.0 };
         // `cost[n][j - 1]`: the least cost of `n`'s subtree in at most `j` slots.
         let mut cost = vec![[0.0f32; WIDTH]; binary.len()];
         let mut choice = vec![0u32; binary.len()];
@@ -1066,22 +1076,19 @@ impl Plan {
                 continue;
             }
             let (l, r) = (cost[n + 1], cost[node.index as usize]);
-            // The least cost of the children in `j` slots shared, and the first's share (a
-            // share of 1 to begin with, so that one is chosen even where the surfaces overflow
-            // to infinity, in scenes of coordinates beyond 1e19).
+            // The least cost of the children in `j` slots shared, and the first's share.
             let shared = |j: usize| {
                 (2..j).fold((l[0] + r[j - 2], 1), |best, k| {
                     let c = l[k - 1] + r[j - k - 1];
                     if c < best.0 { (c, k) } else { best }
                 })
             };
-            let d = node.max - node.min;
-            let whole = (d.x * d.y + d.y * d.z + d.z * d.x) + shared(WIDTH).0;
+            let whole = (surface(node) * scale) as f32 + shared(WIDTH).0;
             let mut row = [whole; WIDTH];
             let mut bits = 0;
             for j in 2..=WIDTH {
                 let (c, k) = shared(j);
-                let keep = whole <= c;
+                let keep = whole < c;
                 row[j - 1] = if keep { whole } else { c };
                 bits |= (k as u32 | (keep as u32) << 3) << (4 * (j - 2));
             }
@@ -1213,17 +1220,60 @@ mod tests {
         );
     }
 
+    /// A binary tree in the layout of [`super::Bvh`] over `leaves` leaves, split at random,
+    /// with random leaf boxes (scaled by `scale`) and each interior node's box their union.
+    fn random_tree(s: &mut crate::sampling::Sampler, leaves: usize, scale: f32) -> Vec<Node> {
+        fn grow(out: &mut Vec<Node>, s: &mut crate::sampling::Sampler, leaves: usize, scale: f32) {
+            let me = out.len();
+            let mut v = || glam::Vec3::new(s.next_f32(), s.next_f32(), s.next_f32());
+            if leaves == 1 {
+                let (c, r) = (v() * 10.0, v() + glam::Vec3::splat(0.01));
+                let (min, max) = ((c - r) * scale, (c + r) * scale);
+                let index = out.iter().filter(|n| n.count > 0).count() as u32;
+                out.push(Node {
+                    min,
+                    index,
+                    max,
+                    count: 1,
+                });
+                return;
+            }
+            out.push(Node {
+                min: v(),
+                index: 0,
+                max: v(),
+                count: 0,
+            });
+            let k = (1 + (s.next_f32() * (leaves - 1) as f32) as usize).min(leaves - 1);
+            grow(out, s, k, scale);
+            let second = out.len();
+            grow(out, s, leaves - k, scale);
+            let (a, b) = (out[me + 1], out[second]);
+            out[me] = Node {
+                min: a.min.min(b.min),
+                index: second as u32,
+                max: a.max.max(b.max),
+                count: 0,
+            };
+        }
+        let mut out = Vec::new();
+        grow(&mut out, s, leaves, scale);
+        out
+    }
+
     /// The planned grouping is the one of least cost (the sum of the wide nodes' surfaces)
     /// among all groupings of the binary tree into nodes of at most eight entries, found by
-    /// trying every one: each non-root interior node of small trees (up to 15 interior nodes,
-    /// from meshes of 6 to 60 triangles) either is a wide node or is opened into its parent's.
+    /// trying every one: each non-root interior node of 200 random trees of 9 to 15 leaves
+    /// either is a wide node or is opened into its parent's. The planned tree covers every
+    /// leaf once, in order, with nodes of two to eight entries; so it does where the boxes'
+    /// surfaces overflow a float (trees scaled by 1e19).
     #[test]
     fn the_planned_grouping_costs_least_of_all() {
         fn area(n: &Node) -> f64 {
-            let d = n.max - n.min;
-            f64::from(d.x * d.y + d.y * d.z + d.z * d.x)
+            let d = n.max.as_dvec3() - n.min.as_dvec3();
+            d.x * d.y + d.y * d.z + d.z * d.x
         }
-        /// The entries of wide node `w` (its frontier), given which interior nodes are wide.
+        /// How many entries node `n`'s subtree takes in a wide node, given the wide ones.
         fn entries(b: &[Node], n: usize, wide: &dyn Fn(usize) -> bool) -> usize {
             if b[n].count > 0 || wide(n) {
                 1
@@ -1231,22 +1281,27 @@ mod tests {
                 entries(b, n + 1, wide) + entries(b, b[n].index as usize, wide)
             }
         }
-        /// The planned tree's cost: each wide node's surface, from the root down.
-        fn planned(b: &[Node], plan: &Plan, i: usize) -> f64 {
+        /// The planned tree's cost (each wide node's surface, from node `i` down), with its
+        /// leaves appended in the order the wide nodes hold them.
+        fn planned(b: &[Node], plan: &Plan, i: usize, leaves: &mut Vec<u32>) -> f64 {
             let (kids, n) = plan.children(b, i);
             assert!((2..=WIDTH).contains(&n), "{n} children");
-            let below = kids[..n].iter().filter(|&&k| b[k].count == 0);
-            area(&b[i]) + below.map(|&k| planned(b, plan, k)).sum::<f64>()
-        }
-        let mut trees = 0;
-        for (triangles, bump) in (6..=60).step_by(3).flat_map(|n| [(n, 0.05), (n, 0.4)]) {
-            let mesh = displaced_sphere(triangles, glam::Vec3::ZERO, 1.0, bump);
-            let (b, _) = Bvh::build_nodes(&Prim::flat_triangles(&mesh));
-            let inner: Vec<usize> = (1..b.len()).filter(|&n| b[n].count == 0).collect();
-            if b[0].count > 0 || inner.len() > 14 {
-                continue;
+            let mut cost = area(&b[i]);
+            for &k in &kids[..n] {
+                if b[k].count > 0 {
+                    leaves.push(b[k].index);
+                } else {
+                    cost += planned(b, plan, k, leaves);
+                }
             }
-            trees += 1;
+            cost
+        }
+        let mut s = crate::sampling::Sampler::new(7, 0, 0);
+        for tree in 0..200 {
+            let leaves = 9 + tree % 7;
+            let scale = if tree % 10 == 9 { 1e19 } else { 1.0 };
+            let b = random_tree(&mut s, leaves, scale);
+            let inner: Vec<usize> = (1..b.len()).filter(|&n| b[n].count == 0).collect();
             let mut least = f64::INFINITY;
             for set in 0u32..1 << inner.len() {
                 let wide = |n: usize| {
@@ -1256,54 +1311,28 @@ mod tests {
                             .position(|&m| m == n)
                             .is_some_and(|k| set >> k & 1 != 0)
                 };
-                let fits = (0..b.len())
-                    .filter(|&n| b[n].count == 0 && wide(n))
-                    .all(|n| {
-                        entries(&b, n + 1, &wide) + entries(&b, b[n].index as usize, &wide) <= WIDTH
-                    });
+                let nodes = || (0..b.len()).filter(|&n| b[n].count == 0 && wide(n));
+                let fits = nodes().all(|n| {
+                    entries(&b, n + 1, &wide) + entries(&b, b[n].index as usize, &wide) <= WIDTH
+                });
                 if fits {
-                    let cost = (0..b.len())
-                        .filter(|&n| b[n].count == 0 && wide(n))
-                        .map(|n| area(&b[n]))
-                        .sum();
-                    least = least.min(cost);
+                    least = least.min(nodes().map(|n| area(&b[n])).sum());
                 }
             }
-            let got = planned(&b, &Plan::new(&b), 0);
+            let mut seen = Vec::new();
+            let got = planned(&b, &Plan::new(&b), 0, &mut seen);
             assert!(
-                got <= least * (1.0 + 1e-5),
-                "{triangles} triangles: planned {got}, least {least}"
+                (got - least).abs() <= least * 1e-5,
+                "tree {tree}: planned {got}, least {least}"
             );
+            assert_eq!(seen, (0..leaves as u32).collect::<Vec<_>>(), "tree {tree}");
+            if scale > 1.0 {
+                assert!(
+                    (area(&b[0]) as f32).is_infinite(),
+                    "the root's surface overflows"
+                );
+            }
         }
-        assert!(trees >= 20, "only {trees} trees tried");
-        // Boxes whose surfaces overflow to infinity (every grouping then costs as much) still
-        // get nodes of two to eight entries that cover every leaf once.
-        let mesh = displaced_sphere(2_000, glam::Vec3::ZERO, 1.0, 0.05);
-        let (mut b, _) = Bvh::build_nodes(&Prim::flat_triangles(&mesh));
-        for n in &mut b {
-            (n.min, n.max) = (n.min * 1e19, n.max * 1e19);
-        }
-        assert!(
-            (area(&b[0]) as f32).is_infinite(),
-            "the root's surface overflows"
-        );
-        let plan = Plan::new(&b);
-        fn leaves(b: &[Node], plan: &Plan, i: usize) -> usize {
-            let (kids, n) = plan.children(b, i);
-            assert!((2..=WIDTH).contains(&n), "{n} children");
-            let each = |&k: &usize| {
-                if b[k].count > 0 {
-                    1
-                } else {
-                    leaves(b, plan, k)
-                }
-            };
-            kids[..n].iter().map(each).sum()
-        }
-        assert_eq!(
-            leaves(&b, &plan, 0),
-            b.iter().filter(|n| n.count > 0).count()
-        );
     }
 
     /// `enter` visits the nearest child entered and leaves the others on the stack farthest
