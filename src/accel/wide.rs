@@ -1120,18 +1120,20 @@ impl Subtree<'_> {
 /// Interior node `node`'s costs and choices (see [`Plan`]) from its children's costs `l` and
 /// `r`; `scale` is one over the root's surface.
 fn entry(node: &Node, l: &[f32; WIDTH], r: &[f32; WIDTH], scale: f64) -> ([f32; WIDTH], u32) {
-    // The least cost of the children in `j` slots shared, and the first's share.
-    let shared = |j: usize| {
+    // `shared[j - 2]`: the least cost of the children in `j` slots shared (2 to 8), and the
+    // first's share.
+    let shared: [(f32, usize); WIDTH - 1] = std::array::from_fn(|i| {
+        let j = i + 2;
         (2..j).fold((l[0] + r[j - 2], 1), |best, k| {
             let c = l[k - 1] + r[j - k - 1];
             if c < best.0 { (c, k) } else { best }
         })
-    };
-    let whole = (surface(node) * scale) as f32 + shared(WIDTH).0;
+    });
+    let whole = (surface(node) * scale) as f32 + shared[WIDTH - 2].0;
     let mut row = [whole; WIDTH];
     let mut bits = 0;
     for j in 2..=WIDTH {
-        let (c, k) = shared(j);
+        let (c, k) = shared[j - 2];
         let keep = whole < c;
         row[j - 1] = if keep { whole } else { c };
         bits |= (k as u32 | (keep as u32) << 3) << (4 * (j - 2));
@@ -1184,12 +1186,16 @@ impl Plan {
         len: &mut usize,
     ) {
         let node = &binary[n];
-        if node.count > 0 || j == 1 || self.choice(n, j).1 {
+        let (k, keep) = if node.count > 0 || j == 1 {
+            (0, true)
+        } else {
+            self.choice(n, j)
+        };
+        if keep {
             kids[*len] = n;
             *len += 1;
             return;
         }
-        let k = self.choice(n, j).0;
         self.cover(binary, n + 1, k, kids, len);
         self.cover(binary, node.index as usize, j - k, kids, len);
     }
@@ -1310,10 +1316,11 @@ mod tests {
                 });
                 return;
             }
+            // (Its box and second child are set below, once its subtrees are laid out.)
             out.push(Node {
-                min: v(),
+                min: glam::Vec3::ZERO,
                 index: 0,
-                max: v(),
+                max: glam::Vec3::ZERO,
                 count: 0,
             });
             let k = (1 + (s.next_f32() * (leaves - 1) as f32) as usize).min(leaves - 1);
