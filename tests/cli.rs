@@ -1,15 +1,19 @@
 //! The command line: renders, checks, and fails cleanly (message, location, non-zero exit, no
 //! panic, no half-written file).
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
+/// Run the binary; one that runs past 300 s is killed and fails the test.
 fn rtis(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtis"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run rtis")
+    common::output_within(
+        Command::new(env!("CARGO_BIN_EXE_rtis"))
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR")),
+        300,
+    )
 }
 
 fn tmp(name: &str) -> PathBuf {

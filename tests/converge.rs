@@ -166,6 +166,116 @@ fn variance_and_bias_of_known_images() {
     assert!((mse - 0.01).abs() < 1e-7, "{mse}");
 }
 
+/// The decomposition's formula, exactly: two seeds at `mu + b + d` and `mu + b - d` against a
+/// reference `mu` give a per-pixel variance of `2 d^2` (the unbiased one, over K - 1 = 1), a mean
+/// `b` off the reference, and so `bias2 = b^2 - 2 d^2 / 2 - v_r` with the given reference noise
+/// `v_r`: the seeds' variance enters divided by their count and the reference's noise is taken
+/// off whole. Tolerance: rounding of f32 pixels read in f64 (1e-12).
+#[test]
+fn bias_and_variance_enter_as_documented() {
+    let img = |f: &dyn Fn(usize) -> f32| Image {
+        width: 4,
+        height: 3,
+        pixels: (0..12).map(|i| glam::Vec3A::splat(f(i))).collect(),
+    };
+    let mu = |i: usize| 0.25 + 0.0625 * i as f32;
+    let (b, d, v_r) = (0.125f32, 0.0625f32, 0.001f64);
+    let seeds = [img(&|i| mu(i) + b + d), img(&|i| mu(i) + b - d)];
+    let parts = converge::metrics::bias_and_variance(&seeds, &img(&mu), v_r);
+    let (b, d) = (b as f64, d as f64);
+    assert!((parts.variance - 2.0 * d * d).abs() < 1e-12, "{parts:?}");
+    assert!(
+        (parts.bias2 - (b * b - d * d - v_r)).abs() < 1e-12,
+        "{parts:?}: want {}",
+        b * b - d * d - v_r
+    );
+}
+
+/// Gaussian noise of standard deviation `sigma` (Box-Muller), added to `base`.
+fn noisy(base: &Image, offset: f32, sigma: f32, s: &mut rtis::sampling::Sampler) -> Image {
+    let mut normal = || {
+        let (u1, u2) = s.next_2d();
+        let r = (-2.0 * (1.0 - u1 as f64).ln()).sqrt();
+        (r * (2.0 * std::f64::consts::PI * u2 as f64).cos()) as f32
+    };
+    Image {
+        width: base.width,
+        height: base.height,
+        pixels: base
+            .pixels
+            .iter()
+            .map(|p| {
+                *p + glam::Vec3A::splat(offset)
+                    + sigma * glam::Vec3A::new(normal(), normal(), normal())
+            })
+            .collect(),
+    }
+}
+
+/// The decomposition recovers a known bias and a known noise. Synthetic images of N = 3 x
+/// 160 x 160 values: a rung of k = 4 seeds at `mu + b + N(0, s^2)` (b = 0.05, s = 0.1), and a
+/// reference made as `rtis converge` makes it, the pooled mean of two independent halves of
+/// 8 and 24 samples of per-sample noise S = 0.4 (so its own noise is S^2 / 32 = 0.005, which
+/// `pooled_noise` must find from the halves alone).
+///
+/// Tolerances, 5 standard errors each: the variance estimate has SE s^2 sqrt(2 / ((k - 1) N))
+/// = 2.9e-5; the halves' noise estimate S^2 / 32 sqrt(2 / N) = 2.6e-5; the squared bias is a
+/// mean of `(m - r)^2` with `v = s^2 / k + S^2 / 32 = 0.0075`, SE sqrt((2 v^2 + 4 b^2 v) / N)
+/// = 4.9e-5, plus the other two estimates' shares (8.2e-5 in all, against b^2 = 0.0025). A
+/// reference noise left in (+0.005), a variance not divided by k (+0.0075), or the halves'
+/// noise taken as if they were of equal size (0.0133 instead of 0.005) each miss by far more.
+#[test]
+fn bias_and_variance_are_recovered_from_known_noise() {
+    let (w, h) = (160u32, 160u32);
+    let n = (3 * w * h) as f64;
+    let mut s = rtis::sampling::Sampler::new(11, 0, 0);
+    let mu = Image {
+        width: w,
+        height: h,
+        pixels: (0..w * h)
+            .map(|_| glam::Vec3A::new(s.next_f32(), s.next_f32(), s.next_f32()))
+            .collect(),
+    };
+    let (b, sigma, big, na, nb, k) = (0.05f32, 0.1f32, 0.4f32, 8u64, 24u64, 4usize);
+    let ha = noisy(&mu, 0.0, big / (na as f32).sqrt(), &mut s);
+    let hb = noisy(&mu, 0.0, big / (nb as f32).sqrt(), &mut s);
+    let noise = converge::metrics::pooled_noise(&ha, na, &hb, nb);
+    let want_noise = (big * big) as f64 / (na + nb) as f64;
+    let se_noise = want_noise * (2.0 / n).sqrt();
+    assert!(
+        (noise - want_noise).abs() < 5.0 * se_noise,
+        "reference noise {noise}, want {want_noise} +- 5 x {se_noise}"
+    );
+    // The reference: the halves' pooled mean, weighted by their samples.
+    let reference = Image {
+        width: w,
+        height: h,
+        pixels: ha
+            .pixels
+            .iter()
+            .zip(&hb.pixels)
+            .map(|(a, b)| (*a * na as f32 + *b * nb as f32) / (na + nb) as f32)
+            .collect(),
+    };
+    let seeds: Vec<Image> = (0..k).map(|_| noisy(&mu, b, sigma, &mut s)).collect();
+    let parts = converge::metrics::bias_and_variance(&seeds, &reference, noise);
+    let s2 = (sigma * sigma) as f64;
+    let se_var = s2 * (2.0 / ((k - 1) as f64 * n)).sqrt();
+    assert!(
+        (parts.variance - s2).abs() < 5.0 * se_var,
+        "variance {}, want {s2} +- 5 x {se_var}",
+        parts.variance
+    );
+    let (b, v) = (b as f64, s2 / k as f64 + want_noise);
+    let se_bias = ((2.0 * v * v + 4.0 * b * b * v) / n).sqrt() + se_var / k as f64 + se_noise;
+    assert!(
+        (parts.bias2 - b * b).abs() < 5.0 * se_bias,
+        "bias^2 {}, want {} +- 5 x {se_bias}",
+        parts.bias2,
+        b * b
+    );
+}
+
 #[test]
 fn base64_matches_the_standard() {
     use converge::report::base64;

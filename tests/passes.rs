@@ -17,7 +17,10 @@ fn small_box(spp: u32) -> rtis::RenderScene {
     rtis::extract(&s)
 }
 
+/// The `n` passes of `s`, each rendered under a time limit ([`common::deadline`]): a range bug
+/// fails the test rather than hanging it.
 fn passes(s: &rtis::RenderScene, n: u32) -> Vec<(String, Pass)> {
+    let _limit = common::deadline(120);
     (0..n)
         .map(|i| {
             let r = pass_range(i, n, s.film.spp).unwrap();
@@ -103,11 +106,12 @@ fn cli_passes_and_merge() {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     let rtis = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_rtis"))
-            .args(args)
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .output()
-            .unwrap()
+        common::output_within(
+            Command::new(env!("CARGO_BIN_EXE_rtis"))
+                .args(args)
+                .current_dir(env!("CARGO_MANIFEST_DIR")),
+            120,
+        )
     };
     let p = |n: &str| d.join(n).to_str().unwrap().to_string();
     let size = ["--width", "40", "--height", "32", "--spp", "5"];
@@ -164,4 +168,105 @@ fn cli_passes_and_merge() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("not an rtis pass"), "{e}");
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// The R, G and B channels of a pass file: the preview a person looks at.
+fn preview_channels(path: &std::path::Path) -> Vec<[u32; 3]> {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .unwrap();
+    let channel = |name: &str| -> Vec<f32> {
+        let ch = image
+            .layer_data
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .unwrap_or_else(|| panic!("no channel {name}"));
+        match &ch.sample_data {
+            FlatSamples::F32(v) => v.clone(),
+            other => panic!("channel {name} is not f32: {other:?}"),
+        }
+    };
+    let (r, g, b) = (channel("R"), channel("G"), channel("B"));
+    (0..r.len())
+        .map(|i| [r[i].to_bits(), g[i].to_bits(), b[i].to_bits()])
+        .collect()
+}
+
+/// Partial merges, adjacent or not: for every non-empty subset of four passes (of 7 spp, so the
+/// passes hold 1, 2, 2 and 2 samples), the merged preview, in memory and in the file it writes,
+/// is each pixel's mean over exactly the samples it holds: their exact sum, rendered here one
+/// sample at a time, divided by their count. A mean over the render's spp, or over the passes'
+/// count, or over the last range alone, fails it.
+#[test]
+fn partial_merges_preview_the_mean_of_exactly_their_samples() {
+    let _limit = common::deadline(120);
+    let s = rtis::extract(&scene(
+        "Scene(extends: \"cornell.ron\", film: (width: 9, height: 7, spp: 7),
+               shader: Path(max_depth: 3))",
+    ));
+    let parts = passes(&s, 4);
+    let d = std::env::temp_dir().join(format!("rtis-partial-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    for subset in 1u32..16 {
+        let chosen: Vec<(String, Pass)> = (0..4)
+            .filter(|i| subset & (1 << i) != 0)
+            .map(|i| parts[i].clone())
+            .collect();
+        let held: Vec<u32> = (0..4u32)
+            .filter(|i| subset & (1 << i) != 0)
+            .flat_map(|i| pass_range(i, 4, 7).unwrap())
+            .collect();
+        let merged = Pass::merge(chosen).unwrap();
+        assert_eq!(merged.samples(), held.len() as u64, "subset {subset:04b}");
+        // Each pixel's samples, rendered one at a time and summed exactly.
+        let mut want = Vec::new();
+        for row in 0..s.film.height {
+            for col in 0..s.film.width {
+                let mut sum = rtis::render::exact::RgbSum::default();
+                let mut stats = rtis::stats::RayStats::default();
+                for &k in &held {
+                    sum.add(rtis::render::render_sample(&s, col, row, k, &mut stats));
+                }
+                let m = sum.mean(held.len() as u64);
+                want.push([m.x.to_bits(), m.y.to_bits(), m.z.to_bits()]);
+            }
+        }
+        assert_eq!(bits(&merged.image()), want, "subset {subset:04b}");
+        let file = d.join(format!("partial-{subset}.exr"));
+        merged.write(&file).unwrap();
+        assert_eq!(preview_channels(&file), want, "subset {subset:04b}: file");
+        // The file read back holds the same samples and gives the same preview.
+        let back = Pass::read(&file).unwrap();
+        assert_eq!(back.ranges, merged.ranges);
+        assert_eq!(bits(&back.image()), want, "subset {subset:04b}: read back");
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// A pass whose range runs past the render's samples is refused with its figures, at once
+/// (before the check, such an index sent the pixel-sample permutation into an endless loop).
+#[test]
+#[should_panic(expected = "samples 4..8 of a render of 7 spp")]
+fn a_range_past_the_samples_is_refused() {
+    let _limit = common::deadline(60);
+    let s = small_box(7);
+    render_pass(&s, 4..8, &|| {}, &AtomicBool::new(false));
+}
+
+/// One sample past the end, asked of a single pixel, is refused by the pixel sampler.
+#[test]
+#[should_panic(expected = "sample index 7 is out of range: a pixel has the samples 0..7")]
+fn a_sample_index_past_the_end_is_refused() {
+    let _limit = common::deadline(60);
+    let s = small_box(7);
+    let mut stats = rtis::stats::RayStats::default();
+    rtis::render::render_sample(&s, 3, 3, 7, &mut stats);
 }

@@ -101,9 +101,8 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
             // would cover only part of it under stratification): var(a - b) = s^2 (1/na +
             // 1/nb), and the reference, their exact pooled mean, has noise variance s^2 / spp.
             let (ha, hb) = (parts[0].image(), parts[1].image());
-            let (na, nb) = (parts[0].samples() as f64, parts[1].samples() as f64);
-            let diff = converge::metrics::rmse(&ha, &hb).powi(2);
-            let noise = diff / ((1.0 / na + 1.0 / nb) * spp as f64);
+            let noise =
+                converge::metrics::pooled_noise(&ha, parts[0].samples(), &hb, parts[1].samples());
             let mut pooled = parts[0].sums.clone();
             for (a, b) in pooled.iter_mut().zip(&parts[1].sums) {
                 *a += *b;

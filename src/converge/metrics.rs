@@ -106,6 +106,45 @@ pub fn variance_and_mse_of_mean(images: &[Image], reference: &Image) -> (f64, f6
     (var / n, mse / n)
 }
 
+/// A rung's error split into its parts ([`bias_and_variance`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Decomposition {
+    /// The mean over pixels and channels of the unbiased per-pixel variance across the seeds.
+    pub variance: f64,
+    /// The squared bias, estimated without bias: can dip below zero by noise where it is small.
+    pub bias2: f64,
+}
+
+/// Squared bias and variance of a rung from `k` images of independent seeds, against a
+/// reference whose own noise variance per pixel and channel is `reference_noise`.
+///
+/// For a pixel value `x_i = mu + b + e_i` (seed noise of variance `s^2`) and a reference
+/// `r = mu + e_r` (noise variance `v_r`), the mean of the seeds `m` has
+/// `E[(m - r)^2] = b^2 + s^2 / k + v_r`, and the seeds' sample variance estimates `s^2` without
+/// bias. So `bias2 = MSE(m, r) - variance / k - v_r`, averaged over pixels and channels.
+pub fn bias_and_variance(
+    images: &[Image],
+    reference: &Image,
+    reference_noise: f64,
+) -> Decomposition {
+    let (variance, mse_of_mean) = variance_and_mse_of_mean(images, reference);
+    let k = images.len().max(1) as f64;
+    Decomposition {
+        variance,
+        bias2: mse_of_mean - variance / k - reference_noise,
+    }
+}
+
+/// The noise variance per pixel and channel of the pooled mean of two independent renders of
+/// one scene, `a` of `na` samples per pixel and `b` of `nb`, each over the whole pixel.
+///
+/// With a per-sample variance `s^2`, `a - b` has variance `s^2 (1/na + 1/nb)`, which their mean
+/// squared difference estimates; the pooled mean of `na + nb` samples has `s^2 / (na + nb)`.
+pub fn pooled_noise(a: &Image, na: u64, b: &Image, nb: u64) -> f64 {
+    let (na, nb) = (na.max(1) as f64, nb.max(1) as f64);
+    rmse(a, b).powi(2) / ((1.0 / na + 1.0 / nb) * (na + nb))
+}
+
 /// Per-pixel relative squared error `(x - r)^2 / (r^2 + 0.01)`, averaged over channels.
 pub fn rel_se_map(a: &Image, reference: &Image) -> Vec<f32> {
     a.pixels

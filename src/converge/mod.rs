@@ -49,7 +49,7 @@ pub struct Row {
     pub variance: f64,
     /// Squared bias: the MSE of the seed mean against the reference, less `variance / seeds`
     /// and less the reference's own noise variance (an unbiased estimate: it can dip below
-    /// zero by noise when the bias is small).
+    /// zero by noise when the bias is small; [`metrics::bias_and_variance`]).
     pub bias2: f64,
 }
 
@@ -256,7 +256,7 @@ pub fn sweep(
                 };
                 images.push(render(&other, &|| {}).image);
             }
-            let (variance, mse_of_mean) = metrics::variance_and_mse_of_mean(&images, reference);
+            let parts = metrics::bias_and_variance(&images, reference, reference_noise);
             let k = images.len() as f64;
             let mean_mse = images
                 .iter()
@@ -272,8 +272,8 @@ pub fn sweep(
                 rel_mse: metrics::rel_mse(&out.image, reference),
                 flip: metrics::flip(&out.image, reference).mean,
                 seeds: images.len() as u32,
-                variance,
-                bias2: mse_of_mean - variance / k - reference_noise,
+                variance: parts.variance,
+                bias2: parts.bias2,
             };
             on_rung(&row);
             Measured {

@@ -137,12 +137,23 @@ pub fn render_until(
 
 /// Render the sample indices `samples` of every pixel, keeping exact sums: passes of one
 /// scene, merged, give the same bits as one render ([`render`]) of all its samples.
+///
+/// # Panics
+/// If `samples` reaches past the film's spp (a caller's range bug; `pass::pass_range` gives
+/// ranges within it).
 pub fn render_pass(
     scene: &RenderScene,
     samples: std::ops::Range<u32>,
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
 ) -> Tiled<RgbSum> {
+    assert!(
+        samples.end <= scene.film.spp,
+        "samples {}..{} of a render of {} spp: a pass holds sample indices below the spp",
+        samples.start,
+        samples.end,
+        scene.film.spp
+    );
     by_tiles(scene, on_tile, stop, |col, row, stats| {
         pixel_sum(scene, col, row, samples.clone(), stats)
     })

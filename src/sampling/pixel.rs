@@ -8,8 +8,17 @@ use super::Sampler;
 /// cell of an `m x m` grid; any other count uses Latin-hypercube (n-rooks) strata, one row and
 /// one column of an `spp x spp` grid per sample, with the column order shuffled per pixel by
 /// `perm_seed` so the strata stay independent.
+///
+/// # Panics
+/// If `i` is not a sample of the pixel (`i >= spp`): a caller's range bug, refused here with
+/// its figures rather than left to the permutation, whose cycle-walking loop never ends for
+/// some indices out of range.
 #[inline]
 pub fn pixel_sample(i: u32, spp: u32, perm_seed: u64, rng: &mut Sampler) -> (f32, f32) {
+    assert!(
+        i < spp,
+        "sample index {i} is out of range: a pixel has the samples 0..{spp}"
+    );
     if spp == 1 {
         return (0.5, 0.5);
     }
@@ -25,7 +34,12 @@ pub fn pixel_sample(i: u32, spp: u32, perm_seed: u64, rng: &mut Sampler) -> (f32
 
 /// A pseudo-random permutation of `0..n` evaluated at `i` (Kensler's hashed permutation,
 /// "Correlated Multi-Jittered Sampling", 2013), so no table is stored per pixel.
+///
+/// The loop walks the cycle of `i` under a bijection of `0..=w` until it lands below `n`; for
+/// `i < n` that ends within the cycle, but an `i` in `n..=w` can sit on a cycle that never
+/// enters `0..n`, so such an index is refused.
 fn permute(mut i: u32, n: u32, seed: u64) -> u32 {
+    assert!(i < n, "permutation index {i} is out of range 0..{n}");
     let p = seed as u32;
     let mut w = n - 1;
     w |= w >> 1;
@@ -72,5 +86,13 @@ mod tests {
                 assert_eq!(seen, (0..n).collect::<Vec<_>>(), "n={n} seed={seed}");
             }
         }
+    }
+
+    /// An index past the end is refused at once: without the check, `permute(3, 3, 0)` never
+    /// returns (the bijection of 0..=3 maps 3 to itself, so the walk never goes below 3).
+    #[test]
+    #[should_panic(expected = "permutation index 3 is out of range 0..3")]
+    fn permute_refuses_an_index_out_of_range() {
+        permute(3, 3, 0);
     }
 }

@@ -18,8 +18,10 @@ pub fn scene(text: &str) -> Scene {
 }
 
 /// Extract and render a loaded scene on the global pool; asserts that no sample was dropped
-/// as NaN, infinite or negative, and that every pixel is finite and non-negative.
+/// as NaN, infinite or negative, and that every pixel is finite and non-negative. A render that
+/// runs past 300 s fails the test binary ([`deadline`]): the tests' renders take seconds.
 pub fn render_scene(s: &Scene) -> Rendered {
+    let _limit = deadline(300);
     let r = render(&rtis::extract(s), &|| {});
     assert_eq!(
         r.stats.dropped, 0,
@@ -128,5 +130,89 @@ pub fn lights_out_of_room(scene: &mut rtis::RenderScene) {
     for light in &mut scene.lights {
         let rtis::light::Light::Point(p) = light;
         p.in_room = false;
+    }
+}
+
+/// A time limit on the test that holds it: if the guard is still alive `seconds` after it was
+/// made, the test binary prints the test's name and exits with a failure, so a bug that makes a
+/// loop run forever fails the suite instead of hanging it (`cargo test` has no per-test limit).
+/// Dropping the guard (the test ends, or panics) lifts the limit.
+#[must_use = "the limit holds while the guard lives"]
+pub struct Deadline(u64);
+
+/// The live deadlines: guard number, when it expires, the test's name and its limit.
+type Deadlines = std::collections::HashMap<u64, (std::time::Instant, String, u64)>;
+
+fn deadlines() -> &'static std::sync::Mutex<Deadlines> {
+    static LIVE: std::sync::OnceLock<std::sync::Mutex<Deadlines>> = std::sync::OnceLock::new();
+    LIVE.get_or_init(|| {
+        // One watchdog per test binary, started with the first deadline.
+        std::thread::spawn(|| {
+            loop {
+                std::thread::sleep(std::time::Duration::from_millis(200));
+                let now = std::time::Instant::now();
+                let live = deadlines().lock().unwrap_or_else(|e| e.into_inner());
+                if let Some((_, name, limit)) = live.values().find(|(at, ..)| *at <= now) {
+                    eprintln!(
+                        "test `{name}` ran past its limit of {limit} s: a loop that does not end? \
+                         Failing the test binary."
+                    );
+                    std::process::exit(3);
+                }
+            }
+        });
+        Default::default()
+    })
+}
+
+/// Put a limit of `seconds` on the running test ([`Deadline`]).
+pub fn deadline(seconds: u64) -> Deadline {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let id = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = std::thread::current()
+        .name()
+        .unwrap_or("(unnamed)")
+        .to_string();
+    let at = std::time::Instant::now() + std::time::Duration::from_secs(seconds);
+    deadlines()
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(id, (at, name, seconds));
+    Deadline(id)
+}
+
+impl Drop for Deadline {
+    fn drop(&mut self) {
+        deadlines()
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .remove(&self.0);
+    }
+}
+
+/// Run `cmd` to its end and return what it printed, but kill it and fail the test if it runs
+/// longer than `seconds` (a child process that loops forever would otherwise hang the suite).
+pub fn output_within(cmd: &mut std::process::Command, seconds: u64) -> std::process::Output {
+    use std::process::Stdio;
+    let child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+    let pid = child.id();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(child.wait_with_output());
+    });
+    match rx.recv_timeout(std::time::Duration::from_secs(seconds)) {
+        Ok(out) => out.unwrap_or_else(|e| panic!("waiting for {cmd:?}: {e}")),
+        Err(_) => {
+            // SAFETY: `kill` on the child's own pid; it has not been reaped while it runs.
+            unsafe { libc::kill(pid as libc::pid_t, libc::SIGKILL) };
+            panic!(
+                "{cmd:?} ran past its limit of {seconds} s and was killed: a loop that does not end?"
+            )
+        }
     }
 }
