@@ -153,7 +153,11 @@ fn deadlines() -> &'static std::sync::Mutex<Deadlines> {
                 let now = std::time::Instant::now();
                 let live = deadlines().lock().unwrap_or_else(|e| e.into_inner());
                 if let Some((_, name, limit)) = live.values().find(|(at, ..)| *at <= now) {
-                    eprintln!(
+                    // Straight to the standard error: `eprintln!` would go to the test's
+                    // captured output, which is lost when the process exits.
+                    use std::io::Write;
+                    let _ = writeln!(
+                        std::io::stderr(),
                         "test `{name}` ran past its limit of {limit} s: a loop that does not end? \
                          Failing the test binary."
                     );
