@@ -162,6 +162,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
         effects: derived.effects,
         switched_off: derived.switched_off,
         warnings,
+        audit: None,
     };
     render.set_effects(derived.effects);
     render.set_shader(s.shader);

@@ -87,7 +87,7 @@ fn agree_with(name: &str, rs: &RenderScene, g: &Global) {
 /// Both orders on `rs` with the shader's parameters `g`.
 fn agree_in(name: &str, rs: &RenderScene, g: &Global) {
     let g = *g;
-    let rays = rays(rs, 200, 11);
+    let rays = rays(rs, 1000, 11);
     let (waves, waves_stats) = trace(rs, &g, &rays, Order::Waves);
     let (walk, walk_stats) = trace(rs, &g, &rays, Order::DepthFirst);
     for (k, (a, b)) in waves.iter().zip(&walk).enumerate() {
@@ -113,7 +113,7 @@ fn unsampled_emitter_seen(name: &str, rs: &RenderScene) {
         emission: false,
         ..rs.effects
     });
-    let rays = rays(rs, 200, 11);
+    let rays = rays(rs, 1000, 11);
     assert_ne!(
         trace(rs, &g, &rays, Order::DepthFirst).0,
         trace(&dark, &g, &rays, Order::DepthFirst).0,
@@ -272,4 +272,51 @@ fn waves_stand_aside_where_they_would_not_give_the_same_bits_or_fit() {
     let rs = rtis::extract(&scene(&text));
     assert_eq!(rs.lights.len(), 68);
     assert!(!applies(&rs, &global(&rs)));
+}
+
+/// Each wave kernel against the walk on one scene that holds every material it serves: the
+/// course's diffuse Phong (shaded in lanes), a glossy Phong (the scalar reflectance), a mirror,
+/// glass, and an emitter that chains see (not sampled: `light_samples` 0), with grey and
+/// coloured point lights, under both models. Packed (the kernel of `waves/lanes.rs`: planes
+/// and spheres) and with a BVH (the kernel of `waves.rs`: the same, with triangles of each
+/// material and a smooth mesh).
+#[test]
+fn each_wave_kernel_gives_the_walk_on_every_material_it_serves() {
+    let cornell = scenes_dir().join("cornell.ron");
+    let packed = "(name: \"lamp\", shape: Sphere(center: (1.5, 1.4, 6.5), radius: 1.4), \
+         emitter: Emitter(radiance: (2, 1.5, 1))), \
+         (shape: Sphere(center: (-2.2, 2, 7.5), radius: 0.7), material: Phong(kd: (0.2, 0.6, 0.3), ks: (0.5, 0.4, 0.3), shininess: 12)), \
+         (light: Point(position: (1, 2.5, 4), intensity: (9, 3, 0.5)))";
+    let meshes = "(shape: TriangleMesh(vertices: [(-1.6, -3, 1), (-0.4, -3, 1), (-1, -3, 2), (-1.6, -1.6, 1), (-0.4, -1.6, 1), (-1, -1.6, 2)], \
+         faces: [(0, 1, 2), (3, 5, 4), (0, 3, 4), (0, 4, 1), (1, 4, 5), (1, 5, 2), (2, 5, 3), (2, 3, 0)]), material: Transmissive(ior: 1.3, color: (0.9, 1, 0.95))), \
+         (shape: TriangleMesh(vertices: [(0.5, -3, 7.5), (2.8, -3, 6.5), (2.8, 0, 6.5), (0.5, 0, 7.5)], faces: [(0, 1, 2), (0, 2, 3)]), material: Mirror(color: (0.95, 0.95, 0.95))), \
+         (shape: Triangle(a: (-2.5, -2.99, 0.5), b: (-1, -2.99, 0), c: (-1.8, -2.99, 1.2)), material: Phong(kd: (0.9, 0.9, 0.2))), \
+         (shape: Mesh(path: \"assets/blob.obj\"), material: Phong(kd: (0.6, 0.6, 0.3), ks: (0.3, 0.3, 0.3), shininess: 30), transform: (scale: (0.8, 0.8, 0.8), translate: (1.8, -2, 5))), \
+         (shape: Rectangle(corner: (-0.5, 2.9, 2.5), u: (1, 0, 0), v: (0, 0, 1)), emitter: Emitter(radiance: (3, 3, 3)))";
+    for (kernel, extra) in [
+        ("lanes", packed.to_string()),
+        ("bvh", format!("{packed}, {meshes}")),
+    ] {
+        for model in ["Course", "Physical"] {
+            let text = format!(
+                "Scene(extends: {:?}, model: {model}, shader: Global(samples: 4, max_depth: 3, ambient: (0.1, 0.1, 0.1)), \
+                 entities: [{extra}])",
+                cornell.to_str().unwrap()
+            );
+            let rs = rtis::extract(&scene(&text));
+            assert_eq!(rs.geometry.bvh.is_empty(), kernel == "lanes", "{kernel}");
+            // Every material: diffuse and glossy Phong, mirror, glass; and an emitter.
+            let has = |f: &dyn Fn(&rtis::material::Material) -> bool| rs.materials.iter().any(f);
+            use rtis::material::Material;
+            assert!(has(
+                &|m| matches!(m, Material::Phong(p) if p.ks == Vec3A::ZERO)
+            ));
+            assert!(has(
+                &|m| matches!(m, Material::Phong(p) if p.ks != Vec3A::ZERO)
+            ));
+            assert!(has(&|m| matches!(m, Material::Mirror(_))));
+            assert!(has(&|m| matches!(m, Material::Transmissive(_))));
+            unsampled_emitter_seen(&format!("every material, {kernel}, {model}"), &rs);
+        }
+    }
 }

@@ -7,7 +7,7 @@ use crate::effects::Effects;
 use crate::light::{Emitters, Light};
 use crate::material::{Material, Model};
 use crate::sampling::Sampler;
-use crate::shader::{Shader, Tracer};
+use crate::shader::{RayAudit, Shader, Tracer};
 use crate::stats::RayStats;
 use glam::{DVec3, Vec3A};
 
@@ -102,6 +102,8 @@ pub struct RenderScene {
     pub switched_off: Effects,
     /// Notes from extraction and effect derivation (ignored degenerate triangles...).
     pub warnings: Vec<String>,
+    /// The observer of every ray its shaders trace, for tests ([`RayAudit`]); `None` in renders.
+    pub audit: Option<RayAudit>,
 }
 
 impl RenderScene {
@@ -155,6 +157,7 @@ impl RenderScene {
             effects: self.effects,
             sampler,
             stats,
+            audit: self.audit,
         }
     }
 }

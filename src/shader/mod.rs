@@ -58,6 +58,13 @@ pub enum Shader {
     Path(Path),
 }
 
+/// An observer of every ray a shader traces, told each ray with its kind where the ray is
+/// counted ([`RayStats`]), whichever code traces it: the one-ray queries, the waves' batches and
+/// their rays in lanes. For tests (`tests/origins.rs` checks that every spawned ray starts on
+/// the side of the surface it leaves towards); renders leave it unset, at the cost of one
+/// predictable branch per ray.
+pub type RayAudit = fn(&Ray, RayKind);
+
 /// What one camera sample needs while it is traced: the parts of the scene it reads, its
 /// random numbers and its counters.
 pub struct Tracer<'a> {
@@ -79,20 +86,32 @@ pub struct Tracer<'a> {
     pub sampler: Sampler,
     /// Rays traced so far, by kind.
     pub stats: &'a mut RayStats,
+    /// The observer of every ray traced, if any ([`RayAudit`]).
+    pub audit: Option<RayAudit>,
 }
 
 impl Tracer<'_> {
+    /// Count a ray of `kind` that is about to be traced, and show it to the audit if there is
+    /// one. Every ray a shader traces passes here once.
+    #[inline]
+    pub fn count(&mut self, ray: &Ray, kind: RayKind) {
+        self.stats.count(kind);
+        if let Some(audit) = self.audit {
+            audit(ray, kind);
+        }
+    }
+
     /// Nearest hit of a ray of the given kind (counted).
     #[inline]
     pub fn trace(&mut self, ray: &Ray, kind: RayKind) -> Option<Hit> {
-        self.stats.count(kind);
+        self.count(ray, kind);
         self.geometry.intersect(ray)
     }
 
     /// True if nothing blocks the shadow ray (counted).
     #[inline]
     pub fn unoccluded(&mut self, ray: &Ray) -> bool {
-        self.stats.count(RayKind::Shadow);
+        self.count(ray, RayKind::Shadow);
         !self.geometry.occluded(ray)
     }
 
@@ -100,7 +119,7 @@ impl Tracer<'_> {
     /// ([`Light::in_room`]): the planes are not tested.
     #[inline]
     pub fn unoccluded_in_room(&mut self, ray: &Ray) -> bool {
-        self.stats.count(RayKind::Shadow);
+        self.count(ray, RayKind::Shadow);
         !self.geometry.occluded_in_room(ray)
     }
 }

@@ -22,8 +22,8 @@ use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
 use crate::light::Light;
 use crate::material::{Material, Model, Phong, reflect};
-use crate::shader::Tracer;
 use crate::shader::surface::{Interaction, SHADOW_END, emitted, reflectance, specular_bounce};
+use crate::shader::{RayAudit, Tracer};
 use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::PI;
@@ -91,7 +91,7 @@ impl Node {
         let (next, tint, kind) = specular_bounce(si, tr.effects)?;
         self.tint *= tint;
         self.bounces += 1;
-        tr.stats.count(kind);
+        tr.count(&next, kind);
         Some(next)
     }
 
@@ -282,9 +282,9 @@ fn sum_tree(nodes: &[Node], kids: &[u32], root: u32) -> Vec3A {
 fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
     s.nodes.clear();
     s.kids.clear();
-    for _ in roots {
+    for root in roots {
         s.add_node(Vec3A::ONE);
-        tr.stats.count(RayKind::Indirect);
+        tr.count(root, RayKind::Indirect);
     }
     if tr.geometry.bvh.is_empty() {
         // Every primitive packed: each wave traced and shaded in lanes.
@@ -369,8 +369,9 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
     for (k, w) in [n, reflect(wo, n)].into_iter().enumerate() {
         let b = beta * reflectance(tr.model, &phong, w, wo, n) / (4.0 * PI);
         s.add_node(b);
-        s.children.push(first + k as u32, si.spawn(w));
-        tr.stats.count(RayKind::Indirect);
+        let ray = si.spawn(w);
+        s.children.push(first + k as u32, ray);
+        tr.count(&ray, RayKind::Indirect);
     }
 }
 
@@ -567,6 +568,9 @@ unsafe fn point_sums<L: Floats>(
         ];
         let seen = if shadows {
             tr.stats.shadow += u64::from(L::bitmask(valid).count_ones());
+            if let Some(audit) = tr.audit {
+                audit_lanes(audit, o, wi, o_err, dist * end, L::bitmask(valid));
+            }
             let planes = !pl.in_room;
             let blocked = tr
                 .geometry
@@ -620,4 +624,29 @@ unsafe fn point_sums<L: Floats>(
         sum[c].write_to(&mut out[c]);
     }
     out
+}
+
+/// Show the rays in the lanes of `mask` (origins `o`, directions `d`) to `audit` as shadow
+/// rays ([`RayAudit`]), one by one.
+#[inline(always)]
+fn audit_lanes<L: Floats>(audit: RayAudit, o: [L; 3], d: [L; 3], o_err: L, t_max: L, mask: u32) {
+    let column = |x: L| {
+        let mut v = [0.0f32; MAX_LANES];
+        x.write_to(&mut v);
+        v
+    };
+    let (o, d) = (o.map(column), d.map(column));
+    let (o_err, t_max) = (column(o_err), column(t_max));
+    let mut bits = mask;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let ray = Ray {
+            o: Vec3A::new(o[0][i], o[1][i], o[2][i]),
+            d: Vec3A::new(d[0][i], d[1][i], d[2][i]),
+            t_max: t_max[i],
+            o_err: o_err[i],
+        };
+        audit(&ray, RayKind::Shadow);
+    }
 }

@@ -27,6 +27,7 @@ use crate::material::{Material, Model};
 use crate::shader::Tracer;
 use crate::shader::global::Global;
 use crate::shader::surface::{Interaction, emitted, reflectance};
+use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::PI;
 
@@ -94,6 +95,17 @@ impl Columns {
             *slot = node + j as u32;
         }
         self.len += n;
+    }
+
+    /// Ray `k` of the queue.
+    fn ray(&self, k: usize) -> Ray {
+        let v = |row: usize| self.rows[row][k];
+        Ray {
+            o: Vec3A::new(v(OX), v(OX + 1), v(OX + 2)),
+            d: Vec3A::new(v(DX), v(DX + 1), v(DX + 2)),
+            o_err: v(OE),
+            t_max: v(TM),
+        }
     }
 
     /// `L::LANES` values of column `row` from ray `k` on.
@@ -544,5 +556,10 @@ unsafe fn chunk<L: Floats>(
     }
     s.next.len += 2 * n_parents;
     tr.stats.indirect += 2 * n_parents as u64;
+    if let Some(audit) = tr.audit {
+        for k in at..at + 2 * n_parents {
+            audit(&s.next.ray(k), RayKind::Indirect);
+        }
+    }
     count
 }
