@@ -327,7 +327,7 @@ fn check(rs: &mut RenderScene, tally: &mut Tally, what: &str) {
             .entry((format!("{kind:?}"), format!("{shape:?}")))
             .or_default() += 1;
         // The start is strictly on the side the ray leaves towards.
-        if !(s * cos > 0.0) {
+        if s * cos <= 0.0 || (s * cos).is_nan() {
             tally.wrong_count += 1;
             tally.wrong.push(format!(
                 "{what}: a {kind:?} ray leaving a {shape:?} towards side {cos:+.3} starts at \
