@@ -424,3 +424,11 @@ fn diff_prints_exact_figures_and_writes_the_heatmap() {
     assert!(stderr(&o).contains("is 8x8 but"), "{}", stderr(&o));
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// The tests' time limit on a child process holds: one that runs past it is killed and the
+/// test fails with the limit in its message (as a binary caught in an endless loop would).
+#[test]
+#[should_panic(expected = "ran past its limit of 1 s and was killed")]
+fn a_child_past_its_time_limit_is_killed() {
+    common::output_within(Command::new("sleep").arg("30"), 1);
+}

@@ -222,8 +222,9 @@ fn noisy(base: &Image, offset: f32, sigma: f32, s: &mut rtis::sampling::Sampler)
 /// = 2.9e-5; the halves' noise estimate S^2 / 32 sqrt(2 / N) = 2.6e-5; the squared bias is a
 /// mean of `(m - r)^2` with `v = s^2 / k + S^2 / 32 = 0.0075`, SE sqrt((2 v^2 + 4 b^2 v) / N)
 /// = 4.9e-5, plus the other two estimates' shares (8.2e-5 in all, against b^2 = 0.0025). A
-/// reference noise left in (+0.005), a variance not divided by k (+0.0075), or the halves'
-/// noise taken as if they were of equal size (0.0133 instead of 0.005) each miss by far more.
+/// reference noise left in (+0.005), a variance not divided by k (-0.0075), or the halves'
+/// noise taken as if they were of equal size (their mean squared difference over 4, 0.0067
+/// instead of 0.005) each miss by far more.
 #[test]
 fn bias_and_variance_are_recovered_from_known_noise() {
     let (w, h) = (160u32, 160u32);
@@ -236,11 +237,11 @@ fn bias_and_variance_are_recovered_from_known_noise() {
             .map(|_| glam::Vec3A::new(s.next_f32(), s.next_f32(), s.next_f32()))
             .collect(),
     };
-    let (b, sigma, big, na, nb, k) = (0.05f32, 0.1f32, 0.4f32, 8u64, 24u64, 4usize);
-    let ha = noisy(&mu, 0.0, big / (na as f32).sqrt(), &mut s);
-    let hb = noisy(&mu, 0.0, big / (nb as f32).sqrt(), &mut s);
+    let (b, sigma, s_sample, na, nb, k) = (0.05f32, 0.1f32, 0.4f32, 8u64, 24u64, 4usize);
+    let ha = noisy(&mu, 0.0, s_sample / (na as f32).sqrt(), &mut s);
+    let hb = noisy(&mu, 0.0, s_sample / (nb as f32).sqrt(), &mut s);
     let noise = converge::metrics::pooled_noise(&ha, na, &hb, nb);
-    let want_noise = (big * big) as f64 / (na + nb) as f64;
+    let want_noise = (s_sample * s_sample) as f64 / (na + nb) as f64;
     let se_noise = want_noise * (2.0 / n).sqrt();
     assert!(
         (noise - want_noise).abs() < 5.0 * se_noise,

@@ -13,6 +13,8 @@
 
 #![cfg(all(target_arch = "x86_64", target_os = "linux"))]
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -46,7 +48,8 @@ fn rtis(emulated: Option<(&Path, &str)>, args: &[&str]) -> Output {
         }
         None => Command::new(RTIS),
     };
-    cmd.args(args).output().expect("run rtis")
+    // Under emulation a render takes tens of seconds; a hang fails after ten minutes.
+    common::output_within(cmd.args(args), 600)
 }
 
 fn stderr(out: &Output) -> String {

@@ -11,6 +11,7 @@ use rtis::geometry::Ray;
 use rtis::sampling::Sampler;
 use rtis::shader::global::{Order, incident_all};
 use rtis::shader::{Global, Shader};
+use rtis::shape::ShapeKind;
 use rtis::stats::RayStats;
 
 /// The Global parameters of a scene.
@@ -87,7 +88,7 @@ fn agree_with(name: &str, rs: &RenderScene, g: &Global) {
 /// Both orders on `rs` with the shader's parameters `g`.
 fn agree_in(name: &str, rs: &RenderScene, g: &Global) {
     let g = *g;
-    let rays = rays(rs, 1000, 11);
+    let rays = rays(rs, 200, 11);
     let (waves, waves_stats) = trace(rs, &g, &rays, Order::Waves);
     let (walk, walk_stats) = trace(rs, &g, &rays, Order::DepthFirst);
     for (k, (a, b)) in waves.iter().zip(&walk).enumerate() {
@@ -104,6 +105,11 @@ fn agree_in(name: &str, rs: &RenderScene, g: &Global) {
 /// ask for): chains through mirror and glass see them (emission changes some `L_i`, so each
 /// node's `le` matters), and both orders agree.
 fn unsampled_emitter_seen(name: &str, rs: &RenderScene) {
+    unsampled_emitter_seen_by(name, rs, 200);
+}
+
+/// [`unsampled_emitter_seen`] with `count` rays.
+fn unsampled_emitter_seen_by(name: &str, rs: &RenderScene, count: usize) {
     let g = Global {
         light_samples: 0,
         ..global(rs)
@@ -113,7 +119,7 @@ fn unsampled_emitter_seen(name: &str, rs: &RenderScene) {
         emission: false,
         ..rs.effects
     });
-    let rays = rays(rs, 1000, 11);
+    let rays = rays(rs, count, 11);
     assert_ne!(
         trace(rs, &g, &rays, Order::DepthFirst).0,
         trace(&dark, &g, &rays, Order::DepthFirst).0,
@@ -274,6 +280,51 @@ fn waves_stand_aside_where_they_would_not_give_the_same_bits_or_fit() {
     assert!(!applies(&rs, &global(&rs)));
 }
 
+thread_local! {
+    /// The rays the audit saw on this thread.
+    static SEEN: std::cell::RefCell<Vec<Ray>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// The audit of [`materials_met`]: keep every ray.
+fn record(ray: &Ray, _: rtis::stats::RayKind) {
+    SEEN.with_borrow_mut(|v| v.push(*ray));
+}
+
+/// What the walk of `count` of [`rays`] meets (every ray it traces, seen through the tracer's
+/// audit): the kind of material (diffuse or glossy Phong, mirror, glass) and of shape of each
+/// hit.
+fn materials_met(rs: &RenderScene, count: usize) -> Vec<(&'static str, ShapeKind)> {
+    use rtis::material::Material;
+    let mut audited = rs.clone();
+    audited.audit = Some(record);
+    SEEN.with_borrow_mut(Vec::clear);
+    trace(
+        &audited,
+        &global(rs),
+        &rays(rs, count, 11),
+        Order::DepthFirst,
+    );
+    let mut met = Vec::new();
+    for ray in SEEN.with_borrow_mut(std::mem::take) {
+        let Some(hit) = rs.geometry.intersect(&ray) else {
+            continue;
+        };
+        let prim = rs.geometry.prim(hit.prim);
+        let what = match rs.materials[prim.material as usize] {
+            Material::Phong(p) if p.is_black() => "black",
+            Material::Phong(p) if p.ks == Vec3A::ZERO => "diffuse",
+            Material::Phong(_) => "glossy",
+            Material::Mirror(_) => "mirror",
+            Material::Transmissive(_) => "glass",
+        };
+        let key = (what, prim.shape.kind());
+        if !met.contains(&key) {
+            met.push(key);
+        }
+    }
+    met
+}
+
 /// Each wave kernel against the walk on one scene that holds every material it serves: the
 /// course's diffuse Phong (shaded in lanes), a glossy Phong (the scalar reflectance), a mirror,
 /// glass, and an emitter that chains see (not sampled: `light_samples` 0), with grey and
@@ -305,18 +356,25 @@ fn each_wave_kernel_gives_the_walk_on_every_material_it_serves() {
             );
             let rs = rtis::extract(&scene(&text));
             assert_eq!(rs.geometry.bvh.is_empty(), kernel == "lanes", "{kernel}");
-            // Every material: diffuse and glossy Phong, mirror, glass; and an emitter.
-            let has = |f: &dyn Fn(&rtis::material::Material) -> bool| rs.materials.iter().any(f);
-            use rtis::material::Material;
-            assert!(has(
-                &|m| matches!(m, Material::Phong(p) if p.ks == Vec3A::ZERO)
-            ));
-            assert!(has(
-                &|m| matches!(m, Material::Phong(p) if p.ks != Vec3A::ZERO)
-            ));
-            assert!(has(&|m| matches!(m, Material::Mirror(_))));
-            assert!(has(&|m| matches!(m, Material::Transmissive(_))));
-            unsampled_emitter_seen(&format!("every material, {kernel}, {model}"), &rs);
+            let name = format!("every material, {kernel}, {model}");
+            // The rays of the comparison meet every material: diffuse walls, glossy, mirror and
+            // glass spheres, and with a BVH the same four on triangles.
+            let met = materials_met(&rs, 1000);
+            let mut want = vec![
+                ("diffuse", ShapeKind::Plane),
+                ("glossy", ShapeKind::Sphere),
+                ("mirror", ShapeKind::Sphere),
+                ("glass", ShapeKind::Sphere),
+            ];
+            if kernel == "bvh" {
+                for what in ["diffuse", "glossy", "mirror", "glass"] {
+                    want.push((what, ShapeKind::Triangle));
+                }
+            }
+            for key in want {
+                assert!(met.contains(&key), "{name}: no ray meets {key:?}: {met:?}");
+            }
+            unsampled_emitter_seen_by(&name, &rs, 1000);
         }
     }
 }

@@ -39,7 +39,7 @@ const BVH: &str = "(shape: Triangle(a: (0, -50, 0), b: (1, -50, 0), c: (0, -50, 
 /// Render `text` (a scene whose entities end with `LIGHTS`) in the three orders of tracing:
 /// the waves in lanes (every primitive packed), the waves of a scene with a BVH ([`BVH`]
 /// added), and the depth-first walk ([`walk_lights`] added). Checks that each is the one meant.
-fn both_orders(text: &str) -> [(&'static str, Rendered); 3] {
+fn every_order(text: &str) -> [(&'static str, Rendered); 3] {
     ["lanes", "bvh", "walk"].map(|order| {
         let extra = match order {
             "lanes" => String::new(),
@@ -78,7 +78,7 @@ fn eq4_weight_is_one_over_two_pi_n_exactly() {
         ],
     )"#;
     let want = Vec3A::new(2.0, 1.0, 0.5) * Vec3A::new(0.5, 0.25, 0.75) / (2.0 * PI);
-    for (order, r) in both_orders(text) {
+    for (order, r) in every_order(text) {
         for (i, p) in r.image.pixels.iter().enumerate() {
             assert!(
                 common::close(*p, want, 1e-6),
@@ -118,8 +118,8 @@ fn n_bounce_weight_is_one_over_four_pi_over_both_rays_exactly() {
         )"#
         )
     };
-    let d1 = both_orders(&room(1, "Phong(kd: (0.5, 0.25, 0.125))"));
-    let d2 = both_orders(&room(
+    let d1 = every_order(&room(1, "Phong(kd: (0.5, 0.25, 0.125))"));
+    let d2 = every_order(&room(
         2,
         "Phong(kd: (0, 0, 0), ks: (0.3, 0.6, 0.9), shininess: 0)",
     ));
@@ -182,7 +182,7 @@ fn n_bounce_statistics(ks_c: Vec3A) {
     // Moments of g(u) per channel, by Simpson's rule on [0, 1] (error far below the tolerance).
     let simpson = |f: &dyn Fn(f64) -> f64| {
         let m = 20_000;
-        let hh = 1.0 / m as f64;
+        let step = 1.0 / m as f64;
         (0..=m)
             .map(|i| {
                 let c = if i == 0 || i == m {
@@ -190,10 +190,10 @@ fn n_bounce_statistics(ks_c: Vec3A) {
                 } else {
                     [2.0, 4.0][i % 2]
                 };
-                c * f(i as f64 * hh)
+                c * f(i as f64 * step)
             })
             .sum::<f64>()
-            * hh
+            * step
             / 3.0
     };
     let scale = a * kd_f * kd_f / (8.0 * PI * PI);
@@ -209,7 +209,7 @@ fn n_bounce_statistics(ks_c: Vec3A) {
         want[c] = scale[c] * closed as f32;
         sigma[c] = scale[c] * (var / (w * h * n) as f64).sqrt() as f32;
     }
-    for (order, r) in both_orders(&text) {
+    for (order, r) in every_order(&text) {
         let got = r.image.mean();
         assert!(
             (got - want).abs().cmple(5.0 * sigma).all(),

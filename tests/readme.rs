@@ -3,6 +3,8 @@
 //! checks that every block is there with its stamp, and that the README's two commands are the
 //! ones the project promises.
 
+mod common;
+
 use std::process::Command;
 
 #[test]
@@ -40,11 +42,12 @@ fn readme_error_example_is_real() {
         .find("error: tests/data/broken.ron")
         .expect("the example");
     let example = &text[start..start + text[start..].find("```").unwrap()];
-    let o = Command::new(env!("CARGO_BIN_EXE_rtis"))
-        .args(["check", "tests/data/broken.ron"])
-        .current_dir(root)
-        .output()
-        .unwrap();
+    let o = common::output_within(
+        Command::new(env!("CARGO_BIN_EXE_rtis"))
+            .args(["check", "tests/data/broken.ron"])
+            .current_dir(root),
+        120,
+    );
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(
         String::from_utf8_lossy(&o.stderr).trim_end(),

@@ -1,6 +1,8 @@
 //! `rtis warptest` (src/converge/warptest.rs): every sampler passes its chi-squared test, a
 //! sampler with the wrong pdf fails it, and the p-values are right where tables give them.
 
+mod common;
+
 use glam::Vec3A;
 use rtis::converge::warptest::{self, Case, direction_bin, gamma_q, integrate_pdf};
 use rtis::sampling::hemisphere;
@@ -76,16 +78,16 @@ fn the_command_prints_and_writes_its_page() {
     let d = std::env::temp_dir().join(format!("rtis-warp-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     let page = d.join("w.html");
-    let o = Command::new(env!("CARGO_BIN_EXE_rtis"))
-        .args([
+    let o = common::output_within(
+        Command::new(env!("CARGO_BIN_EXE_rtis")).args([
             "warptest",
             "--samples",
             "100000",
             "-o",
             page.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+        ]),
+        600,
+    );
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(
         o.status.success(),

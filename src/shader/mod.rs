@@ -92,7 +92,9 @@ pub struct Tracer<'a> {
 
 impl Tracer<'_> {
     /// Count a ray of `kind` that is about to be traced, and show it to the audit if there is
-    /// one. Every ray a shader traces passes here once.
+    /// one. Every ray traced one at a time passes here once; the waves' rays in lanes (the
+    /// children of `waves/lanes.rs`, the shadow rays of the light pass) are counted and shown
+    /// to the audit where they are made, in the same way.
     #[inline]
     pub fn count(&mut self, ray: &Ray, kind: RayKind) {
         self.stats.count(kind);

@@ -161,6 +161,12 @@ fn deadlines() -> &'static std::sync::Mutex<Deadlines> {
                         "test `{name}` ran past its limit of {limit} s: a loop that does not end? \
                          Failing the test binary."
                     );
+                    // The children still running would outlive the binary: kill them first.
+                    for &pid in children().lock().unwrap_or_else(|e| e.into_inner()).iter() {
+                        // SAFETY: `kill` on a pid whose process `output_within` has not reaped
+                        // (it reaps only with the list locked, and takes the pid off at once).
+                        unsafe { libc::kill(pid as libc::pid_t, libc::SIGKILL) };
+                    }
                     std::process::exit(3);
                 }
             }
@@ -196,27 +202,65 @@ impl Drop for Deadline {
 
 /// Run `cmd` to its end and return what it printed, but kill it and fail the test if it runs
 /// longer than `seconds` (a child process that loops forever would otherwise hang the suite).
+/// While it runs it is on the watchdog's list ([`deadline`]), which kills it before failing
+/// the binary, so no child outlives the tests.
 pub fn output_within(cmd: &mut std::process::Command, seconds: u64) -> std::process::Output {
+    use std::io::Read;
     use std::process::Stdio;
-    let child = cmd
+    let mut child = cmd
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
     let pid = child.id();
-    let (tx, rx) = std::sync::mpsc::channel();
-    std::thread::spawn(move || {
-        let _ = tx.send(child.wait_with_output());
-    });
-    match rx.recv_timeout(std::time::Duration::from_secs(seconds)) {
-        Ok(out) => out.unwrap_or_else(|e| panic!("waiting for {cmd:?}: {e}")),
-        Err(_) => {
-            // SAFETY: `kill` on the child's own pid; it has not been reaped while it runs.
-            unsafe { libc::kill(pid as libc::pid_t, libc::SIGKILL) };
-            panic!(
-                "{cmd:?} ran past its limit of {seconds} s and was killed: a loop that does not end?"
-            )
+    children()
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(pid);
+    // Read both pipes as the child writes, so that it never blocks on a full pipe.
+    let reader = |mut pipe: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            let _ = pipe.read_to_end(&mut bytes);
+            bytes
+        })
+    };
+    let out = reader(Box::new(child.stdout.take().expect("piped")));
+    let err = reader(Box::new(child.stderr.take().expect("piped")));
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(seconds);
+    // The child is reaped only with the list locked, and taken off it at once, so the
+    // watchdog (which kills what is on the list, holding the lock) never signals a pid that
+    // may have been given to another process.
+    let status = loop {
+        {
+            let mut live = children().lock().unwrap_or_else(|e| e.into_inner());
+            let timed_out = std::time::Instant::now() >= end;
+            if timed_out {
+                let _ = child.kill();
+            }
+            if let Some(status) = child.try_wait().expect("wait for the child") {
+                live.retain(|&p| p != pid);
+                break (!timed_out).then_some(status);
+            }
         }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let Some(status) = status else {
+        panic!(
+            "{cmd:?} ran past its limit of {seconds} s and was killed: a loop that does not end?"
+        )
+    };
+    std::process::Output {
+        status,
+        stdout: out.join().expect("stdout reader"),
+        stderr: err.join().expect("stderr reader"),
     }
+}
+
+/// The child processes [`output_within`] is waiting for, which the watchdog kills before it
+/// fails the test binary.
+fn children() -> &'static std::sync::Mutex<Vec<u32>> {
+    static LIVE: std::sync::OnceLock<std::sync::Mutex<Vec<u32>>> = std::sync::OnceLock::new();
+    LIVE.get_or_init(Default::default)
 }
