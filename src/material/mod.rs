@@ -5,6 +5,7 @@
 //! from the surface towards the light; both are unit vectors; `n` is the unit normal on the
 //! side of `wo`.
 
+pub mod microfacet;
 mod mirror;
 mod model;
 pub mod phong;
