@@ -5,10 +5,12 @@
 //! from the surface towards the light; both are unit vectors; `n` is the unit normal on the
 //! side of `wo`.
 
+pub mod conductor;
 pub mod microfacet;
 mod mirror;
 mod model;
 pub mod phong;
+pub mod rough_conductor;
 mod transmissive;
 
 pub use mirror::Mirror;
