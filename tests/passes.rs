@@ -270,3 +270,28 @@ fn a_sample_index_past_the_end_is_refused() {
     let mut stats = rtis::stats::RayStats::default();
     rtis::render::render_sample(&s, 3, 3, 7, &mut stats);
 }
+
+/// A pass file whose header names an empty sample range is refused on reading (a range holds
+/// at least one sample), as is one past the spp.
+#[test]
+fn pass_files_with_empty_or_outlying_ranges_are_refused() {
+    let _limit = common::deadline(60);
+    let s = small_box(6);
+    let d = std::env::temp_dir().join(format!("rtis-ranges-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let (_, good) = passes(&s, 3).remove(0);
+    for (name, ranges) in [("empty", vec![0..2, 4..4]), ("outlying", vec![0..2, 5..7])] {
+        let bad = Pass {
+            ranges,
+            ..good.clone()
+        };
+        let file = d.join(format!("{name}.exr"));
+        bad.write(&file).unwrap();
+        let e = Pass::read(&file).unwrap_err();
+        assert!(e.contains("not a list of sample ranges within spp"), "{name}: {e}");
+    }
+    let file = d.join("good.exr");
+    good.write(&file).unwrap();
+    assert_eq!(Pass::read(&file).unwrap().ranges, good.ranges);
+    std::fs::remove_dir_all(&d).unwrap();
+}

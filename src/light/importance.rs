@@ -121,6 +121,21 @@ mod tests {
         }
     }
 
+    /// The defensive end: should `u * total` reach the last cumulative weight (`u = 1`, outside
+    /// the contract), the last light with a weight is chosen, never one of weight 0 after it.
+    #[test]
+    fn a_u_past_the_end_takes_the_last_light_of_weight() {
+        let lights = [
+            point(0.0, 1.0, 0.0, 2.0),
+            point(3.0, 1.0, 0.0, 5.0),
+            point(0.0, -1.0, 0.0, 9.0), // below the surface: weight 0
+        ];
+        let (p, n) = (Vec3A::ZERO, Vec3A::Y);
+        let (j, pmf) = choose_by_importance(&lights, p, n, 1.0).unwrap();
+        assert_eq!(j, 1);
+        assert!(pmf > 0.0);
+    }
+
     /// Past the weights kept between the passes (more than 16 lights), the choice and its
     /// probability are still those of the cumulative weights, checked against a direct search.
     #[test]
