@@ -36,8 +36,9 @@ pub fn pixel_sample(i: u32, spp: u32, perm_seed: u64, rng: &mut Sampler) -> (f32
 /// "Correlated Multi-Jittered Sampling", 2013), so no table is stored per pixel.
 ///
 /// The loop walks the cycle of `i` under a bijection of `0..=w` until it lands below `n`; for
-/// `i < n` that ends within the cycle, but an `i` in `n..=w` can sit on a cycle that never
-/// enters `0..n`, so such an index is refused.
+/// `i < n` that ends within the cycle, so within `w + 1` steps, but an `i` in `n..=w` can sit on
+/// a cycle that never enters `0..n`, so such an index is refused. The walk is bounded by the
+/// cycle's longest length: a step that is not a bijection fails at once instead of looping.
 fn permute(mut i: u32, n: u32, seed: u64) -> u32 {
     assert!(i < n, "permutation index {i} is out of range 0..{n}");
     let p = seed as u32;
@@ -47,7 +48,7 @@ fn permute(mut i: u32, n: u32, seed: u64) -> u32 {
     w |= w >> 4;
     w |= w >> 8;
     w |= w >> 16;
-    loop {
+    for _ in 0..=w {
         i ^= p;
         i = i.wrapping_mul(0xe170893d);
         i ^= p >> 16;
@@ -67,10 +68,10 @@ fn permute(mut i: u32, n: u32, seed: u64) -> u32 {
         i &= w;
         i ^= i >> 5;
         if i < n {
-            break;
+            return (i + p) % n;
         }
     }
-    (i + p) % n
+    panic!("the permutation of 0..{n} did not return below {n} within {} steps", w as u64 + 1)
 }
 
 #[cfg(test)]
