@@ -399,3 +399,62 @@ fn albedo_table() {
         }
     }
 }
+
+/// A smooth conductor renders its Fresnel term exactly: under a uniform sky `b`, an
+/// orthographic view of a metal plane turned `theta` from the view shows `F(cos(theta)) *
+/// specular_reflectance * b` in every pixel, in Direct, Global and Path under both models
+/// (the reflected ray escapes to the sky), for named metals and for `eta` and `k` given
+/// directly. Tolerance: single-precision rounding (1e-5 relative). `none` is the mirror.
+#[test]
+fn a_conductor_reflects_its_fresnel_term_of_the_sky() {
+    let b = Vec3A::new(0.5, 1.0, 2.0);
+    for (material, eta, k) in [
+        (
+            "material: \"Au\"",
+            conductor::named("Au").unwrap().0,
+            conductor::named("Au").unwrap().1,
+        ),
+        (
+            "material: \"Cr\"",
+            conductor::named("Cr").unwrap().0,
+            conductor::named("Cr").unwrap().1,
+        ),
+        (
+            "eta: (1.5, 0.4, 0.2), k: (3, 2, 1)",
+            Vec3A::new(1.5, 0.4, 0.2),
+            Vec3A::new(3.0, 2.0, 1.0),
+        ),
+        ("", Vec3A::ZERO, Vec3A::ONE),
+    ] {
+        for theta in [0.0f32, 60.0] {
+            let t = theta.to_radians();
+            for (shader, model) in [
+                ("Direct()", "Course"),
+                ("Global(samples: 2, max_depth: 1)", "Course"),
+                ("Path(max_depth: 3)", "Physical"),
+            ] {
+                let text = format!(
+                    "Scene(film: (width: 3, height: 2), model: {model}, shader: {shader},
+                       camera: Orthographic(position: (0, 0, -5), look_at: (0, 0, 0), height: 1),
+                       background: (0.5, 1, 2),
+                       entities: [(shape: InfinitePlane(point: (0, 0, 0), normal: ({}, 0, {})),
+                                   material: Conductor({material}{}specular_reflectance: (1, 0.5, 0.25)))])",
+                    t.sin(),
+                    -t.cos(),
+                    if material.is_empty() { "" } else { ", " }
+                );
+                let s = rtis::scene::load_str(&text, "test.ron", None)
+                    .unwrap_or_else(|e| panic!("{e}"));
+                let r = rtis::render(&rtis::extract(&s), &|| {});
+                let f = |c: usize| fresnel_conductor(t.cos(), eta[c], k[c]);
+                let want = Vec3A::new(f(0), f(1), f(2)) * Vec3A::new(1.0, 0.5, 0.25) * b;
+                for p in &r.image.pixels {
+                    assert!(
+                        (*p - want).abs().max_element() <= 1e-5 * want.max_element(),
+                        "{material} {theta} {shader}: {p} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -288,7 +288,10 @@ fn pass_files_with_empty_or_outlying_ranges_are_refused() {
         let file = d.join(format!("{name}.exr"));
         bad.write(&file).unwrap();
         let e = Pass::read(&file).unwrap_err();
-        assert!(e.contains("not a list of sample ranges within spp"), "{name}: {e}");
+        assert!(
+            e.contains("not a list of sample ranges within spp"),
+            "{name}: {e}"
+        );
     }
     let file = d.join("good.exr");
     good.write(&file).unwrap();

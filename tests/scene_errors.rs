@@ -29,6 +29,22 @@ const CASES: &[(&str, &str)] = &[
         "Scene(entities: [(shape: Sphere(center: (0, inf, 5), radius: 1), material: Mirror())])",
     ),
     ("NaN", "Scene(background: (NaN, 0, 0))"),
+    (
+        "unknown metal",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Conductor(material: \"Gold\"))])",
+    ),
+    (
+        "conductor with a metal and eta",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Conductor(material: \"Au\", eta: (1, 1, 1), k: (2, 2, 2)))])",
+    ),
+    (
+        "conductor with eta alone",
+        "Scene(materials: { \"metal\": Conductor(eta: (1, 1, 1)) }, entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Named(\"metal\"))])",
+    ),
+    (
+        "conductor eta negative",
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Conductor(eta: (-1, 1, 1), k: (1, 1, 1)))])",
+    ),
     // Finite as doubles, beyond what single-precision render data holds.
     (
         "shininess beyond f32",

@@ -167,6 +167,19 @@ mod random_scenes {
                     num(s)
                 )),
             rgb01().prop_map(|c| format!("Mirror(color: {c})")),
+            // Metals at the ends of their ranges: every named one, and eta and k from 0 to
+            // 1000 (eta 0 with k 0 reflects everything at every angle).
+            (
+                prop_oneof![
+                    Just("material: \"Au\"".to_string()),
+                    Just("material: \"Cr\"".to_string()),
+                    Just("material: \"none\"".to_string()),
+                    Just("eta: (0, 0, 0), k: (0, 0, 0)".to_string()),
+                    Just("eta: (1000, 0.001, 1), k: (0, 1000, 1e-3)".to_string()),
+                ],
+                rgb01()
+            )
+                .prop_map(|(m, c)| format!("Conductor({m}, specular_reflectance: {c})")),
             (
                 prop_oneof![Just(0.01), Just(1.0), Just(1.5), Just(2.4), Just(100.0)],
                 rgb01()

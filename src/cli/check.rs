@@ -45,6 +45,12 @@ fn material(m: &Material) -> String {
             num(p.shininess)
         ),
         Material::Mirror(m) => format!("Mirror(color: {})", rgb(m.color)),
+        Material::Conductor(c) => format!(
+            "Conductor(eta: {}, k: {}, specular_reflectance: {})",
+            rgb(c.eta),
+            rgb(c.k),
+            rgb(c.specular_reflectance)
+        ),
         Material::Transmissive(t) => {
             format!("Transmissive(ior: {}, color: {})", num(t.ior), rgb(t.color))
         }

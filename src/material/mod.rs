@@ -27,6 +27,8 @@ pub enum Material {
     Phong(Phong),
     /// Perfect specular reflection, tinted.
     Mirror(Mirror),
+    /// A smooth metal: specular reflection weighted by its Fresnel term.
+    Conductor(conductor::Conductor),
     /// Perfect specular refraction (Snell), tinted; total internal reflection when needed.
     Transmissive(Transmissive),
 }
@@ -40,7 +42,7 @@ impl Material {
     pub fn diffuse_coefficient(&self) -> Option<Vec3A> {
         match self {
             Material::Phong(p) => Some(p.kd),
-            Material::Mirror(_) | Material::Transmissive(_) => None,
+            Material::Mirror(_) | Material::Conductor(_) | Material::Transmissive(_) => None,
         }
     }
 

@@ -51,7 +51,9 @@ pub fn derive(
         && any_mat(|m| matches!(m, Material::Phong(p) if p.kd != Vec3A::ZERO));
     let possible = Effects {
         shadows: shading && (!lights.is_empty() || emission) && !geometry.is_empty() && has_phong,
-        reflection: shading && (any_mat(|m| matches!(m, Material::Mirror(_))) || has_glass),
+        reflection: shading
+            && (any_mat(|m| matches!(m, Material::Mirror(_) | Material::Conductor(_)))
+                || has_glass),
         refraction: shading && has_glass,
         indirect,
         ambient,

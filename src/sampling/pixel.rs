@@ -71,7 +71,10 @@ fn permute(mut i: u32, n: u32, seed: u64) -> u32 {
             return (i + p) % n;
         }
     }
-    panic!("the permutation of 0..{n} did not return below {n} within {} steps", w as u64 + 1)
+    panic!(
+        "the permutation of 0..{n} did not return below {n} within {} steps",
+        w as u64 + 1
+    )
 }
 
 #[cfg(test)]

@@ -6,12 +6,14 @@
 //! type (`to_world`), which `super::load` puts into the world.
 
 use super::values::{
-    Count, Direction, Fov, Ior, NonNegative, Point, Positive, Reflectance, Rgb, Scale, UpTo,
+    Count, Direction, Fov, Ior, IorPart, Metal, NonNegative, Point, Positive, Reflectance, Rgb,
+    Scale, UpTo,
 };
 use crate::camera::{Projection, WorldCamera};
 use crate::effects::Switches;
 use crate::geometry::Transform;
 use crate::light::{Emitter, WorldLight};
+use crate::material::conductor::{Conductor, named};
 use crate::material::{Material, Mirror, Phong, Transmissive};
 use crate::mesh::MeshData;
 use crate::render::{Film, MAX_SIDE, MAX_SPP};
@@ -410,6 +412,24 @@ pub enum MaterialDesc {
         #[serde(default = "unit")]
         color: Reflectance,
     },
+    /// A smooth metal (Mitsuba 3's `conductor`): the mirror reflection weighted by the Fresnel
+    /// term of the complex index `eta + i k` per channel, times `specular_reflectance`. The
+    /// index comes from a named metal (`material`: "Au", "Ag", "Al", "Cu", "Cr", or "none", a
+    /// perfect mirror, the default) or from `eta` and `k` given together.
+    Conductor {
+        /// A metal of Mitsuba's table, instead of `eta` and `k`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        material: Option<Metal>,
+        /// Real part of the index per channel, with `k`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        eta: Option<IorPart>,
+        /// Imaginary part (absorption) per channel, with `eta`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        k: Option<IorPart>,
+        /// Tint, a reflectance in [0, 1] per channel (default white).
+        #[serde(default = "unit")]
+        specular_reflectance: Reflectance,
+    },
     /// A perfect refractor (inside index `ior`, outside air) tinted by `color`.
     Transmissive {
         /// Index of refraction, from 0.01 to 100.
@@ -421,11 +441,36 @@ pub enum MaterialDesc {
 }
 
 impl MaterialDesc {
-    /// The material, or `None` for a `Named` reference (resolved by the loader).
-    pub fn to_world(&self) -> Option<Material> {
+    /// The material, `Ok(None)` for a `Named` reference (resolved by the loader), or why the
+    /// fields do not make one (a conductor given both a named metal and `eta` or `k`, or only
+    /// one of `eta` and `k`).
+    pub fn to_world(&self) -> Result<Option<Material>, String> {
         let rgb = |c: &Reflectance| c.0.as_vec3a();
-        Some(match self {
-            MaterialDesc::Named(_) => return None,
+        Ok(Some(match self {
+            MaterialDesc::Named(_) => return Ok(None),
+            MaterialDesc::Conductor {
+                material,
+                eta,
+                k,
+                specular_reflectance,
+            } => {
+                let (eta, k) = match (material, eta, k) {
+                    (Some(m), None, None) => named(&m.0).ok_or("unknown metal")?,
+                    (None, Some(eta), Some(k)) => (eta.0.as_vec3a(), k.0.as_vec3a()),
+                    (None, None, None) => named("none").ok_or("unknown metal")?,
+                    (Some(_), ..) => {
+                        return Err("a conductor takes a named `material` or `eta` and `k`, \
+                                    not both"
+                            .into());
+                    }
+                    _ => return Err("a conductor's `eta` and `k` go together: give both".into()),
+                };
+                Material::Conductor(Conductor {
+                    eta,
+                    k,
+                    specular_reflectance: rgb(specular_reflectance),
+                })
+            }
             MaterialDesc::Phong { kd, ks, shininess } => Material::Phong(Phong {
                 kd: rgb(kd),
                 ks: rgb(ks),
@@ -436,7 +481,7 @@ impl MaterialDesc {
                 ior: ior.0 as f32,
                 color: rgb(color),
             }),
-        })
+        }))
     }
 }
 
@@ -448,7 +493,7 @@ pub struct TableMaterial(pub Material);
 impl TryFrom<MaterialDesc> for TableMaterial {
     type Error = String;
     fn try_from(m: MaterialDesc) -> Result<Self, String> {
-        match m.to_world() {
+        match m.to_world()? {
             Some(m) => Ok(TableMaterial(m)),
             None => Err(format!(
                 "an entry of `materials` cannot be {m:?}: write the material itself, as \

@@ -382,7 +382,10 @@ impl Resolved {
                     }
                 },
                 Some(m) => {
-                    if let Some(m) = m.to_world() {
+                    if let Some(m) = m
+                        .to_world()
+                        .map_err(|why| src.error(place("material", None), why))?
+                    {
                         b.add(m);
                     }
                 }

@@ -44,6 +44,7 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
             ("Named", "Named(\"red\")"),
             ("Phong", "Phong(kd: (0.8, 0.8, 0.8))"),
             ("Mirror", "Mirror()"),
+            ("Conductor", "Conductor(material: \"Au\")"),
             ("Transmissive", "Transmissive(ior: 1.5)"),
         ],
     ),
@@ -144,7 +145,8 @@ fn field_form(name: &str) -> Option<&'static str> {
         }
         "material" => {
             "`Named(\"name\")` for a material of the table, or one written inline: \
-             `Phong(kd: (0.8, 0.8, 0.8))`, `Mirror()` or `Transmissive(ior: 1.5)`"
+             `Phong(kd: (0.8, 0.8, 0.8))`, `Mirror()`, `Conductor(material: \"Au\")` or \
+             `Transmissive(ior: 1.5)`"
         }
         "shape" => {
             "one of `Sphere(...)`, `InfinitePlane(...)`, `Triangle(...)`, \

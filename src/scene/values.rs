@@ -140,6 +140,57 @@ impl From<Rgb> for [f64; 3] {
     }
 }
 
+/// One part of a conductor's complex index of refraction `eta + i k`, per channel `(r, g, b)`:
+/// each from 0 to 1000 (unitless; measured metals lie below 10).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "[f64; 3]", into = "[f64; 3]")]
+pub struct IorPart(pub DVec3);
+
+impl TryFrom<[f64; 3]> for IorPart {
+    type Error = String;
+    fn try_from(v: [f64; 3]) -> Result<Self, String> {
+        let c = finite3(v)?;
+        if c.min_element() < 0.0 || c.max_element() > 1000.0 {
+            return Err(format!(
+                "{} out of range: a conductor's eta and k must be from 0 to 1000 per channel",
+                show3(v)
+            ));
+        }
+        Ok(IorPart(c))
+    }
+}
+impl From<IorPart> for [f64; 3] {
+    fn from(p: IorPart) -> Self {
+        p.0.to_array()
+    }
+}
+
+/// A metal named as in Mitsuba 3's `material` parameter (`crate::material::conductor::named`).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct Metal(pub String);
+
+impl TryFrom<String> for Metal {
+    type Error = String;
+    fn try_from(v: String) -> Result<Self, String> {
+        match crate::material::conductor::named(&v) {
+            Some(_) => Ok(Metal(v)),
+            None => Err(format!(
+                "unknown metal \"{}\": known metals are {}",
+                v.chars().take(40).collect::<String>(),
+                crate::material::conductor::NAMED
+                    .map(|m| format!("\"{m}\""))
+                    .join(", ")
+            )),
+        }
+    }
+}
+impl From<Metal> for String {
+    fn from(m: Metal) -> Self {
+        m.0
+    }
+}
+
 /// A reflectance `(r, g, b)`: the fraction of light a surface sends on, each channel in [0, 1]
 /// (unitless).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]

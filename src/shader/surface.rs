@@ -310,6 +310,14 @@ pub fn specular_bounce(si: &Interaction, effects: Effects) -> Option<(Ray, Vec3A
             let wr = m.reflect(si.wo, si.n);
             Some((si.spawn(wr), m.color, RayKind::Reflection))
         }
+        // A metal: the mirror direction, weighted by the Fresnel term at its angle.
+        Material::Conductor(c) => {
+            if !effects.reflection {
+                return None;
+            }
+            let (wr, f) = c.reflect(si.wo, si.n);
+            Some((si.spawn(wr), f, RayKind::Reflection))
+        }
         Material::Transmissive(g) => {
             let r = g.refract(si.wo, si.hit.n);
             let (kind, on) = if r.total_internal_reflection {
