@@ -291,7 +291,7 @@ fn record(ray: &Ray, _: rtis::stats::RayKind) {
 }
 
 /// What the walk of `count` of [`rays`] meets (every ray it traces, seen through the tracer's
-/// audit): the kind of material (diffuse or glossy Phong, mirror, glass) and of shape of each
+/// audit): the kind of material (diffuse or glossy Phong, mirror, metal, glass) and of shape of each
 /// hit.
 fn materials_met(rs: &RenderScene, count: usize) -> Vec<(&'static str, ShapeKind)> {
     use rtis::material::Material;
@@ -315,6 +315,7 @@ fn materials_met(rs: &RenderScene, count: usize) -> Vec<(&'static str, ShapeKind
             Material::Phong(p) if p.ks == Vec3A::ZERO => "diffuse",
             Material::Phong(_) => "glossy",
             Material::Mirror(_) => "mirror",
+            Material::Conductor(_) => "metal",
             Material::Transmissive(_) => "glass",
         };
         let key = (what, prim.shape.kind());
@@ -326,7 +327,7 @@ fn materials_met(rs: &RenderScene, count: usize) -> Vec<(&'static str, ShapeKind
 }
 
 /// Each wave kernel against the walk on one scene that holds every material it serves: the
-/// course's diffuse Phong (shaded in lanes), a glossy Phong (the scalar reflectance), a mirror,
+/// course's diffuse Phong (shaded in lanes), a glossy Phong (the scalar reflectance), a mirror, a metal (`Conductor`),
 /// glass, and an emitter that chains see (not sampled: `light_samples` 0), with grey and
 /// coloured point lights, under both models. Packed (the kernel of `waves/lanes.rs`: planes
 /// and spheres) and with a BVH (the kernel of `waves.rs`: the same, with triangles of each
@@ -337,11 +338,13 @@ fn each_wave_kernel_gives_the_walk_on_every_material_it_serves() {
     let packed = "(name: \"lamp\", shape: Sphere(center: (1.5, 1.4, 6.5), radius: 1.4), \
          emitter: Emitter(radiance: (2, 1.5, 1))), \
          (shape: Sphere(center: (-2.2, 2, 7.5), radius: 0.7), material: Phong(kd: (0.2, 0.6, 0.3), ks: (0.5, 0.4, 0.3), shininess: 12)), \
+         (shape: Sphere(center: (2.2, -2.2, 2.5), radius: 0.7), material: Conductor(material: \"Cu\")), \
          (light: Point(position: (1, 2.5, 4), intensity: (9, 3, 0.5)))";
     let meshes = "(shape: TriangleMesh(vertices: [(-1.6, -3, 1), (-0.4, -3, 1), (-1, -3, 2), (-1.6, -1.6, 1), (-0.4, -1.6, 1), (-1, -1.6, 2)], \
          faces: [(0, 1, 2), (3, 5, 4), (0, 3, 4), (0, 4, 1), (1, 4, 5), (1, 5, 2), (2, 5, 3), (2, 3, 0)]), material: Transmissive(ior: 1.3, color: (0.9, 1, 0.95))), \
          (shape: TriangleMesh(vertices: [(0.5, -3, 7.5), (2.8, -3, 6.5), (2.8, 0, 6.5), (0.5, 0, 7.5)], faces: [(0, 1, 2), (0, 2, 3)]), material: Mirror(color: (0.95, 0.95, 0.95))), \
          (shape: Triangle(a: (-2.5, -2.99, 0.5), b: (-1, -2.99, 0), c: (-1.8, -2.99, 1.2)), material: Phong(kd: (0.9, 0.9, 0.2))), \
+         (shape: TriangleMesh(vertices: [(-2.9, -2, 8), (-1, -2, 8.9), (-1, 1, 8.9), (-2.9, 1, 8)], faces: [(0, 1, 2), (0, 2, 3)]), material: Conductor(material: \"Au\")), \
          (shape: Mesh(path: \"assets/blob.obj\"), material: Phong(kd: (0.6, 0.6, 0.3), ks: (0.3, 0.3, 0.3), shininess: 30), transform: (scale: (0.8, 0.8, 0.8), translate: (1.8, -2, 5))), \
          (shape: Rectangle(corner: (-0.5, 2.9, 2.5), u: (1, 0, 0), v: (0, 0, 1)), emitter: Emitter(radiance: (3, 3, 3)))";
     for (kernel, extra) in [
@@ -357,17 +360,18 @@ fn each_wave_kernel_gives_the_walk_on_every_material_it_serves() {
             let rs = rtis::extract(&scene(&text));
             assert_eq!(rs.geometry.bvh.is_empty(), kernel == "lanes", "{kernel}");
             let name = format!("every material, {kernel}, {model}");
-            // The rays of the comparison meet every material: diffuse walls, glossy, mirror and
-            // glass spheres, and with a BVH the same four on triangles.
+            // The rays of the comparison meet every material: diffuse walls, glossy, mirror,
+            // metal and glass spheres, and with a BVH the same five on triangles.
             let met = materials_met(&rs, 1000);
             let mut want = vec![
                 ("diffuse", ShapeKind::Plane),
                 ("glossy", ShapeKind::Sphere),
                 ("mirror", ShapeKind::Sphere),
+                ("metal", ShapeKind::Sphere),
                 ("glass", ShapeKind::Sphere),
             ];
             if kernel == "bvh" {
-                for what in ["diffuse", "glossy", "mirror", "glass"] {
+                for what in ["diffuse", "glossy", "mirror", "metal", "glass"] {
                     want.push((what, ShapeKind::Triangle));
                 }
             }
