@@ -327,8 +327,9 @@ fn materials_met(rs: &RenderScene, count: usize) -> Vec<(&'static str, ShapeKind
 }
 
 /// Each wave kernel against the walk on one scene that holds every material it serves: the
-/// course's diffuse Phong (shaded in lanes), a glossy Phong (the scalar reflectance), a mirror, a metal (`Conductor`),
-/// glass, and an emitter that chains see (not sampled: `light_samples` 0), with grey and
+/// course's diffuse Phong (shaded in lanes), a glossy Phong (the scalar reflectance), a mirror,
+/// a metal (`Conductor`), glass, and an emitter that chains see (not sampled: `light_samples`
+/// 0), with grey and
 /// coloured point lights, under both models. Packed (the kernel of `waves/lanes.rs`: planes
 /// and spheres) and with a BVH (the kernel of `waves.rs`: the same, with triangles of each
 /// material and a smooth mesh).
