@@ -1,4 +1,5 @@
-//! Property tests of the materials: the course reflectance, mirrors and Snell refraction.
+//! Property tests of the materials: the course reflectance, mirrors and Snell refraction, and
+//! the conductors, smooth and rough (Fresnel, furnace, reciprocity, sampling, limits).
 
 use glam::Vec3A;
 use proptest::prelude::*;

@@ -167,8 +167,8 @@ mod random_scenes {
                     num(s)
                 )),
             rgb01().prop_map(|c| format!("Mirror(color: {c})")),
-            // Metals at the ends of their ranges: every named one, and eta and k from 0 to
-            // 1000 (eta 0 with k 0 reflects everything at every angle).
+            // Metals: three named ones (a mirror among them), and eta and k at the ends of
+            // their range, 0 to 1000 (eta 0 with k 0 reflects everything at every angle).
             (
                 prop_oneof![
                     Just("material: \"Au\"".to_string()),

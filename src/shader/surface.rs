@@ -294,8 +294,9 @@ pub fn brdf_pdf(phong: &Phong, wo: Vec3A, n: Vec3A, wi: Vec3A, sampling: Samplin
 /// Shadow rays end at this fraction of the distance to the light.
 pub const SHADOW_END: f32 = 1.0 - 1e-4;
 
-/// The one ray a mirror or glass surface sends on, its tint, and its kind, in the course's
-/// model; `None` for Phong, and for an effect that is off (the surface is then black).
+/// The one ray a mirror, metal (`Conductor`) or glass surface sends on, its tint, and its kind,
+/// in the course's model; `None` for Phong, and for an effect that is off (the surface is then
+/// black).
 ///
 /// Mirrors reflect `wo` about the normal. Glass refracts with Snell's law (`eta = 1 / ior`
 /// entering, `ior` leaving) and reflects under total internal reflection.

@@ -1,5 +1,5 @@
 //! The Beckmann distribution: Gaussian slopes, `D = exp(-e) / (pi ax ay cos^4(theta_m))` with
-//! `e` the roughness-scaled squared slope (Walter et al. 2007, eq. 25).
+//! `e` the roughness-scaled squared slope (Walter et al. 2007, section 5.1).
 
 use glam::Vec3A;
 use std::f64::consts::PI;
@@ -11,9 +11,9 @@ pub(super) fn d(e: f32) -> f32 {
 }
 
 /// Smith's `Lambda` from `t2 = alpha(phi)^2 tan^2(theta)`: with `a = 1 / sqrt(t2)`,
-/// `(erf(a) - 1) / 2 + exp(-a^2) / (2 a sqrt(pi))` (Walter et al. 2007, eq. 27; Heitz 2014,
-/// eq. 80), written with `erfc` and in double precision, where the two terms nearly cancel for
-/// large `a`.
+/// `(erf(a) - 1) / 2 + exp(-a^2) / (2 a sqrt(pi))` (the exact form: Walter et al. 2007,
+/// section 5.1; Heitz 2014, eq. 80), written with `erfc` and in double precision, where the two
+/// terms nearly cancel for large `a`.
 #[inline]
 pub(super) fn lambda(t2: f32) -> f32 {
     if t2 <= 0.0 {
@@ -21,7 +21,7 @@ pub(super) fn lambda(t2: f32) -> f32 {
     }
     let a = 1.0 / (t2 as f64).sqrt();
     if a > 26.0 {
-        // Both terms underflow: no facet is hidden.
+        // Both terms are below 1e-290, far below what an f32 holds: no facet is hidden.
         return 0.0;
     }
     (((-a * a).exp() / (a * PI.sqrt()) - libm::erfc(a)) / 2.0).max(0.0) as f32
@@ -60,6 +60,9 @@ pub(super) fn sample_visible(w: Vec3A, ax: f32, ay: f32, u1: f32, u2: f32) -> Ve
 /// `C(x) = (1 + erf(x) + tan(theta) exp(-x^2) / sqrt(pi)) / (1 + erf(cot) + tan(theta)
 /// exp(-cot^2) / sqrt(pi))`; it is inverted by Newton's method kept inside a bracket.
 pub(super) fn visible_slopes(cos_t: f64, u1: f64, u2: f64) -> (f64, f64) {
+    // The ends of [0, 1) map to infinite slopes (a normal of NaN): keep the numbers 1e-12
+    // inside, which moves a slope past 5 standard deviations by less than rounding.
+    let (u1, u2) = (u1.clamp(1e-12, 1.0 - 1e-12), u2.clamp(1e-12, 1.0 - 1e-12));
     let y = erf_inv(2.0 * u2 - 1.0);
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
     if sin_t < 1e-6 {

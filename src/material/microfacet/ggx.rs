@@ -1,6 +1,6 @@
 //! The GGX (Trowbridge-Reitz) distribution: `D = 1 / (pi ax ay cos^4(theta_m) (1 + e)^2)` with
-//! `e` the roughness-scaled squared slope (Walter et al. 2007, eq. 33; Heitz 2014, eq. 85 for
-//! the anisotropic form).
+//! `e` the roughness-scaled squared slope (Walter et al. 2007, section 5.2; Heitz 2014, eq. 85
+//! for the anisotropic form).
 
 use glam::Vec3A;
 use std::f32::consts::TAU;

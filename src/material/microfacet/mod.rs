@@ -27,8 +27,9 @@ mod ggx;
 
 use glam::Vec3A;
 
-/// The smallest `alpha` a rough material accepts: below it the distribution's peak, `1 / (pi
-/// alpha^2)`, nears the largest `f32`; the smooth materials are the limit.
+/// The smallest `alpha` a rough material accepts: the lobe is then some 1e-4 rad wide, near
+/// what a unit vector in `f32` resolves (about 6e-8 rad per component step, and less as
+/// directions are rounded through the half vector); the smooth materials are the limit.
 pub const MIN_ALPHA: f32 = 1e-4;
 
 /// The shape of the distribution of microfacet normals.
