@@ -106,7 +106,7 @@ fn fresnel_matches_the_angle_form_at_oblique_incidence() {
 
 // Conductors and rough conductors (src/material/conductor.rs, rough_conductor.rs).
 
-use rtis::material::conductor::{self, Conductor, fresnel_conductor};
+use rtis::material::conductor::{Conductor, Metal, fresnel_conductor};
 use rtis::material::microfacet::{Distribution, Microfacet, NormalSampling};
 use rtis::material::rough_conductor::RoughConductor;
 
@@ -141,8 +141,9 @@ fn fresnel_complex(cos: f64, eta: f64, k: f64) -> f64 {
 /// reducing to the dielectric's Fresnel term.
 #[test]
 fn conductor_fresnel_matches_the_complex_amplitudes() {
-    for name in conductor::NAMED {
-        let (eta, k) = conductor::named(name).unwrap();
+    for metal in Metal::ALL {
+        let name = metal.name();
+        let (eta, k) = metal.eta_k();
         for c in 0..3 {
             let (e, kk) = (eta[c], k[c]);
             for i in 0..=100 {
@@ -165,7 +166,12 @@ fn conductor_fresnel_matches_the_complex_amplitudes() {
             );
         }
     }
-    assert!(conductor::named("unobtainium").is_none());
+    assert_eq!(Metal::from_name("unobtainium"), None);
+    assert!(
+        Metal::ALL
+            .iter()
+            .all(|&m| Metal::from_name(m.name()) == Some(m))
+    );
     for cos in [0.05f32, 0.3, 0.7, 1.0] {
         let d = rtis::material::fresnel_dielectric(cos, 1.0 / 1.5);
         assert!(
@@ -177,7 +183,7 @@ fn conductor_fresnel_matches_the_complex_amplitudes() {
 
 /// A rough conductor of the given distribution and roughness, of a named metal.
 fn rough(distribution: Distribution, ax: f32, ay: f32, metal: &str) -> RoughConductor {
-    let (eta, k) = conductor::named(metal).unwrap();
+    let (eta, k) = Metal::from_name(metal).unwrap().eta_k();
     RoughConductor {
         microfacet: Microfacet {
             distribution,
@@ -305,7 +311,7 @@ proptest! {
         beckmann in any::<bool>(), metal in 0usize..6,
     ) {
         let d = if beckmann { Distribution::Beckmann } else { Distribution::Ggx };
-        let b = rough(d, ax, ay, conductor::NAMED[metal]);
+        let b = rough(d, ax, ay, Metal::ALL[metal].name());
         let (a, c) = (b.eval(wo, wi), b.eval(wi, wo));
         prop_assert!(a.is_finite() && a.min_element() >= 0.0, "{a}");
         if wo.z > 1e-3 && wi.z > 1e-3 {
@@ -410,16 +416,8 @@ fn albedo_table() {
 fn a_conductor_reflects_its_fresnel_term_of_the_sky() {
     let b = Vec3A::new(0.5, 1.0, 2.0);
     for (material, eta, k) in [
-        (
-            "material: \"Au\"",
-            conductor::named("Au").unwrap().0,
-            conductor::named("Au").unwrap().1,
-        ),
-        (
-            "material: \"Cr\"",
-            conductor::named("Cr").unwrap().0,
-            conductor::named("Cr").unwrap().1,
-        ),
+        ("material: \"Au\"", Metal::Au.eta_k().0, Metal::Au.eta_k().1),
+        ("material: \"Cr\"", Metal::Cr.eta_k().0, Metal::Cr.eta_k().1),
         (
             "eta: (1.5, 0.4, 0.2), k: (3, 2, 1)",
             Vec3A::new(1.5, 0.4, 0.2),

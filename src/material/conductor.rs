@@ -59,21 +59,63 @@ pub fn fresnel_conductor(cos_i: f32, eta: f32, k: f32) -> f32 {
     }
 }
 
-/// A metal named as in Mitsuba 3's `material` parameter, with the RGB `eta` and `k` that
-/// Mitsuba's RGB variants derive from its measured spectra (read from Mitsuba 3.7's
-/// `scalar_rgb` plugins), or `None` (a perfect mirror).
-pub fn named(name: &str) -> Option<(Vec3A, Vec3A)> {
-    let v = Vec3A::new;
-    Some(match name {
-        "Au" => (v(0.143036, 0.375307, 1.44205), v(3.983, 2.38556, 1.60336)),
-        "Ag" => (v(0.155276, 0.116728, 0.138388), v(4.82835, 3.12222, 2.1469)),
-        "Al" => (v(1.6575, 0.880405, 0.521244), v(9.22381, 6.2695, 4.837)),
-        "Cu" => (v(0.201005, 0.92375, 1.10222), v(3.91326, 2.45305, 2.14209)),
-        "Cr" => (v(4.36967, 2.91651, 1.6549), v(5.20655, 4.23131, 3.7547)),
-        "none" => (Vec3A::ZERO, Vec3A::ONE),
-        _ => return None,
-    })
+/// The metals Mitsuba 3 names in its `material` parameter, with the RGB `eta` and `k` that its
+/// RGB variants derive from its measured spectra (read from Mitsuba 3.7's `scalar_rgb`
+/// plugins).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Metal {
+    /// Gold.
+    Au,
+    /// Silver.
+    Ag,
+    /// Aluminium.
+    Al,
+    /// Copper.
+    Cu,
+    /// Chromium.
+    Cr,
+    /// No metal: `eta = 0, k = 1`, which reflects everything (a perfect mirror).
+    None,
 }
 
-/// The names [`named`] knows, for messages.
-pub const NAMED: [&str; 6] = ["Au", "Ag", "Al", "Cu", "Cr", "none"];
+impl Metal {
+    /// Every metal, in the order the messages list them.
+    pub const ALL: [Metal; 6] = [
+        Metal::Au,
+        Metal::Ag,
+        Metal::Al,
+        Metal::Cu,
+        Metal::Cr,
+        Metal::None,
+    ];
+
+    /// Its name in a scene file (Mitsuba's).
+    pub fn name(self) -> &'static str {
+        match self {
+            Metal::Au => "Au",
+            Metal::Ag => "Ag",
+            Metal::Al => "Al",
+            Metal::Cu => "Cu",
+            Metal::Cr => "Cr",
+            Metal::None => "none",
+        }
+    }
+
+    /// The metal of a name, if it is one of [`Metal::ALL`]'s.
+    pub fn from_name(name: &str) -> Option<Metal> {
+        Metal::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// Its complex index of refraction `(eta, k)` per channel.
+    pub fn eta_k(self) -> (Vec3A, Vec3A) {
+        let v = Vec3A::new;
+        match self {
+            Metal::Au => (v(0.143036, 0.375307, 1.44205), v(3.983, 2.38556, 1.60336)),
+            Metal::Ag => (v(0.155276, 0.116728, 0.138388), v(4.82835, 3.12222, 2.1469)),
+            Metal::Al => (v(1.6575, 0.880405, 0.521244), v(9.22381, 6.2695, 4.837)),
+            Metal::Cu => (v(0.201005, 0.92375, 1.10222), v(3.91326, 2.45305, 2.14209)),
+            Metal::Cr => (v(4.36967, 2.91651, 1.6549), v(5.20655, 4.23131, 3.7547)),
+            Metal::None => (Vec3A::ZERO, Vec3A::ONE),
+        }
+    }
+}

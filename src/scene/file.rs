@@ -6,14 +6,14 @@
 //! type (`to_world`), which `super::load` puts into the world.
 
 use super::values::{
-    Count, Direction, Fov, Ior, IorPart, Metal, NonNegative, Point, Positive, Reflectance, Rgb,
+    Count, Direction, Fov, Ior, IorPart, MetalName, NonNegative, Point, Positive, Reflectance, Rgb,
     Scale, UpTo,
 };
 use crate::camera::{Projection, WorldCamera};
 use crate::effects::Switches;
 use crate::geometry::Transform;
 use crate::light::{Emitter, WorldLight};
-use crate::material::conductor::{Conductor, named};
+use crate::material::conductor::{Conductor, Metal};
 use crate::material::{Material, Mirror, Phong, Transmissive};
 use crate::mesh::MeshData;
 use crate::render::{Film, MAX_SIDE, MAX_SPP};
@@ -419,7 +419,7 @@ pub enum MaterialDesc {
     Conductor {
         /// A metal of Mitsuba's table, instead of `eta` and `k`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        material: Option<Metal>,
+        material: Option<MetalName>,
         /// Real part of the index per channel, with `k`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         eta: Option<IorPart>,
@@ -455,9 +455,9 @@ impl MaterialDesc {
                 specular_reflectance,
             } => {
                 let (eta, k) = match (material, eta, k) {
-                    (Some(m), None, None) => named(&m.0).ok_or("unknown metal")?,
+                    (Some(m), None, None) => m.0.eta_k(),
                     (None, Some(eta), Some(k)) => (eta.0.as_vec3a(), k.0.as_vec3a()),
-                    (None, None, None) => named("none").ok_or("unknown metal")?,
+                    (None, None, None) => Metal::None.eta_k(),
                     (Some(_), ..) => {
                         return Err("a conductor takes a named `material` or `eta` and `k`, \
                                     not both"

@@ -7,6 +7,7 @@
 //! reflectances within [0, 1]. A value that is finite as a double but would overflow a float
 //! is refused here, with its location, rather than turning into NaN pixels later.
 
+use crate::material::conductor::Metal;
 use glam::DVec3;
 use serde::de::{self, Deserializer, Visitor};
 use serde::{Deserialize, Serialize};
@@ -165,29 +166,27 @@ impl From<IorPart> for [f64; 3] {
     }
 }
 
-/// A metal named as in Mitsuba 3's `material` parameter (`crate::material::conductor::named`).
-#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+/// A metal written by its name in Mitsuba 3's `material` parameter (`"Au"`...): one of
+/// [`Metal::ALL`](crate::material::conductor::Metal::ALL).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "String", into = "String")]
-pub struct Metal(pub String);
+pub struct MetalName(pub Metal);
 
-impl TryFrom<String> for Metal {
+impl TryFrom<String> for MetalName {
     type Error = String;
     fn try_from(v: String) -> Result<Self, String> {
-        match crate::material::conductor::named(&v) {
-            Some(_) => Ok(Metal(v)),
-            None => Err(format!(
+        Metal::from_name(&v).map(MetalName).ok_or_else(|| {
+            format!(
                 "unknown metal \"{}\": known metals are {}",
                 v.chars().take(40).collect::<String>(),
-                crate::material::conductor::NAMED
-                    .map(|m| format!("\"{m}\""))
-                    .join(", ")
-            )),
-        }
+                Metal::ALL.map(|m| format!("\"{}\"", m.name())).join(", ")
+            )
+        })
     }
 }
-impl From<Metal> for String {
-    fn from(m: Metal) -> Self {
-        m.0
+impl From<MetalName> for String {
+    fn from(m: MetalName) -> Self {
+        m.0.name().to_string()
     }
 }
 
