@@ -205,29 +205,9 @@ fn at(theta: f32) -> Vec3A {
     Vec3A::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
 }
 
-/// `int g(wm) dwm` over the normals, in slope space stretched by the roughness (as the
-/// microfacet unit tests integrate): `r = tan(pi t / 2)`, 1500 x 256 midpoints.
+/// `int g(wm) dwm` over the normals (`Microfacet::integrate_over_normals`, 1500 x 256 points).
 fn over_normals(m: &Microfacet, g: impl Fn(Vec3A) -> f64) -> f64 {
-    let (nt, np) = (1500, 256);
-    let (ax, ay) = (m.alpha_x as f64, m.alpha_y as f64);
-    let pi = std::f64::consts::PI;
-    let mut acc = 0.0;
-    for i in 0..nt {
-        let t = (i as f64 + 0.5) / nt as f64;
-        let r = (pi * t / 2.0).tan();
-        let dr = pi / 2.0 / (pi * t / 2.0).cos().powi(2) / nt as f64;
-        for j in 0..np {
-            let phi = 2.0 * pi * (j as f64 + 0.5) / np as f64;
-            let wm = Vec3A::new(
-                (-ax * r * phi.cos()) as f32,
-                (-ay * r * phi.sin()) as f32,
-                1.0,
-            )
-            .normalize();
-            acc += g(wm) * (wm.z as f64).powi(3) * ax * ay * r * dr * (2.0 * pi / np as f64);
-        }
-    }
-    acc
+    m.integrate_over_normals(1500, 256, g)
 }
 
 /// The single-scattering albedo of a rough mirror from `wo`, `int D_wo(wm) G1(wi, wm) dwm` with

@@ -205,6 +205,32 @@ impl Microfacet {
     }
 }
 
+impl Microfacet {
+    /// `int f(wm) dwm` over the hemisphere of normals, by the midpoint rule in slope space
+    /// stretched by the roughness: slopes `(ax r cos(phi), ay r sin(phi))` with `r = tan(pi t /
+    /// 2)` for `t` in [0, 1), on `nt x np` points, a normal's solid angle being `cos^3(theta_m)`
+    /// times its slopes' area. Every roughness then spreads over the same grid, so a lobe of
+    /// alpha 1e-3 is resolved as well as one of alpha 1: for tests and tables (the albedo a
+    /// rough surface keeps), not for rendering.
+    pub fn integrate_over_normals(&self, nt: usize, np: usize, f: impl Fn(Vec3A) -> f64) -> f64 {
+        use std::f64::consts::PI;
+        let (ax, ay) = (self.alpha_x as f64, self.alpha_y as f64);
+        let mut acc = 0.0;
+        for i in 0..nt {
+            let t = (i as f64 + 0.5) / nt as f64;
+            let r = (PI * t / 2.0).tan();
+            let dr = PI / 2.0 / (PI * t / 2.0).cos().powi(2) / nt as f64;
+            for j in 0..np {
+                let phi = 2.0 * PI * (j as f64 + 0.5) / np as f64;
+                let (sx, sy) = (ax * r * phi.cos(), ay * r * phi.sin());
+                let wm = from_slopes(sx as f32, sy as f32);
+                acc += f(wm) * (wm.z as f64).powi(3) * ax * ay * r * dr * (2.0 * PI / np as f64);
+            }
+        }
+        acc
+    }
+}
+
 /// The unit normal of the microfacet with slopes `(sx, sy)`: `(-sx, -sy, 1)` normalised.
 #[inline]
 fn from_slopes(sx: f32, sy: f32) -> Vec3A {
@@ -214,29 +240,10 @@ fn from_slopes(sx: f32, sy: f32) -> Vec3A {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
-    /// `int f(wm) dwm` over the hemisphere, in slope space stretched by the roughness: slopes
-    /// `(ax r cos(phi), ay r sin(phi))` with `r = tan(pi t / 2)`, where a normal's solid angle is
-    /// `cos^3(theta_m)` times its slopes' area. Every roughness then spreads over the same grid
-    /// (2000 x 256 midpoints).
+    /// The quadrature of the tests (2000 x 256 points).
     fn over_normals(m: &Microfacet, f: impl Fn(Vec3A) -> f64) -> f64 {
-        let (nt, np) = (2000, 256);
-        let (ax, ay) = (m.alpha_x as f64, m.alpha_y as f64);
-        let mut acc = 0.0;
-        for i in 0..nt {
-            let t = (i as f64 + 0.5) / nt as f64;
-            let r = (PI * t / 2.0).tan();
-            let dr = PI / 2.0 / (PI * t / 2.0).cos().powi(2) / nt as f64;
-            for j in 0..np {
-                let phi = 2.0 * PI * (j as f64 + 0.5) / np as f64;
-                let (sx, sy) = (ax * r * phi.cos(), ay * r * phi.sin());
-                let wm = Vec3A::new(-sx as f32, -sy as f32, 1.0).normalize();
-                let cos3 = (wm.z as f64).powi(3);
-                acc += f(wm) * cos3 * ax * ay * r * dr * (2.0 * PI / np as f64);
-            }
-        }
-        acc
+        m.integrate_over_normals(2000, 256, f)
     }
 
     fn distributions() -> Vec<Microfacet> {
