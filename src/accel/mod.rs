@@ -343,22 +343,6 @@ impl Geometry {
         }
     }
 
-    /// The material index of primitive `index`: [`Geometry::prim`]'s, without rebuilding a
-    /// triangle. (Out of line: inlined into the Global shader's light pass, whose scalar
-    /// reflectance calls it, it measured 5% slower.)
-    #[inline(never)]
-    pub fn material(&self, index: u32) -> u32 {
-        let i = index as usize;
-        if i >= self.attrs.len() {
-            return self.others[i - self.attrs.len()].material;
-        }
-        let (block, lane) = (&self.blocks[i / 4], i % 4);
-        match block.has_triangle(lane) {
-            true => self.attrs[i].material & !SMOOTH,
-            false => self.others[block.other_index(lane as u32)].material,
-        }
-    }
-
     /// Every primitive's index: the occupied block lanes, then the primitives outside the BVH.
     pub fn indices(&self) -> impl Iterator<Item = u32> + '_ {
         let lanes = self

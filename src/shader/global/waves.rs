@@ -18,7 +18,7 @@ mod lanes;
 
 use super::Global;
 use crate::accel::lanes::dot;
-use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
+use crate::accel::{Floats, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
 use crate::light::Light;
 use crate::material::{Material, Model, Phong, reflect};
@@ -141,8 +141,8 @@ struct End {
     o_err: f32,
     /// Index of its [`Lit`] in the wave.
     lit: u32,
-    /// The primitive hit, whose material the scalar reflectance reads.
-    prim: u32,
+    /// Index of its Phong material in the wave's `phongs`, which the scalar reflectance reads.
+    phong: u32,
     /// True under the Course model for a material without a specular lobe (`ks` zero): the
     /// light pass computes its reflectance `kd max(wi.n, 0)` in lanes.
     lambert: bool,
@@ -152,9 +152,10 @@ struct End {
 const _: () = assert!(std::mem::size_of::<End>() == 128);
 
 impl End {
-    /// The light pass's part of `si`, a hit on the Phong material `phong` under `model`.
+    /// The light pass's part of `si`, a hit on the Phong material `phong` under `model`, whose
+    /// parameters are at `index` in the wave's `phongs`.
     #[inline(always)]
-    fn new(si: &Interaction, phong: &Phong, model: Model, lit: u32) -> Self {
+    fn new(si: &Interaction, phong: &Phong, index: u32, model: Model, lit: u32) -> Self {
         End {
             p: si.hit.p,
             n: si.n,
@@ -165,16 +166,8 @@ impl End {
             wo: si.wo,
             o_err: si.origins.o_err,
             lit,
-            prim: si.hit.prim,
+            phong: index,
             lambert: model == Model::Course && phong.ks == Vec3A::ZERO,
-        }
-    }
-
-    /// Its Phong material, for the scalar reflectance.
-    fn phong(&self, geometry: &Geometry, materials: &[Material]) -> Phong {
-        match materials[geometry.material(self.prim) as usize] {
-            Material::Phong(phong) => phong,
-            _ => unreachable!("an End is a Phong hit"),
         }
     }
 }
@@ -225,6 +218,9 @@ struct Scratch {
     hits: Vec<Option<Hit>>,
     lit: Vec<Lit>,
     ends: Vec<End>,
+    /// The Phong parameters of the ends, in their order (kept apart from the 128 bytes the
+    /// light pass reads of each; only the scalar reflectance reads them).
+    phongs: Vec<Phong>,
     /// The lanes kernel's queues: the wave traced now (and its bounces), the next depth.
     queue: lanes::Columns,
     next: lanes::Columns,
@@ -303,6 +299,7 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         s.children.clear();
         s.lit.clear();
         s.ends.clear();
+        s.phongs.clear();
         // Each bounce of the mirror and glass chains in one batch, until every chain ends.
         while !s.now.rays.is_empty() {
             tr.geometry.intersect_batch(&s.now.rays, &mut s.hits);
@@ -348,8 +345,10 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
     // Eq. 3 waits for the wave's light pass ([`light_sums`]). A surface that reflects nothing
     // has no light terms (`point_lights`).
     if !phong.is_black() {
+        let index = s.phongs.len() as u32;
         s.ends
-            .push(End::new(&si, &phong, tr.model, s.lit.len() as u32));
+            .push(End::new(&si, &phong, index, tr.model, s.lit.len() as u32));
+        s.phongs.push(phong);
     }
     // Eq. 2 at depth D ends the path; above it, task 2: Eq. 4 with the directions fixed to
     // the normal w_n and the reflection w_r, weighted by 1 / (4 pi).
@@ -466,13 +465,12 @@ unsafe fn light_sums_in<L: Floats>(tr: &mut Tracer, s: &mut Scratch) {
             }
         };
         let model = tr.model;
-        let (geometry, materials) = (tr.geometry, tr.materials);
+        let phongs = &s.phongs;
         // SAFETY: the caller vouches for the instruction set.
         let out = unsafe {
             point_sums(tr, &h, |i, w, l| {
                 let end = e[i];
-                let phong = end.phong(geometry, materials);
-                l * reflectance(model, &phong, w, end.wo, end.n)
+                l * reflectance(model, &phongs[end.phong as usize], w, end.wo, end.n)
             })
         };
         for (i, end) in e.iter().enumerate().take(count) {

@@ -23,7 +23,7 @@ use crate::accel::lanes::{RayLanes, abs_max, dot};
 use crate::accel::{Floats, Isa, MAX_LANES};
 use crate::geometry::{Hit, Origins, Ray, UNIT_ROUNDOFF};
 use crate::light::NO_LIGHT;
-use crate::material::{Material, Model};
+use crate::material::{Material, Model, Phong};
 use crate::shader::Tracer;
 use crate::shader::global::Global;
 use crate::shader::surface::{Interaction, emitted, reflectance};
@@ -130,10 +130,11 @@ pub(super) struct Slot {
     material: Material,
     /// Its area light, or [`NO_LIGHT`].
     light: u32,
-    /// A Phong material's `kd` (zero for mirror and glass).
-    kd: Vec3A,
+    /// A Phong material's parameters (black for the others, whose lanes never read them: the
+    /// Phong, lit and parent lanes are chosen by `is_phong` and `lit`).
+    phong: Phong,
     /// A Phong material.
-    phong: bool,
+    is_phong: bool,
     /// A Phong material that reflects light (`point_lights` has terms for it).
     lit: bool,
     /// A Phong material whose reflectance is the course's diffuse `kd max(w.n, 0)` (the Course
@@ -156,8 +157,12 @@ fn slot_table(tr: &Tracer, slots: &mut Vec<Slot>) {
             prim,
             material,
             light: p.light,
-            kd: phong.map_or(Vec3A::ZERO, |p| p.kd),
-            phong: phong.is_some(),
+            phong: phong.unwrap_or(Phong {
+                kd: Vec3A::ZERO,
+                ks: Vec3A::ZERO,
+                shininess: 1.0,
+            }),
+            is_phong: phong.is_some(),
             lit: phong.is_some_and(|p| !p.is_black()),
             lambert: phong.is_some_and(|p| tr.model == Model::Course && p.ks == Vec3A::ZERO),
         });
@@ -333,12 +338,12 @@ unsafe fn chunk<L: Floats>(
                 node.le += node.tint * Vec3A::ZERO;
             }
         }
-        if !e.phong {
+        if !e.is_phong {
             whole |= 1 << i;
             continue;
         }
         beta[i] = node.beta * node.tint;
-        kd[i] = e.kd;
+        kd[i] = e.phong.kd;
         phong_lanes |= 1 << i;
         lit_lanes |= u32::from(e.lit) << i;
         lambert |= u32::from(e.lambert) << i;
@@ -412,7 +417,7 @@ unsafe fn chunk<L: Floats>(
             if emitting & (1 << i) != 0 {
                 node.le += node.tint * emitted(tr, &si);
             }
-            if !e.phong
+            if !e.is_phong
                 && node.bounces < g.max_specular
                 && let Some(next) = node.bounce(&si, tr)
             {
@@ -466,11 +471,9 @@ unsafe fn chunk<L: Floats>(
         let (model, slots) = (tr.model, &s.slots);
         point = unsafe {
             point_sums(tr, &h, |i, w, l| {
-                let Material::Phong(phong) = slots[slot[i].to_bits() as usize].material else {
-                    unreachable!("a lit lane is a Phong hit")
-                };
+                let phong = &slots[slot[i].to_bits() as usize].phong;
                 let (wo, n) = wo_n(i);
-                l * reflectance(model, &phong, w, wo, n)
+                l * reflectance(model, phong, w, wo, n)
             })
         };
     }
@@ -542,12 +545,10 @@ unsafe fn chunk<L: Floats>(
             let b = if lambert & (1 << i) != 0 {
                 Vec3A::new(weights[c][0][i], weights[c][1][i], weights[c][2][i])
             } else {
-                let Material::Phong(phong) = s.slots[slot[i].to_bits() as usize].material else {
-                    unreachable!("a parent is a Phong hit")
-                };
+                let phong = &s.slots[slot[i].to_bits() as usize].phong;
                 let (wo, n) = wo_n(i);
                 let w = Vec3A::new(dirs[c][0][i], dirs[c][1][i], dirs[c][2][i]);
-                beta[i] * reflectance(tr.model, &phong, w, wo, n) / (4.0 * PI)
+                beta[i] * reflectance(tr.model, phong, w, wo, n) / (4.0 * PI)
             };
             s.add_node(b);
             s.next.nodes[at + c * n_parents + r] = child + c as u32;
