@@ -285,35 +285,26 @@ fn waves_stand_aside_where_they_would_not_give_the_same_bits_or_fit() {
     assert!(!applies(&rs, &global(&rs)));
 }
 
-thread_local! {
-    /// The rays the audit saw on this thread.
-    static SEEN: std::cell::RefCell<Vec<Ray>> = const { std::cell::RefCell::new(Vec::new()) };
-}
-
-/// The audit of [`materials_met`]: keep every ray but shadow rays (whose hits are not shaded).
-fn record(ray: &Ray, kind: rtis::stats::RayKind) {
-    if kind != rtis::stats::RayKind::Shadow {
-        SEEN.with_borrow_mut(|v| v.push(*ray));
-    }
-}
-
 /// What the walk meets of the rays the comparison of [`unsampled_emitter_seen_by`] traces
 /// (`count` of [`rays`], with `light_samples` 0; every ray but the shadow rays, seen through
 /// the tracer's audit): the kind of material (diffuse or glossy Phong, mirror, metal, glass)
 /// and of shape of each hit.
 fn materials_met(rs: &RenderScene, count: usize) -> Vec<(&'static str, ShapeKind)> {
     use rtis::material::Material;
-    let mut audited = rs.clone();
-    audited.audit = Some(record);
-    SEEN.with_borrow_mut(Vec::clear);
     let g = Global {
         light_samples: 0,
         ..global(rs)
     };
-    trace(&audited, &g, &rays(rs, count, 11), Order::DepthFirst);
+    let traced = common::rays_traced(rs, |audited| {
+        trace(audited, &g, &rays(rs, count, 11), Order::DepthFirst);
+    });
     let mut met = Vec::new();
-    for ray in SEEN.with_borrow_mut(std::mem::take) {
-        let Some(hit) = rs.geometry.intersect(&ray) else {
+    // Shadow rays are left out: their hits are not shaded.
+    for (ray, _) in traced
+        .iter()
+        .filter(|(_, k)| *k != rtis::stats::RayKind::Shadow)
+    {
+        let Some(hit) = rs.geometry.intersect(ray) else {
             continue;
         };
         let prim = rs.geometry.prim(hit.prim);

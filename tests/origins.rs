@@ -18,24 +18,12 @@ mod common;
 use glam::{DVec3, Vec3A};
 use rtis::RenderScene;
 use rtis::accel::Prim;
-use rtis::geometry::Ray;
 use rtis::render::render_sample;
 use rtis::shader::Shader;
 use rtis::shader::global::Order;
 use rtis::shape::{Shape, ShapeKind};
 use rtis::stats::{RayKind, RayStats};
-use std::cell::RefCell;
 use std::collections::BTreeMap;
-
-thread_local! {
-    /// The rays the audit saw on this thread (the renders here run on the test's thread).
-    static SEEN: RefCell<Vec<(Ray, RayKind)>> = const { RefCell::new(Vec::new()) };
-}
-
-/// The audit: keep every ray.
-fn record(ray: &Ray, kind: RayKind) {
-    SEEN.with_borrow_mut(|v| v.push((*ray, kind)));
-}
 
 /// A room of planes at scale `s` and offset `o` (every point `p` placed at `s p + o`): a mirror
 /// wall, a glossy back wall, a mirror ball, a glass ball and a Phong ball, two point lights;
@@ -263,18 +251,17 @@ impl Tally {
 
 /// Render `rs` on this thread with the audit on, and check every ray that leaves a surface.
 /// `order` names the code that traces it.
-fn check(rs: &mut RenderScene, tally: &mut Tally, order: &'static str, what: &str) {
-    rs.audit = Some(record);
-    SEEN.with_borrow_mut(Vec::clear);
+fn check(rs: &RenderScene, tally: &mut Tally, order: &'static str, what: &str) {
     let mut stats = RayStats::default();
-    for row in 0..rs.film.height {
-        for col in 0..rs.film.width {
-            for s in 0..rs.film.spp {
-                render_sample(rs, col, row, s, &mut stats);
+    let seen = common::rays_traced(rs, |rs| {
+        for row in 0..rs.film.height {
+            for col in 0..rs.film.width {
+                for s in 0..rs.film.spp {
+                    render_sample(rs, col, row, s, &mut stats);
+                }
             }
         }
-    }
-    let seen = SEEN.with_borrow_mut(std::mem::take);
+    });
     // The audit saw every ray counted, kind by kind.
     let mut audited = RayStats::default();
     for (_, kind) in &seen {
@@ -435,7 +422,7 @@ fn spawned_rays_start_on_the_side_they_leave_towards() {
                     "Physical"
                 };
                 let text = room(scale, offset, model, shader, bvh, area);
-                let mut rs = rtis::extract(&common::scene(&text));
+                let rs = rtis::extract(&common::scene(&text));
                 // The order this render takes.
                 let order = match rs.shader {
                     Shader::Global(g) => {
@@ -453,7 +440,7 @@ fn spawned_rays_start_on_the_side_they_leave_towards() {
                 let what = format!(
                     "{name} ({order}), scale {scale}, offset {offset}, bvh {bvh}, area {area}"
                 );
-                check(&mut rs, &mut tally, order, &what);
+                check(&rs, &mut tally, order, &what);
             }
         }
     }

@@ -264,3 +264,27 @@ fn children() -> &'static std::sync::Mutex<Vec<u32>> {
     static LIVE: std::sync::OnceLock<std::sync::Mutex<Vec<u32>>> = std::sync::OnceLock::new();
     LIVE.get_or_init(Default::default)
 }
+
+thread_local! {
+    /// The rays the audit saw on this thread ([`rays_traced`]).
+    static SEEN: std::cell::RefCell<Vec<(rtis::geometry::Ray, rtis::stats::RayKind)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// The audit of [`rays_traced`]: keep every ray.
+fn record(ray: &rtis::geometry::Ray, kind: rtis::stats::RayKind) {
+    SEEN.with_borrow_mut(|v| v.push((*ray, kind)));
+}
+
+/// Every ray `run` traces through a copy of `rs` with the tracer's audit on
+/// (`rtis::shader::RayAudit`), with its kind, in order. `run` must trace on this thread.
+pub fn rays_traced(
+    rs: &rtis::RenderScene,
+    run: impl FnOnce(&rtis::RenderScene),
+) -> Vec<(rtis::geometry::Ray, rtis::stats::RayKind)> {
+    let mut audited = rs.clone();
+    audited.audit = Some(record);
+    SEEN.with_borrow_mut(Vec::clear);
+    run(&audited);
+    SEEN.with_borrow_mut(std::mem::take)
+}
