@@ -315,6 +315,7 @@ fn materials_met(rs: &RenderScene, count: usize) -> Vec<(&'static str, ShapeKind
             Material::Mirror(_) => "mirror",
             Material::Conductor(_) => "metal",
             Material::Transmissive(_) => "glass",
+            Material::Bsdf(b) => b.name(),
         };
         let key = (what, prim.shape.kind());
         if !met.contains(&key) {

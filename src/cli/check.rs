@@ -7,6 +7,8 @@
 
 use super::CliError;
 use glam::{DVec3, Vec3A};
+use rtis::material::microfacet::Microfacet;
+use rtis::material::{Bsdf, Coating};
 use rtis::render::estimate::{self, human_seconds};
 use rtis::scene::{self, Scene};
 use rtis::shader::Shader;
@@ -54,7 +56,56 @@ fn material(m: &Material) -> String {
         Material::Transmissive(t) => {
             format!("Transmissive(ior: {}, color: {})", num(t.ior), rgb(t.color))
         }
+        Material::Bsdf(b) => bsdf(b),
     }
+}
+
+fn bsdf(b: &Bsdf) -> String {
+    let coating = |c: &Coating| {
+        format!(
+            "int_ior: {}, ext_ior: 1, diffuse_reflectance: {}, specular_reflectance: {}, \
+             nonlinear: {}",
+            num(c.eta),
+            rgb(c.diffuse_reflectance),
+            rgb(c.specular_reflectance),
+            c.nonlinear
+        )
+    };
+    match b {
+        Bsdf::RoughConductor(r) => format!(
+            "RoughConductor({}, eta: {}, k: {}, specular_reflectance: {})",
+            microfacet(&r.microfacet),
+            rgb(r.metal.eta),
+            rgb(r.metal.k),
+            rgb(r.metal.specular_reflectance)
+        ),
+        Bsdf::RoughDielectric(r) => format!(
+            "RoughDielectric({}, int_ior: {}, ext_ior: 1, specular_reflectance: {}, \
+             specular_transmittance: {})",
+            microfacet(&r.microfacet),
+            num(r.eta),
+            rgb(r.specular_reflectance),
+            rgb(r.specular_transmittance)
+        ),
+        Bsdf::RoughPlastic(r) => format!(
+            "RoughPlastic(distribution: {:?}, alpha: {}, sampling: {:?}, {})",
+            r.microfacet.distribution,
+            num(r.microfacet.alpha_x),
+            r.microfacet.sampling,
+            coating(&r.coating)
+        ),
+        Bsdf::Plastic(p) => format!("Plastic({})", coating(&p.coating)),
+    }
+}
+
+fn microfacet(m: &Microfacet) -> String {
+    format!(
+        "distribution: {:?}, alpha_u: {}, alpha_v: {}, sampling: {:?}",
+        m.distribution,
+        num(m.alpha_x),
+        num(m.alpha_y),
+        m.sampling
+    )
 }
 
 fn shape(s: &WorldShape) -> String {

@@ -10,12 +10,18 @@
 //! same way over its two outcomes. Area-light sampling (choose a light by power, then a
 //! direction towards it) is tested against `Emitters::pdf_direction` from a point. The
 //! microfacet samplers (GGX and Beckmann, visible and full) are tested through the directions
-//! they reflect, against `Microfacet::pdf_reflection`.
+//! they reflect, against `Microfacet::pdf_reflection`; every BSDF through `Bsdf::sample`
+//! against `Bsdf::pdf`, over the whole sphere.
 
 use crate::geometry::Frame;
 use crate::light::{AreaLight, Emitter, Emitters, Emitting};
+use crate::material::conductor::Conductor;
 use crate::material::microfacet::{Distribution, Microfacet, NormalSampling};
-use crate::material::{Phong, fresnel_dielectric, reflect};
+use crate::material::plastic::Plastic;
+use crate::material::rough_conductor::RoughConductor;
+use crate::material::rough_dielectric::RoughDielectric;
+use crate::material::rough_plastic::RoughPlastic;
+use crate::material::{Bsdf, Coating, Phong, fresnel_dielectric, reflect};
 use crate::sampling::{Sampler, Sampling, hemisphere};
 use crate::shader::path;
 use crate::shape::{Sphere, Triangle};
@@ -216,6 +222,120 @@ pub fn microfacet_cases() -> Vec<Case> {
     cases
 }
 
+/// The sampler of a BSDF ([`Bsdf::sample`]) for the viewer `wo` (local frame), against
+/// [`Bsdf::pdf`], over the whole sphere (a dielectric transmits). A delta lobe (a smooth
+/// coating's mirror) is expected in its bin with the probability of choosing it.
+pub fn bsdf_case(name: &str, bsdf: Bsdf, wo: Vec3A) -> Case {
+    let mut expected = integrate_pdf_peaked(|wi| bsdf.pdf(wo, wi) as f64);
+    // The delta lobe's share: the chance of choosing it (the only sample with `uc` below it).
+    if let Some(s) = bsdf.sample(wo, 0.0, 0.5, 0.5).filter(|s| s.delta) {
+        expected[direction_bin(s.wi)] += s.pdf as f64;
+    }
+    Case {
+        name: name.to_string(),
+        draw: Box::new(move |s: &mut Sampler| {
+            let uc = s.next_f32();
+            let (u1, u2) = s.next_2d();
+            let b = bsdf.sample(wo, uc, u1, u2)?;
+            Some(direction_bin(b.wi))
+        }),
+        expected,
+        columns: BINS_PHI,
+    }
+}
+
+/// The BSDF samplers: rough dielectrics from outside and inside, at roughness 0.01 to 1 and
+/// one anisotropic pair, from normal incidence to 85 degrees (past the critical angle inside);
+/// rough plastics; a smooth plastic, its mirror included; a rough conductor seen from below.
+pub fn bsdf_cases() -> Vec<Case> {
+    let dir = |theta: f32, side: f32| {
+        let (t, p) = (theta.to_radians(), 30f32.to_radians());
+        Vec3A::new(t.sin() * p.cos(), t.sin() * p.sin(), side * t.cos())
+    };
+    let mut cases = Vec::new();
+    for distribution in [Distribution::Ggx, Distribution::Beckmann] {
+        for (ax, ay) in [(0.01, 0.01), (0.2, 0.2), (1.0, 1.0), (0.1, 0.5)] {
+            let microfacet = Microfacet {
+                distribution,
+                alpha_x: ax,
+                alpha_y: ay,
+                sampling: NormalSampling::Visible,
+            };
+            let b = Bsdf::RoughDielectric(RoughDielectric {
+                microfacet,
+                eta: 1.5,
+                specular_reflectance: Vec3A::ONE,
+                specular_transmittance: Vec3A::ONE,
+            });
+            for (theta, side) in [
+                (0.0, 1.0),
+                (45.0, 1.0),
+                (85.0, 1.0),
+                (30.0, -1.0),
+                (60.0, -1.0),
+            ] {
+                let name = format!(
+                    "RoughDielectric {distribution:?}, alpha {ax} x {ay}, eta 1.5, theta_o {} {theta}",
+                    if side > 0.0 { "outside" } else { "inside" }
+                );
+                cases.push(bsdf_case(&name, b, dir(theta, side)));
+            }
+        }
+        let full = Microfacet {
+            sampling: NormalSampling::Full,
+            ..Microfacet::isotropic(distribution, 0.3)
+        };
+        let b = Bsdf::RoughDielectric(RoughDielectric {
+            microfacet: full,
+            eta: 1.33,
+            specular_reflectance: Vec3A::ONE,
+            specular_transmittance: Vec3A::ONE,
+        });
+        cases.push(bsdf_case(
+            &format!("RoughDielectric {distribution:?} Full, alpha 0.3, eta 1.33, theta_o 50"),
+            b,
+            dir(50.0, 1.0),
+        ));
+        for alpha in [0.05, 0.5] {
+            let b = Bsdf::RoughPlastic(RoughPlastic::new(
+                Microfacet::isotropic(distribution, alpha),
+                1.49,
+                Vec3A::new(0.2, 0.5, 0.8),
+                Vec3A::ONE,
+                false,
+            ));
+            for theta in [20.0, 80.0] {
+                let name = format!("RoughPlastic {distribution:?}, alpha {alpha}, theta_o {theta}");
+                cases.push(bsdf_case(&name, b, dir(theta, 1.0)));
+            }
+        }
+    }
+    let plastic = Bsdf::Plastic(Plastic {
+        coating: Coating::smooth(1.49, Vec3A::splat(0.3), Vec3A::ONE, false),
+    });
+    for theta in [10.0, 75.0] {
+        cases.push(bsdf_case(
+            &format!("Plastic, theta_o {theta}"),
+            plastic,
+            dir(theta, 1.0),
+        ));
+    }
+    let metal = Bsdf::RoughConductor(RoughConductor {
+        microfacet: Microfacet::isotropic(Distribution::Ggx, 0.3),
+        metal: Conductor {
+            eta: Vec3A::splat(0.2),
+            k: Vec3A::splat(3.0),
+            specular_reflectance: Vec3A::ONE,
+        },
+    });
+    cases.push(bsdf_case(
+        "RoughConductor GGX, alpha 0.3, from below",
+        metal,
+        dir(40.0, -1.0),
+    ));
+    cases
+}
+
 /// The midpoint rule over one bin on `sub_z x sub_phi` points.
 fn integrate_bin(pdf: &impl Fn(Vec3A) -> f64, bin: usize, sub_z: usize, sub_phi: usize) -> f64 {
     let (t, p) = (bin / BINS_PHI, bin % BINS_PHI);
@@ -379,7 +499,8 @@ fn light_cases() -> Vec<Case> {
 
 /// Every sampler rtis uses: uniform and cosine hemisphere, the Phong lobe at three exponents,
 /// the BRDF mixture of Path at two materials and views, the Fresnel choice of glass, the
-/// area-light samplers, and the microfacet reflection samplers ([`microfacet_cases`]).
+/// area-light samplers, the microfacet reflection samplers ([`microfacet_cases`]) and the
+/// BSDFs' ([`bsdf_cases`]).
 pub fn cases() -> Vec<Case> {
     let white = Phong {
         kd: Vec3A::ONE,
@@ -419,6 +540,7 @@ pub fn cases() -> Vec<Case> {
     .into_iter()
     .chain(light_cases())
     .chain(microfacet_cases())
+    .chain(bsdf_cases())
     .collect()
 }
 

@@ -5,14 +5,22 @@
 //! from the surface towards the light; both are unit vectors; `n` is the unit normal on the
 //! side of `wo`.
 
+pub mod bsdf;
+mod bsdf_sample;
+mod coating;
 pub mod conductor;
 pub mod microfacet;
 mod mirror;
 mod model;
 pub mod phong;
+pub mod plastic;
 pub mod rough_conductor;
+pub mod rough_dielectric;
+pub mod rough_plastic;
 mod transmissive;
 
+pub use bsdf::{Bsdf, BsdfSample};
+pub use coating::{Coating, diffuse_fresnel_reflectance};
 pub use mirror::Mirror;
 pub use model::Model;
 pub use phong::{Phong, reflect};
@@ -31,6 +39,8 @@ pub enum Material {
     Conductor(conductor::Conductor),
     /// Perfect specular refraction (Snell), tinted; total internal reflection when needed.
     Transmissive(Transmissive),
+    /// A material given by its BSDF: rough metals and dielectrics, and plastics.
+    Bsdf(Bsdf),
 }
 
 impl Material {
@@ -42,14 +52,20 @@ impl Material {
     pub fn diffuse_coefficient(&self) -> Option<Vec3A> {
         match self {
             Material::Phong(p) => Some(p.kd),
-            Material::Mirror(_) | Material::Conductor(_) | Material::Transmissive(_) => None,
+            Material::Mirror(_)
+            | Material::Conductor(_)
+            | Material::Transmissive(_)
+            | Material::Bsdf(_) => None,
         }
     }
 
-    /// True for materials that only scatter into one direction (mirror, glass).
+    /// True for materials that only scatter into one direction (mirror, metal, glass).
     #[inline]
     pub fn is_specular(&self) -> bool {
-        !matches!(self, Material::Phong(_))
+        matches!(
+            self,
+            Material::Mirror(_) | Material::Conductor(_) | Material::Transmissive(_)
+        )
     }
 }
 

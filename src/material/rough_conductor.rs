@@ -9,6 +9,7 @@
 //! normal, 88% at alpha 0.3 and 31% at alpha 1 (57% at 85 degrees); `tests/materials.rs`
 //! integrates these (`albedo_table`) and checks the sampler against them.
 
+use super::bsdf_sample::BsdfSample;
 use super::conductor::Conductor;
 use super::microfacet::Microfacet;
 use glam::Vec3A;
@@ -20,17 +21,6 @@ pub struct RoughConductor {
     pub microfacet: Microfacet,
     /// The metal each microfacet is made of.
     pub metal: Conductor,
-}
-
-/// A direction sampled from a material, in the local frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BsdfSample {
-    /// The sampled direction `wi`.
-    pub wi: Vec3A,
-    /// `f(wo, wi) cos(theta_i) / pdf`: what the sample multiplies the throughput by.
-    pub weight: Vec3A,
-    /// The density of `wi` per solid angle.
-    pub pdf: f32,
 }
 
 impl RoughConductor {
@@ -69,12 +59,7 @@ impl RoughConductor {
             return None;
         }
         let (wi, pdf) = self.microfacet.sample_reflection(wo, u1, u2)?;
-        let f = self.eval(wo, wi);
-        if f == Vec3A::ZERO {
-            return None;
-        }
-        let weight = f / pdf;
-        weight.is_finite().then_some(BsdfSample { wi, weight, pdf })
+        BsdfSample::glossy(wi, self.eval(wo, wi), pdf)
     }
 }
 

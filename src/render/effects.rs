@@ -38,7 +38,9 @@ pub fn derive(
         Shader::Direct { .. } | Shader::Global(_) | Shader::Path(_)
     );
     let has_glass = any_mat(|m| matches!(m, Material::Transmissive(_)));
-    let has_phong = any_mat(|m| matches!(m, Material::Phong(_)));
+    // Surfaces that reflect light from every direction: Phong, and the BSDFs (whose sampled
+    // rays are indirect rays).
+    let has_phong = any_mat(|m| matches!(m, Material::Phong(_) | Material::Bsdf(_)));
     let indirect = has_phong
         && match shader {
             Shader::Global(g) => g.max_depth >= 1,

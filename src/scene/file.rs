@@ -2,19 +2,24 @@
 //! every optional field documents its default. `docs/scene-format.md` is the user's guide.
 //!
 //! The format knows no runtime types: it names only leaf enums (the model, the sampling
-//! strategy, the PNG transfer) and converts each description into the world's own component
+//! strategy, the microfacet distribution and its sampling, the PNG transfer) and converts each description into the world's own component
 //! type (`to_world`), which `super::load` puts into the world.
 
 use super::values::{
     Count, Direction, Fov, Ior, IorPart, MetalName, NonNegative, Point, Positive, Reflectance, Rgb,
-    Scale, UpTo,
+    Roughness, Scale, UpTo,
 };
 use crate::camera::{Projection, WorldCamera};
 use crate::effects::Switches;
 use crate::geometry::Transform;
 use crate::light::{Emitter, WorldLight};
 use crate::material::conductor::{Conductor, Metal};
-use crate::material::{Material, Mirror, Phong, Transmissive};
+use crate::material::microfacet::Microfacet;
+use crate::material::plastic::Plastic;
+use crate::material::rough_conductor::RoughConductor;
+use crate::material::rough_dielectric::RoughDielectric;
+use crate::material::rough_plastic::RoughPlastic;
+use crate::material::{Bsdf, Coating, Material, Mirror, Phong, Transmissive};
 use crate::mesh::MeshData;
 use crate::render::{Film, MAX_SIDE, MAX_SPP};
 use crate::shader::{Global, Path, Shader};
@@ -24,6 +29,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 pub use crate::material::Model;
+pub use crate::material::microfacet::{Distribution, NormalSampling};
 pub use crate::render::output::Transfer;
 pub use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
 
@@ -430,6 +436,116 @@ pub enum MaterialDesc {
         #[serde(default = "unit")]
         specular_reflectance: Reflectance,
     },
+    /// A rough metal (Mitsuba 3's `roughconductor`): microfacets, each a [`Conductor`](
+    /// MaterialDesc::Conductor)'s mirror, distributed by `distribution` with roughness `alpha`,
+    /// or `alpha_u` along the surface's tangent and `alpha_v` across it.
+    RoughConductor {
+        /// `Ggx` (default) or `Beckmann`.
+        #[serde(default)]
+        distribution: Distribution,
+        /// Isotropic roughness, from 1e-4 to 1 (default 0.1 unless `alpha_u` and `alpha_v`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha: Option<Roughness>,
+        /// Roughness along the tangent, with `alpha_v`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_u: Option<Roughness>,
+        /// Roughness across the tangent, with `alpha_u`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_v: Option<Roughness>,
+        /// A metal of Mitsuba's table, instead of `eta` and `k` (default "none": Fresnel 1).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        material: Option<MetalName>,
+        /// Real part of the index per channel, with `k`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        eta: Option<IorPart>,
+        /// Imaginary part (absorption) per channel, with `eta`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        k: Option<IorPart>,
+        /// Tint, a reflectance in [0, 1] per channel (default white).
+        #[serde(default = "unit")]
+        specular_reflectance: Reflectance,
+        /// Which normals are sampled: `Visible` (default) or `Full`.
+        #[serde(default)]
+        sampling: NormalSampling,
+    },
+    /// A rough interface between two dielectrics (Mitsuba 3's `roughdielectric`): frosted
+    /// glass. The inside (index `int_ior`) is where the shape's normal points away from.
+    RoughDielectric {
+        /// `Ggx` (default) or `Beckmann`.
+        #[serde(default)]
+        distribution: Distribution,
+        /// Isotropic roughness, from 1e-4 to 1 (default 0.1 unless `alpha_u` and `alpha_v`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha: Option<Roughness>,
+        /// Roughness along the tangent, with `alpha_v`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_u: Option<Roughness>,
+        /// Roughness across the tangent, with `alpha_u`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alpha_v: Option<Roughness>,
+        /// Index of refraction inside, from 0.01 to 100 (default 1.5046, BK7 glass).
+        #[serde(default = "bk7")]
+        int_ior: Ior,
+        /// Index of refraction outside (default 1.000277, air); must differ from `int_ior`.
+        #[serde(default = "air")]
+        ext_ior: Ior,
+        /// Tint of the reflection, a reflectance per channel (default white).
+        #[serde(default = "unit")]
+        specular_reflectance: Reflectance,
+        /// Tint of the transmission, a reflectance per channel (default white).
+        #[serde(default = "unit")]
+        specular_transmittance: Reflectance,
+        /// Which normals are sampled: `Visible` (default) or `Full`.
+        #[serde(default)]
+        sampling: NormalSampling,
+    },
+    /// A diffuse base under a rough dielectric coating (Mitsuba 3's `roughplastic`; isotropic).
+    RoughPlastic {
+        /// `Ggx` (default) or `Beckmann`.
+        #[serde(default)]
+        distribution: Distribution,
+        /// Roughness of the coating, from 1e-4 to 1 (default 0.1).
+        #[serde(default = "alpha")]
+        alpha: Roughness,
+        /// Index of refraction of the coating (default 1.49, polypropylene).
+        #[serde(default = "polypropylene")]
+        int_ior: Ior,
+        /// Index of refraction outside (default 1.000277, air); must differ from `int_ior`.
+        #[serde(default = "air")]
+        ext_ior: Ior,
+        /// Reflectance of the base per channel (default 0.5).
+        #[serde(default = "half")]
+        diffuse_reflectance: Reflectance,
+        /// Tint of the coating's reflection per channel (default white).
+        #[serde(default = "unit")]
+        specular_reflectance: Reflectance,
+        /// Account for the base's colour in the light trapped under the coating (default
+        /// false, as Mitsuba).
+        #[serde(default)]
+        nonlinear: bool,
+        /// Which normals are sampled: `Visible` (default) or `Full`.
+        #[serde(default)]
+        sampling: NormalSampling,
+    },
+    /// A diffuse base under a smooth dielectric coating (Mitsuba 3's `plastic`).
+    Plastic {
+        /// Index of refraction of the coating (default 1.49, polypropylene).
+        #[serde(default = "polypropylene")]
+        int_ior: Ior,
+        /// Index of refraction outside (default 1.000277, air); must differ from `int_ior`.
+        #[serde(default = "air")]
+        ext_ior: Ior,
+        /// Reflectance of the base per channel (default 0.5).
+        #[serde(default = "half")]
+        diffuse_reflectance: Reflectance,
+        /// Tint of the coating's reflection per channel (default white).
+        #[serde(default = "unit")]
+        specular_reflectance: Reflectance,
+        /// Account for the base's colour in the light trapped under the coating (default
+        /// false, as Mitsuba).
+        #[serde(default)]
+        nonlinear: bool,
+    },
     /// A perfect refractor (inside index `ior`, outside air) tinted by `color`.
     Transmissive {
         /// Index of refraction, from 0.01 to 100.
@@ -453,24 +569,68 @@ impl MaterialDesc {
                 eta,
                 k,
                 specular_reflectance,
+            } => Material::Conductor(conductor(material, eta, k, specular_reflectance)?),
+            MaterialDesc::RoughConductor {
+                distribution,
+                alpha,
+                alpha_u,
+                alpha_v,
+                material,
+                eta,
+                k,
+                specular_reflectance,
+                sampling,
             } => {
-                let (eta, k) = match (material, eta, k) {
-                    (Some(m), None, None) => m.0.eta_k(),
-                    (None, Some(eta), Some(k)) => (eta.0.as_vec3a(), k.0.as_vec3a()),
-                    (None, None, None) => Metal::None.eta_k(),
-                    (Some(_), ..) => {
-                        return Err("a conductor takes a named `material` or `eta` and `k`, \
-                                    not both"
-                            .into());
-                    }
-                    _ => return Err("a conductor's `eta` and `k` go together: give both".into()),
-                };
-                Material::Conductor(Conductor {
-                    eta,
-                    k,
-                    specular_reflectance: rgb(specular_reflectance),
-                })
+                let microfacet = roughness(*distribution, *alpha, *alpha_u, *alpha_v, *sampling)?;
+                let metal = conductor(material, eta, k, specular_reflectance)?;
+                Material::Bsdf(Bsdf::RoughConductor(RoughConductor { microfacet, metal }))
             }
+            MaterialDesc::RoughDielectric {
+                distribution,
+                alpha,
+                alpha_u,
+                alpha_v,
+                int_ior,
+                ext_ior,
+                specular_reflectance,
+                specular_transmittance,
+                sampling,
+            } => Material::Bsdf(Bsdf::RoughDielectric(RoughDielectric {
+                microfacet: roughness(*distribution, *alpha, *alpha_u, *alpha_v, *sampling)?,
+                eta: relative_ior(*int_ior, *ext_ior)?,
+                specular_reflectance: rgb(specular_reflectance),
+                specular_transmittance: rgb(specular_transmittance),
+            })),
+            MaterialDesc::RoughPlastic {
+                distribution,
+                alpha,
+                int_ior,
+                ext_ior,
+                diffuse_reflectance,
+                specular_reflectance,
+                nonlinear,
+                sampling,
+            } => Material::Bsdf(Bsdf::RoughPlastic(RoughPlastic::new(
+                roughness(*distribution, Some(*alpha), None, None, *sampling)?,
+                relative_ior(*int_ior, *ext_ior)?,
+                rgb(diffuse_reflectance),
+                rgb(specular_reflectance),
+                *nonlinear,
+            ))),
+            MaterialDesc::Plastic {
+                int_ior,
+                ext_ior,
+                diffuse_reflectance,
+                specular_reflectance,
+                nonlinear,
+            } => Material::Bsdf(Bsdf::Plastic(Plastic {
+                coating: Coating::smooth(
+                    relative_ior(*int_ior, *ext_ior)?,
+                    rgb(diffuse_reflectance),
+                    rgb(specular_reflectance),
+                    *nonlinear,
+                ),
+            })),
             MaterialDesc::Phong { kd, ks, shininess } => Material::Phong(Phong {
                 kd: rgb(kd),
                 ks: rgb(ks),
@@ -483,6 +643,70 @@ impl MaterialDesc {
             }),
         }))
     }
+}
+
+/// The metal of a conductor's fields: a named metal, or `eta` and `k`, or none (Fresnel 1).
+fn conductor(
+    material: &Option<MetalName>,
+    eta: &Option<IorPart>,
+    k: &Option<IorPart>,
+    specular_reflectance: &Reflectance,
+) -> Result<Conductor, String> {
+    let (eta, k) = match (material, eta, k) {
+        (Some(m), None, None) => m.0.eta_k(),
+        (None, Some(eta), Some(k)) => (eta.0.as_vec3a(), k.0.as_vec3a()),
+        (None, None, None) => Metal::None.eta_k(),
+        (Some(_), ..) => {
+            return Err("a conductor takes a named `material` or `eta` and `k`, not both".into());
+        }
+        _ => return Err("a conductor's `eta` and `k` go together: give both".into()),
+    };
+    Ok(Conductor {
+        eta,
+        k,
+        specular_reflectance: specular_reflectance.0.as_vec3a(),
+    })
+}
+
+/// The microfacet distribution of a rough material's fields: `alpha`, or `alpha_u` and
+/// `alpha_v` together, or neither (alpha 0.1, Mitsuba's default).
+fn roughness(
+    distribution: Distribution,
+    alpha: Option<Roughness>,
+    alpha_u: Option<Roughness>,
+    alpha_v: Option<Roughness>,
+    sampling: NormalSampling,
+) -> Result<Microfacet, String> {
+    let (ax, ay) = match (alpha, alpha_u, alpha_v) {
+        (Some(a), None, None) => (a.0, a.0),
+        (None, Some(u), Some(v)) => (u.0, v.0),
+        (None, None, None) => (0.1, 0.1),
+        (Some(_), ..) => {
+            return Err(
+                "a rough material takes `alpha` or `alpha_u` and `alpha_v`, not both".into(),
+            );
+        }
+        _ => return Err("`alpha_u` and `alpha_v` go together: give both".into()),
+    };
+    Ok(Microfacet {
+        distribution,
+        alpha_x: ax as f32,
+        alpha_y: ay as f32,
+        sampling,
+    })
+}
+
+/// `int_ior / ext_ior`, or why the two indices make no interface.
+fn relative_ior(int_ior: Ior, ext_ior: Ior) -> Result<f32, String> {
+    let eta = (int_ior.0 / ext_ior.0) as f32;
+    if (eta - 1.0).abs() < 1e-4 {
+        return Err(format!(
+            "`int_ior` ({}) and `ext_ior` ({}) must differ by 1e-4 relative or more: equal \
+             indices make no interface",
+            int_ior.0, ext_ior.0
+        ));
+    }
+    Ok(eta)
 }
 
 /// An entry of the `materials` table: any material written inline, never `Named`.
@@ -511,6 +735,21 @@ fn unit() -> Reflectance {
 }
 fn shininess() -> NonNegative {
     NonNegative(1.0)
+}
+fn half() -> Reflectance {
+    Reflectance(glam::DVec3::splat(0.5))
+}
+fn alpha() -> Roughness {
+    Roughness(0.1)
+}
+fn bk7() -> Ior {
+    Ior(1.5046)
+}
+fn air() -> Ior {
+    Ior(1.000277)
+}
+fn polypropylene() -> Ior {
+    Ior(1.49)
 }
 
 /// A shape as written, in scene units.

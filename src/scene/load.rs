@@ -11,7 +11,7 @@ use super::messages::{explain, offset_of};
 use super::spans::{self, Node};
 use super::values::Rgb;
 use crate::material::Material;
-use crate::world::{MaterialName, Name, Scene, Settings};
+use crate::world::{MaterialName, Name, Scene, Settings, Shader};
 use ron::extensions::Extensions;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -323,6 +323,16 @@ impl Resolved {
     fn into_scene(self, origin: String) -> Result<Scene, SceneError> {
         let mut world = hecs::World::new();
         let mut warnings = Vec::new();
+        let d = Settings::default();
+        let settings = Settings {
+            film: self.film.map_or(d.film, |f| f.0),
+            camera: self.camera.map_or(d.camera, |c| c.to_world()),
+            shader: self.shader.map_or(d.shader, |s| s.to_world()),
+            background: self.background.map_or(d.background, |b| b.0.as_vec3a()),
+            seed: self.seed.unwrap_or(d.seed),
+            model: self.model.unwrap_or(d.model),
+            effects: self.effects.map_or(d.effects, |e| e.to_world()),
+        };
         for (EntityDesc(e), idx, i) in &self.entities {
             let src = &self.sources[*idx];
             // Where a component's value is written: the value of `field`, then `inner` inside
@@ -364,6 +374,8 @@ impl Resolved {
             match &e.material {
                 Some(MaterialDesc::Named(n)) => match self.materials.get(n) {
                     Some((m, _)) => {
+                        bsdf_allowed(m, &settings)
+                            .map_err(|why| src.error(place("material", Some("Named")), why))?;
                         b.add(*m);
                         b.add(MaterialName(n.clone()));
                     }
@@ -384,6 +396,10 @@ impl Resolved {
                 Some(m) => {
                     if let Some(m) = m
                         .to_world()
+                        .and_then(|m| match m {
+                            Some(m) => bsdf_allowed(&m, &settings).map(|()| Some(m)),
+                            None => Ok(None),
+                        })
                         .map_err(|why| src.error(place("material", None), why))?
                     {
                         b.add(m);
@@ -404,16 +420,6 @@ impl Resolved {
         if self.entities.is_empty() {
             warnings.push("the scene has no entities: every pixel shows the background".into());
         }
-        let d = Settings::default();
-        let settings = Settings {
-            film: self.film.map_or(d.film, |f| f.0),
-            camera: self.camera.map_or(d.camera, |c| c.to_world()),
-            shader: self.shader.map_or(d.shader, |s| s.to_world()),
-            background: self.background.map_or(d.background, |b| b.0.as_vec3a()),
-            seed: self.seed.unwrap_or(d.seed),
-            model: self.model.unwrap_or(d.model),
-            effects: self.effects.map_or(d.effects, |e| e.to_world()),
-        };
         Ok(Scene {
             world,
             settings,
@@ -421,4 +427,27 @@ impl Resolved {
             warnings,
         })
     }
+}
+
+/// Whether the settings can render `m`: a material given by its BSDF (rough materials and
+/// plastics) needs the Physical model, and a shader other than Global, whose Eq. 1-4 are
+/// defined for Phong, mirrors and glass only.
+fn bsdf_allowed(m: &Material, settings: &Settings) -> Result<(), String> {
+    let Material::Bsdf(b) = m else {
+        return Ok(());
+    };
+    let name = b.name();
+    if matches!(settings.shader, Shader::Global(_)) {
+        return Err(format!(
+            "{name} cannot be rendered by the Global shader, whose Eq. 1-4 are defined for \
+             Phong, mirrors and glass: use `shader: Path()` or `shader: Direct()`"
+        ));
+    }
+    if settings.model != crate::material::Model::Physical {
+        return Err(format!(
+            "{name} needs `model: Physical`: the course's model weighs Phong, mirrors and \
+             glass only"
+        ));
+    }
+    Ok(())
 }

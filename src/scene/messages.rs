@@ -45,6 +45,16 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
             ("Phong", "Phong(kd: (0.8, 0.8, 0.8))"),
             ("Mirror", "Mirror()"),
             ("Conductor", "Conductor(material: \"Au\")"),
+            (
+                "RoughConductor",
+                "RoughConductor(alpha: 0.1, material: \"Au\")",
+            ),
+            (
+                "RoughDielectric",
+                "RoughDielectric(alpha: 0.1, int_ior: 1.5)",
+            ),
+            ("RoughPlastic", "RoughPlastic(alpha: 0.1)"),
+            ("Plastic", "Plastic()"),
             ("Transmissive", "Transmissive(ior: 1.5)"),
         ],
     ),
@@ -145,8 +155,9 @@ fn field_form(name: &str) -> Option<&'static str> {
         }
         "material" => {
             "`Named(\"name\")` for a material of the table, or one written inline: \
-             `Phong(kd: (0.8, 0.8, 0.8))`, `Mirror()`, `Conductor(material: \"Au\")` or \
-             `Transmissive(ior: 1.5)`"
+             `Phong(kd: (0.8, 0.8, 0.8))`, `Mirror()`, `Conductor(material: \"Au\")`, \
+             `RoughConductor(alpha: 0.1, material: \"Au\")`, `RoughDielectric(alpha: 0.1, \
+             int_ior: 1.5)`, `RoughPlastic(alpha: 0.1)`, `Plastic()` or `Transmissive(ior: 1.5)`"
         }
         "shape" => {
             "one of `Sphere(...)`, `InfinitePlane(...)`, `Triangle(...)`, \

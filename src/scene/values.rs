@@ -235,6 +235,33 @@ impl TryFrom<f64> for Positive {
     }
 }
 
+/// A microfacet roughness `alpha` (the RMS slope of the microfacets for Beckmann): from
+/// [`MIN_ALPHA`](crate::material::microfacet::MIN_ALPHA), 1e-4, to 1 (unitless).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct Roughness(pub f64);
+
+impl TryFrom<f64> for Roughness {
+    type Error = String;
+    fn try_from(v: f64) -> Result<Self, String> {
+        let min = crate::material::microfacet::MIN_ALPHA as f64;
+        if (min..=1.0).contains(&v) {
+            Ok(Roughness(v))
+        } else {
+            Err(format!(
+                "roughness alpha must be from 1e-4 to 1, got {} (use Mirror, Conductor, \
+                 Transmissive or Plastic for a smooth surface)",
+                show(v)
+            ))
+        }
+    }
+}
+impl From<Roughness> for f64 {
+    fn from(p: Roughness) -> Self {
+        p.0
+    }
+}
+
 /// An index of refraction, in [`IOR_RANGE`].
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "f64", into = "f64")]

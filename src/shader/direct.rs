@@ -1,4 +1,5 @@
-//! The direct shader (assignments 3 and 4): point lights with hard shadows at Phong surfaces,
+//! The direct shader (assignments 3 and 4): point lights with hard shadows at Phong surfaces
+//! (and at rough materials and plastics, weighted by their BSDF),
 //! area lights with soft shadows from `light_samples` samples; mirrors and glass pass on what
 //! their single scattered ray sees; emitters are seen directly and through mirrors and glass.
 
@@ -16,6 +17,10 @@ pub fn radiance(tr: &mut Tracer, ray: &Ray, max_specular: u32, light_samples: u3
     le + match end {
         // Eq. 3 at the Phong surface.
         ChainEnd::Phong { si, phong, beta } => beta * direct_light(tr, &si, &phong, light_samples),
+        // Eq. 3 with the BSDF's f |cos| in place of r.
+        ChainEnd::Bsdf { si, shading, beta } => {
+            beta * direct_light(tr, &si, &shading, light_samples)
+        }
         // A ray that leaves the scene sees the background.
         ChainEnd::Escaped { beta } => beta * tr.background,
         ChainEnd::Absorbed => Vec3A::ZERO,

@@ -24,7 +24,7 @@
 
 use super::Tracer;
 use super::surface::{
-    Interaction, area_lights, emitted, one_light, point_lights, reflectance, specular_bounce,
+    Interaction, Lobe, area_lights, emitted, one_light, point_lights, reflectance, specular_bounce,
 };
 pub use super::surface::{brdf_pdf as pdf, diffuse_probability};
 use crate::geometry::{Frame, Ray};
@@ -83,8 +83,6 @@ pub const MAX_DEPTH: u32 = 1024;
 pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     let model = tr.model;
     let lights = p.lights_under(model);
-    let one_light_mode = p.one_light_under(model);
-    let by_importance = p.lights_per_vertex == LightsPerVertex::Importance;
     let max_depth = p.max_depth.unwrap_or(MAX_DEPTH).min(MAX_DEPTH);
     let mut l = Vec3A::ZERO;
     let mut beta = Vec3A::ONE;
@@ -122,23 +120,7 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
         // Scatter: the next ray, its weight g(wi) / pdf(wi) and its kind.
         let (next_ray, weight, next) = match (si.material, model) {
             (Material::Phong(phong), _) => {
-                // Next-event estimation: Eq. 3 under the model, and one area-light sample. When
-                // no ray continues (indirect light off) the light sample carries all of the
-                // area lights, whatever the strategy.
-                let mis =
-                    (lights == LightSampling::Mis && tr.effects.indirect).then_some(p.sampling);
-                let sample_area = lights != LightSampling::Brdf || !tr.effects.indirect;
-                if one_light_mode {
-                    // One light of all, chosen by power (point lights by importance under
-                    // `Importance`). Under `Brdf` the area lights are left to the sampled rays,
-                    // and a chosen area light adds nothing.
-                    l += beta * one_light(tr, &si, &phong, mis, sample_area, by_importance);
-                } else {
-                    l += beta * point_lights(tr, &si, &phong);
-                    if sample_area {
-                        l += beta * area_lights(tr, &si, &phong, 1, mis);
-                    }
-                }
+                l += beta * next_event(tr, &si, &phong, p);
                 if !tr.effects.indirect {
                     break;
                 }
@@ -148,6 +130,29 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                 };
                 scattered = Some(Scattered { p: si.hit.p, pdf });
                 (si.spawn(wi), weight, RayKind::Indirect)
+            }
+            // A BSDF: next-event estimation with its eval and pdf, then its own sampler. Its
+            // weights are f |cos| / pdf under either model (rough materials ask for the
+            // Physical one; see docs/transport.md).
+            (Material::Bsdf(bsdf), _) => {
+                let shading = si.shading(tr, bsdf);
+                l += beta * next_event(tr, &si, &shading, p);
+                if !tr.effects.indirect {
+                    break;
+                }
+                let frame = shading.frame;
+                let uc = tr.sampler.next_f32();
+                let (u1, u2) = tr.sampler.next_2d();
+                let Some(s) = bsdf.sample(frame.to_local(si.wo), uc, u1, u2) else {
+                    break;
+                };
+                // A delta lobe's direction cannot be found by a light sample: its emitter
+                // counts whole, as after a mirror.
+                scattered = (!s.delta).then_some(Scattered {
+                    p: si.hit.p,
+                    pdf: s.pdf,
+                });
+                (si.spawn(frame.to_world(s.wi)), s.weight, RayKind::Indirect)
             }
             // Fresnel-weighted choice between reflection and refraction.
             (Material::Transmissive(g), Model::Physical) => {
@@ -191,6 +196,28 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
         kind = next;
     }
     l
+}
+
+/// Next-event estimation at a vertex whose surface reflects as `lobe`: Eq. 3 under the model
+/// and one area-light sample, or one light of all. When no ray continues (indirect light off)
+/// the light sample carries all of the area lights, whatever the strategy.
+fn next_event<L: Lobe>(tr: &mut Tracer, si: &Interaction, lobe: &L, p: &Path) -> Vec3A {
+    let lights = p.lights_under(tr.model);
+    let mis = (lights == LightSampling::Mis && tr.effects.indirect).then_some(p.sampling);
+    let sample_area = lights != LightSampling::Brdf || !tr.effects.indirect;
+    if p.one_light_under(tr.model) {
+        // One light of all, chosen by power (point lights by importance under `Importance`).
+        // Under `Brdf` the area lights are left to the sampled rays, and a chosen area light
+        // adds nothing.
+        let by_importance = p.lights_per_vertex == LightsPerVertex::Importance;
+        one_light(tr, si, lobe, mis, sample_area, by_importance)
+    } else {
+        let mut l = point_lights(tr, si, lobe);
+        if sample_area {
+            l += area_lights(tr, si, lobe, 1, mis);
+        }
+        l
+    }
 }
 
 /// Sample a direction at a Phong vertex: the direction, its weight `g / pdf` and its density;

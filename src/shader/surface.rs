@@ -5,9 +5,9 @@
 
 use super::Tracer;
 use crate::effects::Effects;
-use crate::geometry::{Hit, Origins, Ray};
+use crate::geometry::{Frame, Hit, Origins, Ray};
 use crate::light::{AreaLight, Chosen, Incident, Light, NO_LIGHT, choose_by_importance};
-use crate::material::{Material, Model, Phong, reflect};
+use crate::material::{Bsdf, Material, Model, Phong, reflect};
 use crate::sampling::{Sampling, hemisphere, power_heuristic};
 use crate::stats::RayKind;
 use glam::Vec3A;
@@ -56,6 +56,95 @@ impl Interaction {
     pub fn spawn(&self, w: Vec3A) -> Ray {
         self.origins.ray(w, f32::INFINITY)
     }
+
+    /// The BSDF `bsdf` of this surface in its local frame: `z` the shading normal turned to
+    /// the outside (the geometric normal's side), `x` the shape's tangent made orthogonal to it.
+    #[inline]
+    pub fn shading(&self, tr: &Tracer, bsdf: Bsdf) -> Shading {
+        let n = if self.n.dot(self.hit.n) < 0.0 {
+            -self.n
+        } else {
+            self.n
+        };
+        let tangent = tr.geometry.prim(self.hit.prim).shape.tangent(self.hit.p);
+        let s = tangent - n * n.dot(tangent);
+        let frame = match s.try_normalize() {
+            Some(s) => Frame {
+                s,
+                t: n.cross(s),
+                n,
+            },
+            None => Frame::from_normal(n),
+        };
+        Shading { bsdf, frame }
+    }
+}
+
+/// A BSDF at a hit, with the local frame it is evaluated in.
+#[derive(Clone, Copy, Debug)]
+pub struct Shading {
+    /// The material.
+    pub bsdf: Bsdf,
+    /// Its local frame.
+    pub frame: Frame,
+}
+
+/// What next-event estimation needs of the surface at a vertex: how it reflects light from
+/// a light's direction towards the viewer, and the density with which the path's own sampler
+/// would have chosen that direction (for MIS). Phong and the BSDFs answer it; the functions
+/// below are generic over it, so that Phong's code is what it was.
+pub trait Lobe {
+    /// True if the surface reflects nothing (no shadow ray can change that).
+    fn is_black(&self) -> bool;
+    /// True if light from behind the surface reaches the viewer (a rough dielectric).
+    fn transmits(&self) -> bool;
+    /// The weight of incident radiance from `wi` towards `wo` under `model`: the course's
+    /// reflectance, or `f |cos(theta_i)|`.
+    fn reflectance(&self, model: Model, wi: Vec3A, wo: Vec3A, n: Vec3A) -> Vec3A;
+    /// The density per solid angle of the surface's sampler choosing `wi` under `sampling`.
+    fn pdf(&self, wo: Vec3A, n: Vec3A, wi: Vec3A, sampling: Sampling) -> f32;
+}
+
+impl Lobe for Phong {
+    #[inline]
+    fn is_black(&self) -> bool {
+        Phong::is_black(self)
+    }
+    #[inline]
+    fn transmits(&self) -> bool {
+        false
+    }
+    #[inline]
+    fn reflectance(&self, model: Model, wi: Vec3A, wo: Vec3A, n: Vec3A) -> Vec3A {
+        reflectance(model, self, wi, wo, n)
+    }
+    #[inline]
+    fn pdf(&self, wo: Vec3A, n: Vec3A, wi: Vec3A, sampling: Sampling) -> f32 {
+        brdf_pdf(self, wo, n, wi, sampling)
+    }
+}
+
+/// A BSDF's weights are `f |cos(theta_i)|` and its own sampler's density under every model and
+/// sampling strategy: the strategies and the course's reflectance are Phong's.
+impl Lobe for Shading {
+    #[inline]
+    fn is_black(&self) -> bool {
+        false
+    }
+    #[inline]
+    fn transmits(&self) -> bool {
+        self.bsdf.transmits()
+    }
+    #[inline]
+    fn reflectance(&self, _: Model, wi: Vec3A, wo: Vec3A, _: Vec3A) -> Vec3A {
+        let f = &self.frame;
+        self.bsdf.eval(f.to_local(wo), f.to_local(wi))
+    }
+    #[inline]
+    fn pdf(&self, wo: Vec3A, _: Vec3A, wi: Vec3A, _: Sampling) -> f32 {
+        let f = &self.frame;
+        self.bsdf.pdf(f.to_local(wo), f.to_local(wi))
+    }
 }
 
 /// The reflectance that weights incident radiance under `model`: the course's `r(wi, wo)`, or the
@@ -81,8 +170,13 @@ pub fn emitted(tr: &Tracer, si: &Interaction) -> Vec3A {
 /// Eq. 3 with area lights: the point lights' sum ([`point_lights`]) plus the area lights'
 /// integral estimated with `light_samples` samples ([`area_lights`]).
 #[inline]
-pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light_samples: u32) -> Vec3A {
-    point_lights(tr, si, phong) + area_lights(tr, si, phong, light_samples, None)
+pub fn direct_light<L: Lobe>(
+    tr: &mut Tracer,
+    si: &Interaction,
+    lobe: &L,
+    light_samples: u32,
+) -> Vec3A {
+    point_lights(tr, si, lobe) + area_lights(tr, si, lobe, light_samples, None)
 }
 
 /// Eq. 3: `L_dir = sum_s L_i^s r(wi^s, wo) V^s` over the point lights. A light counts only when
@@ -90,22 +184,22 @@ pub fn direct_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light_samp
 ///
 /// Without shadows (`effects: (shadows: false)`) every light facing the point counts.
 #[inline]
-pub fn point_lights(tr: &mut Tracer, si: &Interaction, phong: &Phong) -> Vec3A {
-    if phong.is_black() {
+pub fn point_lights<L: Lobe>(tr: &mut Tracer, si: &Interaction, lobe: &L) -> Vec3A {
+    if lobe.is_black() {
         // Reflects nothing: no shadow ray can change that.
         return Vec3A::ZERO;
     }
     let lights = tr.lights;
     lights
         .iter()
-        .map(|light| point_light(tr, si, phong, light))
+        .map(|light| point_light(tr, si, lobe, light))
         .sum()
 }
 
 /// One point light's term of Eq. 3: `L_i r(wi, wo) V`.
 #[inline]
-fn point_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light: &Light) -> Vec3A {
-    let Some((inc, shadow)) = point_light_ray(si, light) else {
+fn point_light<L: Lobe>(tr: &mut Tracer, si: &Interaction, lobe: &L, light: &Light) -> Vec3A {
+    let Some((inc, shadow)) = point_light_ray(si, light, lobe.transmits()) else {
         return Vec3A::ZERO;
     };
     let visible = !tr.effects.shadows
@@ -113,19 +207,20 @@ fn point_light(tr: &mut Tracer, si: &Interaction, phong: &Phong, light: &Light) 
             true => tr.unoccluded_in_room(&shadow),
             false => tr.unoccluded(&shadow),
         };
-    point_light_term(tr.model, si, phong, &inc, visible)
+    point_light_term(tr.model, si, lobe, &inc, visible)
 }
 
 /// A point light's incident light at `si` and its shadow ray `V^s`, or `None` if the light
-/// adds nothing there whatever the visibility (behind the surface, or at the point itself).
+/// adds nothing there whatever the visibility (behind the surface unless it `transmits`, or at
+/// the point itself).
 ///
 /// The shadow ray stops just short of the light, so that a surface the light sits on does not
 /// block it. No plane can block it when the light is in the planes' room
 /// ([`Light::in_room`]).
 #[inline]
-fn point_light_ray(si: &Interaction, light: &Light) -> Option<(Incident, Ray)> {
+fn point_light_ray(si: &Interaction, light: &Light, transmits: bool) -> Option<(Incident, Ray)> {
     let inc = light.incident(si.hit.p)?;
-    if inc.wi.dot(si.n) <= 0.0 {
+    if !transmits && inc.wi.dot(si.n) <= 0.0 {
         return None;
     }
     let shadow = si.origins.ray(inc.wi, inc.dist * SHADOW_END);
@@ -134,15 +229,15 @@ fn point_light_ray(si: &Interaction, light: &Light) -> Option<(Incident, Ray)> {
 
 /// `L_i r(wi, wo) V` for the incident light `inc` of [`point_light_ray`], seen or not.
 #[inline]
-fn point_light_term(
+fn point_light_term<L: Lobe>(
     model: Model,
     si: &Interaction,
-    phong: &Phong,
+    lobe: &L,
     inc: &Incident,
     visible: bool,
 ) -> Vec3A {
     if visible {
-        inc.li * reflectance(model, phong, inc.wi, si.wo, si.n)
+        inc.li * lobe.reflectance(model, inc.wi, si.wo, si.n)
     } else {
         Vec3A::ZERO
     }
@@ -157,14 +252,14 @@ fn point_light_term(
 /// power heuristic against the density with which that strategy would pick `wi`; the path
 /// tracer's BRDF-sampled hits on emitters take the complementary weight.
 #[inline]
-pub fn area_lights(
+pub fn area_lights<L: Lobe>(
     tr: &mut Tracer,
     si: &Interaction,
-    phong: &Phong,
+    lobe: &L,
     samples: u32,
     mis: Option<Sampling>,
 ) -> Vec3A {
-    if !tr.effects.emission || tr.emitters.is_empty() || samples == 0 || phong.is_black() {
+    if !tr.effects.emission || tr.emitters.is_empty() || samples == 0 || lobe.is_black() {
         return Vec3A::ZERO;
     }
     let mut sum = Vec3A::ZERO;
@@ -173,7 +268,7 @@ pub fn area_lights(
         let u = tr.sampler.next_f64();
         let (u1, u2) = tr.sampler.next_2d();
         if let Some((light, pmf)) = tr.emitters.choose(u) {
-            sum += area_sample(tr, si, phong, light, pmf, (u1, u2), mis);
+            sum += area_sample(tr, si, lobe, light, pmf, (u1, u2), mis);
         }
     }
     sum / samples as f32
@@ -185,15 +280,15 @@ pub fn area_lights(
 /// `by_importance` (`lights_per_vertex: Importance`) the point lights' share of the choice goes
 /// to each in proportion to its unshadowed contribution at the vertex instead.
 #[inline]
-pub fn one_light(
+pub fn one_light<L: Lobe>(
     tr: &mut Tracer,
     si: &Interaction,
-    phong: &Phong,
+    lobe: &L,
     mis: Option<Sampling>,
     area: bool,
     by_importance: bool,
 ) -> Vec3A {
-    if phong.is_black() {
+    if lobe.is_black() {
         return Vec3A::ZERO;
     }
     let u = tr.sampler.next_f64();
@@ -214,14 +309,14 @@ pub fn one_light(
             if !weight.is_finite() {
                 return Vec3A::ZERO;
             }
-            point_light(tr, si, phong, &lights[j]) * weight
+            point_light(tr, si, lobe, &lights[j]) * weight
         }
         Some(Chosen::Point(j, pmf)) => {
             let light = tr.lights[j];
-            point_light(tr, si, phong, &light) / pmf
+            point_light(tr, si, lobe, &light) / pmf
         }
         Some(Chosen::Area(light, pmf)) if area && tr.effects.emission => {
-            area_sample(tr, si, phong, light, pmf, (u1, u2), mis)
+            area_sample(tr, si, lobe, light, pmf, (u1, u2), mis)
         }
         _ => Vec3A::ZERO,
     }
@@ -231,10 +326,10 @@ pub fn one_light(
 /// `L_e r V w / (pmf pdf)`, with `w` the power heuristic's weight against BRDF sampling under
 /// `mis` (else 1).
 #[inline]
-fn area_sample(
+fn area_sample<L: Lobe>(
     tr: &mut Tracer,
     si: &Interaction,
-    phong: &Phong,
+    lobe: &L,
     light: &AreaLight,
     pmf: f32,
     (u1, u2): (f32, f32),
@@ -243,7 +338,7 @@ fn area_sample(
     let Some(ls) = light.sample(si.hit.p, u1, u2) else {
         return Vec3A::ZERO;
     };
-    if ls.le == Vec3A::ZERO || ls.wi.dot(si.n) <= 0.0 {
+    if ls.le == Vec3A::ZERO || (!lobe.transmits() && ls.wi.dot(si.n) <= 0.0) {
         return Vec3A::ZERO;
     }
     let pdf = pmf * ls.pdf;
@@ -258,10 +353,10 @@ fn area_sample(
         return Vec3A::ZERO;
     }
     let w = match mis {
-        Some(sampling) => power_heuristic(pdf, brdf_pdf(phong, si.wo, si.n, ls.wi, sampling)),
+        Some(sampling) => power_heuristic(pdf, lobe.pdf(si.wo, si.n, ls.wi, sampling)),
         None => 1.0,
     };
-    ls.le * reflectance(tr.model, phong, ls.wi, si.wo, si.n) * (w / pdf)
+    ls.le * lobe.reflectance(tr.model, ls.wi, si.wo, si.n) * (w / pdf)
 }
 
 /// Probability of picking the diffuse lobe in BRDF sampling: the lobes' share of `kd + ks`.
@@ -303,7 +398,7 @@ pub const SHADOW_END: f32 = 1.0 - 1e-4;
 #[inline]
 pub fn specular_bounce(si: &Interaction, effects: Effects) -> Option<(Ray, Vec3A, RayKind)> {
     match si.material {
-        Material::Phong(_) => None,
+        Material::Phong(_) | Material::Bsdf(_) => None,
         Material::Mirror(m) => {
             if !effects.reflection {
                 return None;
@@ -351,6 +446,15 @@ pub enum ChainEnd {
         /// Throughput of the chain.
         beta: Vec3A,
     },
+    /// At a surface with a BSDF, reached with throughput `beta`.
+    Bsdf {
+        /// The hit.
+        si: Interaction,
+        /// Its BSDF and frame.
+        shading: Shading,
+        /// Throughput of the chain.
+        beta: Vec3A,
+    },
     /// The chain left the scene with throughput `beta`: it sees the background.
     Escaped {
         /// Throughput of the chain.
@@ -387,8 +491,13 @@ pub fn follow_specular(
         if see_first || chain > 0 {
             le += beta * emitted(tr, &si);
         }
-        if let Material::Phong(phong) = si.material {
-            return (ChainEnd::Phong { si, phong, beta }, le);
+        match si.material {
+            Material::Phong(phong) => return (ChainEnd::Phong { si, phong, beta }, le),
+            Material::Bsdf(bsdf) => {
+                let shading = si.shading(tr, bsdf);
+                return (ChainEnd::Bsdf { si, shading, beta }, le);
+            }
+            _ => {}
         }
         if chain == max_specular {
             break;

@@ -203,6 +203,23 @@ impl Shape {
         }
     }
 
+    /// The direction at `p` along which a rough material's `alpha_u` applies (not unit, not
+    /// yet orthogonal to a shading normal): on a sphere `dp/du` as Mitsuba 3 parametrises it,
+    /// the azimuth about the world `z` axis; on a flat shape, until shapes carry texture
+    /// coordinates, the first tangent of Duff et al.'s frame around its normal, the same over a
+    /// whole rectangle or plane (`x` for a normal along `y` or `z`, `-z` for one along `x`).
+    #[inline]
+    pub fn tangent(&self, p: Vec3A) -> Vec3A {
+        match self {
+            Shape::Sphere(s) => {
+                let d = p - s.c;
+                Vec3A::new(-d.y, d.x, 0.0)
+            }
+            Shape::Plane(pl) => pl.n.any_orthonormal_vector(),
+            Shape::Triangle(t) => t.n.any_orthonormal_vector(),
+        }
+    }
+
     /// Which kind of shape this is.
     pub fn kind(&self) -> ShapeKind {
         match self {

@@ -26,6 +26,7 @@ mod beckmann;
 mod ggx;
 
 use glam::Vec3A;
+use serde::{Deserialize, Serialize};
 
 /// The smallest `alpha` a rough material accepts: the lobe is then some 1e-4 rad wide, near
 /// what a unit vector in `f32` resolves (about 6e-8 rad per component step, and less as
@@ -33,7 +34,7 @@ use glam::Vec3A;
 pub const MIN_ALPHA: f32 = 1e-4;
 
 /// The shape of the distribution of microfacet normals.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, Serialize)]
 pub enum Distribution {
     /// GGX (Trowbridge-Reitz): long tails, the default of Mitsuba 3 and pbrt-v4.
     #[default]
@@ -43,7 +44,7 @@ pub enum Distribution {
 }
 
 /// Which normals a sampler draws.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, Serialize)]
 pub enum NormalSampling {
     /// The normals visible from `wo`, in proportion to their projected area (`D_wo`).
     #[default]

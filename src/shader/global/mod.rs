@@ -63,7 +63,9 @@ pub fn radiance(tr: &mut Tracer, ray: &Ray, g: &Global) -> Vec3A {
     le + match end {
         ChainEnd::Phong { si, phong, beta } => beta * first_hit(tr, g, &si, &phong),
         ChainEnd::Escaped { beta } => beta * tr.background,
-        ChainEnd::Absorbed => Vec3A::ZERO,
+        // Eq. 1-4 are Phong's: a BSDF surface is black, as in the waves (scene files with
+        // one are refused with Global; see `docs/transport.md`).
+        ChainEnd::Bsdf { .. } | ChainEnd::Absorbed => Vec3A::ZERO,
     }
 }
 
@@ -195,7 +197,7 @@ fn incident(tr: &mut Tracer, g: &Global, ray: Ray, stack: &mut Vec<Pending>) -> 
                 l += beta * b * tr.background;
                 continue;
             }
-            ChainEnd::Absorbed => continue,
+            ChainEnd::Bsdf { .. } | ChainEnd::Absorbed => continue,
         };
         // Eq. 3 at this hit.
         let l_dir = direct_light(tr, &si, &phong, g.light_samples);

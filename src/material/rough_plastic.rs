@@ -1,0 +1,158 @@
+//! Rough plastics: a diffuse base under a rough dielectric coating (Mitsuba 3's
+//! `roughplastic`), in the local shading frame (`z` the normal on the viewer's side).
+//!
+//! The coating reflects as a rough dielectric's reflection lobe, `R F D G / (4 cos(theta_o))`
+//! (Walter et al. 2007, eq. 20). The base is the smooth [`Plastic`](super::plastic::Plastic)'s,
+//! with the Fresnel transmittances `1 - F(cos)` replaced by the rough coating's, `T(cos) = 1 -
+//! R_c(cos)`, where `R_c(cos)` is the share of light from the direction of cosine `cos` that the
+//! rough coating reflects (its single-scattering albedo, by quadrature over visible normals),
+//! and the light trapped under the coating by the same albedo seen from inside, averaged over
+//! the hemisphere. This is Mitsuba 3's model and its approximations: the transmitted light is
+//! assumed to reach the base diffusely and leave diffusely, whatever the microfacet it crossed;
+//! the coating's own multiple scattering is lost, as in the rough conductor.
+//!
+//! `T` is tabulated at construction on 32 cosines spaced as squares (`mu = (j / 31)^2`, dense
+//! near grazing, where `T` falls fastest) and interpolated linearly in `sqrt(mu)`; Mitsuba uses
+//! 64 evenly spaced cosines. Sampling picks the coating with probability `(1 - T(cos(theta_o)))
+//! s / ((1 - T) s + T (1 - s))` (`s` the specular share of the mean reflectances), a visible
+//! normal and its mirror direction; the base otherwise, by a cosine-distributed direction.
+
+use super::bsdf_sample::BsdfSample;
+use super::coating::Coating;
+use super::fresnel_dielectric;
+use super::microfacet::Microfacet;
+use glam::Vec3A;
+use std::f32::consts::FRAC_1_PI;
+
+/// Number of cosines in the transmittance table.
+const TABLE: usize = 32;
+
+/// A rough plastic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoughPlastic {
+    /// The coating's distribution of microfacet normals (isotropic) and its sampling.
+    pub microfacet: Microfacet,
+    /// The coating over the diffuse base.
+    pub coating: Coating,
+    /// `T(mu)` at `mu = (j / 31)^2`.
+    transmittance: [f32; TABLE],
+}
+
+impl RoughPlastic {
+    /// A rough plastic whose coating has the distribution `microfacet` and relative index
+    /// `eta = int_ior / ext_ior`, over a base of reflectance `diffuse_reflectance`.
+    pub fn new(
+        microfacet: Microfacet,
+        eta: f32,
+        diffuse_reflectance: Vec3A,
+        specular_reflectance: Vec3A,
+        nonlinear: bool,
+    ) -> Self {
+        // T(mu) = 1 - R_c(mu) for light from outside (eta_i / eta_t = 1 / eta).
+        let transmittance = std::array::from_fn(|j| {
+            let x = j as f32 / (TABLE - 1) as f32;
+            1.0 - coating_albedo(&microfacet, (x * x).max(1e-6), 1.0 / eta)
+        });
+        // F_dr seen from inside: 2 int R_c(mu) mu dmu by the midpoint rule on 32 cosines.
+        let internal = (0..TABLE)
+            .map(|j| {
+                let mu = (j as f32 + 0.5) / TABLE as f32;
+                coating_albedo(&microfacet, mu, eta) * mu
+            })
+            .sum::<f32>()
+            * 2.0
+            / TABLE as f32;
+        RoughPlastic {
+            microfacet,
+            coating: Coating::new(
+                eta,
+                diffuse_reflectance,
+                specular_reflectance,
+                nonlinear,
+                internal,
+            ),
+            transmittance,
+        }
+    }
+
+    /// `T(cos)`: the share of light from the direction of cosine `cos` that crosses the coating.
+    #[inline]
+    pub fn transmittance(&self, cos: f32) -> f32 {
+        let x = cos.clamp(0.0, 1.0).sqrt() * (TABLE - 1) as f32;
+        let j = (x as usize).min(TABLE - 2);
+        let w = x - j as f32;
+        (1.0 - w) * self.transmittance[j] + w * self.transmittance[j + 1]
+    }
+
+    /// `f(wo, wi) cos(theta_i)`: the coating's lobe plus the base's.
+    #[inline]
+    pub fn eval(&self, wo: Vec3A, wi: Vec3A) -> Vec3A {
+        let (cos_o, cos_i) = (wo.z, wi.z);
+        if cos_o <= 0.0 || cos_i <= 0.0 {
+            return Vec3A::ZERO;
+        }
+        let c = &self.coating;
+        let h = wo + wi;
+        let wm = h / h.length();
+        let m = &self.microfacet;
+        let specular = c.fresnel(wo.dot(wm)) * m.d(wm) * m.g(wo, wi, wm) / (4.0 * cos_o);
+        let base = FRAC_1_PI * c.inv_eta2 * self.transmittance(cos_o) * self.transmittance(cos_i);
+        let f = c.specular_reflectance * specular + c.diffuse * (base * cos_i);
+        if f.is_finite() { f } else { Vec3A::ZERO }
+    }
+
+    /// The density per solid angle with which [`RoughPlastic::sample`] draws `wi`.
+    #[inline]
+    pub fn pdf(&self, wo: Vec3A, wi: Vec3A) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let ps = self.specular_probability(wo.z);
+        ps * self.microfacet.pdf_reflection(wo, wi) + (1.0 - ps) * wi.z * FRAC_1_PI
+    }
+
+    /// A direction from the coating's lobe if `uc < P(coating)`, else from the base.
+    #[inline]
+    pub fn sample(&self, wo: Vec3A, uc: f32, u1: f32, u2: f32) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = if uc < self.specular_probability(wo.z) {
+            self.microfacet.sample_reflection(wo, u1, u2)?.0
+        } else {
+            crate::sampling::hemisphere::cosine(u1, u2)
+        };
+        BsdfSample::glossy(wi, self.eval(wo, wi), self.pdf(wo, wi))
+    }
+
+    /// The chance of sampling the coating for a viewer at cosine `cos_o`.
+    #[inline]
+    fn specular_probability(&self, cos_o: f32) -> f32 {
+        self.coating
+            .specular_probability(1.0 - self.transmittance(cos_o))
+    }
+}
+
+/// `R_c(mu)`: the share of light from a direction of cosine `mu` that a rough dielectric
+/// interface of relative index `eta = n_i / n_t` reflects once, `int D_wo(wm) F(wo.wm) G1(wi,
+/// wm) dwm` over the normals visible from `wo` (`wi` the mirror of `wo`; Heitz 2014, eq. 38,
+/// with the separable masking), by quadrature over normals on 64 x 64 points (to about 1e-3).
+pub fn coating_albedo(m: &Microfacet, mu: f32, eta: f32) -> f32 {
+    let wo = Vec3A::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+    let reflected = m.integrate_over_normals(64, 64, |wm| {
+        let cos_om = wo.dot(wm);
+        let wi = 2.0 * cos_om * wm - wo;
+        if cos_om <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        (m.d_visible(wo, wm) * fresnel_dielectric(cos_om, eta) * m.g1(wi, wm)) as f64
+    });
+    // Divided by the same quadrature of D_wo, which is 1: the ratio cancels most of the
+    // quadrature's error near grazing.
+    let visible = m.integrate_over_normals(64, 64, |wm| m.d_visible(wo, wm) as f64);
+    if visible > 0.0 {
+        (reflected / visible) as f32
+    } else {
+        0.0
+    }
+}
