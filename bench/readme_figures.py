@@ -17,6 +17,9 @@ that this script rewrites from a run of `rtis render --stats`, `rtis bench --jso
     converge   `rtis converge scenes/cornell.ron` at 180 px (and docs/images/converge-cornell.png)
     area       area lights: docs/images/cornell-area.png, docs/images/mis-*.png (one per light
                strategy) and `rtis converge scenes/mis.ron` at 180 px
+    materials  the rough-material preview (docs/images/materials.png, scenes/materials.ron at
+               576 px and 256 spp) and `rtis converge scenes/materials.ron`: visible against
+               full microfacet normals (docs/images/converge-materials.png)
     embree     bench/embree_compare.py: rtis against Embree 4.4 on the same meshes and rays
                (installs embreex into .venv itself)
     mitsuba    bench/mitsuba_compare.py: rtis against Mitsuba 3 at equal error (needs mitsuba
@@ -46,7 +49,8 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 README = os.path.join(ROOT, "README.md")
 RTIS = os.path.join(ROOT, "target", "release", "rtis")
-BLOCKS = ["hero", "cornell", "commits", "effects", "meshes", "converge", "area", "obvhs", "embree", "mitsuba"]
+BLOCKS = ["hero", "cornell", "commits", "effects", "meshes", "converge", "area", "materials", "obvhs", "embree",
+          "mitsuba"]
 # The commit the `commits` block compares with: the last before the Global shader's waves.
 COMPARE_BASE = "e3269bf"
 VENV_PYTHON = os.path.join(ROOT, ".venv", "bin", "python")
@@ -214,6 +218,33 @@ def area(_runs):
     return "\n".join(lines)
 
 
+def materials(_runs):
+    s = render_stats("scenes/materials.ron", "docs/images/materials.png", ["--width", "576", "--spp", "256"])
+    with tempfile.TemporaryDirectory() as d:
+        run(["converge", "scenes/materials.ron", "--out", d, "--runs", "1", "--seeds", "2"], stderr=subprocess.DEVNULL)
+        shutil.copyfile(os.path.join(d, "converge.png"), os.path.join(ROOT, "docs", "images", "converge-materials.png"))
+        with open(os.path.join(d, "converge.md")) as f:
+            table = [l for l in f.read().splitlines()
+                     if l.startswith("| family") or l.startswith("|---") or l.startswith("| Path MIS")
+                     or l.startswith("| Path full normals")]
+    return "\n".join([
+        "![Rough gold, frosted glass and rough plastic at three roughnesses](docs/images/materials.png)",
+        "",
+        f"*`scenes/materials.ron` at 576x384, 256 spp: {s['total_rays'] / 1e6:.0f} M rays in {s['seconds']:.1f} s. "
+        "Rows, front to back: `RoughConductor(material: \"Au\")`, `RoughDielectric(int_ior: 1.5)`, "
+        "`RoughPlastic`; alpha 0.03, 0.15 and 0.5 from left to right; a smooth `Plastic` floor.*",
+        "",
+        "![Error against time, visible and full microfacet normals](docs/images/converge-materials.png)",
+        "",
+        "*`rtis converge scenes/materials.ron` (180 px, 2 seeds): the same path tracer with every rough "
+        "material sampling its visible normals (`Path MIS`, the default) and all normals (`Path full normals`).*",
+        "",
+        *table,
+        "",
+        stamp("`rtis render --stats` and `rtis converge scenes/materials.ron --runs 1 --seeds 2`"),
+    ])
+
+
 def obvhs(_runs):
     out = subprocess.run(["cargo", "run", "--release", "--quiet"], cwd=os.path.join(ROOT, "bench", "obvhs-compare"),
                          check=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True).stdout
@@ -361,7 +392,7 @@ def main():
     makers = {"hero": hero, "cornell": cornell, "commits": commits, "effects": effects, "meshes": meshes,
               "converge": converge,
               "obvhs": obvhs,
-              "area": area, "embree": embree, "mitsuba": mitsuba}
+              "area": area, "materials": materials, "embree": embree, "mitsuba": mitsuba}
     for name in a.only.split(","):
         if name not in makers:
             print(f"unknown block {name}: use {', '.join(BLOCKS)}", file=sys.stderr)

@@ -202,6 +202,8 @@ golden_tests! {
     cornell_n_bounce => "cornell-n-bounce.ron",
     cornell_physical => "cornell-physical.ron",
     cornell_two_bounce => "cornell-two-bounce.ron",
+    materials => "materials.ron",
+    materials_beckmann => "materials-beckmann.ron",
     mesh => "mesh.ron",
     mis => "mis.ron",
     mitsuba_cornell => "mitsuba-cornell.ron",

@@ -45,6 +45,38 @@ const CASES: &[(&str, &str)] = &[
         "conductor eta negative",
         "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Conductor(eta: (-1, 1, 1), k: (1, 1, 1)))])",
     ),
+    (
+        "roughness below its range",
+        "Scene(model: Physical, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: RoughConductor(alpha: 1e-5))])",
+    ),
+    (
+        "roughness above its range",
+        "Scene(model: Physical, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: RoughDielectric(alpha_u: 0.1, alpha_v: 1.5))])",
+    ),
+    (
+        "alpha with alpha_u",
+        "Scene(model: Physical, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: RoughConductor(alpha: 0.1, alpha_u: 0.2, alpha_v: 0.3))])",
+    ),
+    (
+        "alpha_u alone",
+        "Scene(model: Physical, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: RoughDielectric(alpha_u: 0.2))])",
+    ),
+    (
+        "unknown distribution",
+        "Scene(model: Physical, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: RoughPlastic(distribution: Phong))])",
+    ),
+    (
+        "equal indices",
+        "Scene(model: Physical, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Plastic(int_ior: 1.3, ext_ior: 1.3))])",
+    ),
+    (
+        "rough material under Global",
+        "Scene(model: Physical, shader: Global(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: RoughPlastic())])",
+    ),
+    (
+        "rough material under the Course model",
+        "Scene(materials: { \"frosted\": RoughDielectric() }, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Named(\"frosted\"))])",
+    ),
     // Finite as doubles, beyond what single-precision render data holds.
     (
         "shininess beyond f32",

@@ -185,6 +185,42 @@ mod random_scenes {
                 rgb01()
             )
                 .prop_map(|(ior, c)| format!("Transmissive(ior: {}, color: {c})", num(ior))),
+            // Rough materials and plastics at the ends of their ranges: alpha 1e-4 and 1 (and
+            // an anisotropic pair), indices 1.0001 and 4 (against an outside of 1), both
+            // distributions and samplers.
+            (
+                prop_oneof![
+                    Just("RoughConductor"),
+                    Just("RoughDielectric"),
+                    Just("RoughPlastic")
+                ],
+                prop_oneof![Just("alpha: 1e-4"), Just("alpha: 1"), Just("alpha: 0.2")],
+                prop_oneof![Just("Ggx"), Just("Beckmann")],
+                prop_oneof![Just("Visible"), Just("Full")],
+                prop_oneof![Just(1.0001), Just(1.5), Just(4.0)],
+                rgb01(),
+            )
+                .prop_map(|(m, a, d, smp, ior, c)| match m {
+                    "RoughConductor" => format!(
+                        "RoughConductor(distribution: {d}, {a}, material: \"Cu\", \
+                         specular_reflectance: {c}, sampling: {smp})"
+                    ),
+                    "RoughDielectric" => format!(
+                        "RoughDielectric(distribution: {d}, {a}, int_ior: {}, ext_ior: 1, \
+                         specular_transmittance: {c}, sampling: {smp})",
+                        num(ior)
+                    ),
+                    _ => format!(
+                        "RoughPlastic(distribution: {d}, {a}, int_ior: {}, ext_ior: 1, \
+                         diffuse_reflectance: {c}, sampling: {smp}, nonlinear: true)",
+                        num(ior)
+                    ),
+                }),
+            Just("RoughDielectric(alpha_u: 1e-4, alpha_v: 1, int_ior: 4, ext_ior: 1)".to_string()),
+            (prop_oneof![Just(1.0001), Just(4.0)], rgb01()).prop_map(|(ior, c)| format!(
+                "Plastic(int_ior: {}, ext_ior: 1, diffuse_reflectance: {c})",
+                num(ior)
+            )),
         ]
     }
 
@@ -372,6 +408,11 @@ mod random_scenes {
                 )
             };
             let b = num(background);
+            // Rough materials and plastics render under the Physical model, in Direct and
+            // Path: a scene with one gets those.
+            let bsdf = things.contains("Rough") || things.contains("Plastic(");
+            let physical = physical || bsdf;
+            let shader = if bsdf && shader.starts_with("Global") { "Path()".to_string() } else { shader };
             format!(
                 "Scene(film: (width: 9, height: 7, spp: {spp}), seed: {seed}, camera: {camera}, \
                  shader: {shader}, model: {}, background: ({b}, {b}, {b}), \

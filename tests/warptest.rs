@@ -214,3 +214,76 @@ fn peaked_integration_keeps_every_lobe() {
         }
     }
 }
+
+/// The BSDF tests have power: a rough dielectric (GGX, alpha 0.3, eta 1.5, from 45 degrees
+/// outside and 40 inside) drawn against the pdf of alpha 0.315 (5% off), of eta 1.55, and of
+/// full-normal sampling; and a rough plastic against the pdf of another base colour (which
+/// moves the choice between coating and base) are each rejected (p below 1e-6 at 200,000
+/// samples).
+#[test]
+fn a_wrong_bsdf_pdf_is_rejected() {
+    use rtis::material::Bsdf;
+    use rtis::material::microfacet::{Distribution, Microfacet, NormalSampling};
+    use rtis::material::rough_dielectric::RoughDielectric;
+    use rtis::material::rough_plastic::RoughPlastic;
+    let case = |wo: Vec3A, drawn: Bsdf, claimed: Bsdf| Case {
+        name: String::new(),
+        draw: Box::new(move |s| {
+            let uc = s.next_f32();
+            let (u1, u2) = s.next_2d();
+            Some(direction_bin(drawn.sample(wo, uc, u1, u2)?.wi))
+        }),
+        expected: warptest::integrate_pdf_peaked(|wi| claimed.pdf(wo, wi) as f64),
+        columns: warptest::BINS_PHI,
+    };
+    let m = Microfacet::isotropic(Distribution::Ggx, 0.3);
+    let glass = |m: Microfacet, eta: f32| {
+        Bsdf::RoughDielectric(RoughDielectric {
+            microfacet: m,
+            eta,
+            specular_reflectance: Vec3A::ONE,
+            specular_transmittance: Vec3A::ONE,
+        })
+    };
+    let plastic =
+        |rho: Vec3A| Bsdf::RoughPlastic(RoughPlastic::new(m, 1.49, rho, Vec3A::ONE, false));
+    let (t, p) = (45f32.to_radians(), 30f32.to_radians());
+    let outside = Vec3A::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+    let inside = Vec3A::new(0.6428 * p.cos(), 0.6428 * p.sin(), -0.766);
+    let full = Microfacet {
+        sampling: NormalSampling::Full,
+        ..m
+    };
+    let wrong = [
+        (
+            "alpha 5% off, outside",
+            case(
+                outside,
+                glass(m, 1.5),
+                glass(Microfacet::isotropic(Distribution::Ggx, 0.315), 1.5),
+            ),
+        ),
+        (
+            "alpha 5% off, inside",
+            case(
+                inside,
+                glass(m, 1.5),
+                glass(Microfacet::isotropic(Distribution::Ggx, 0.315), 1.5),
+            ),
+        ),
+        ("eta 1.55", case(outside, glass(m, 1.5), glass(m, 1.55))),
+        ("full pdf", case(outside, glass(m, 1.5), glass(full, 1.5))),
+        (
+            "plastic base colour",
+            case(
+                outside,
+                plastic(Vec3A::splat(0.2)),
+                plastic(Vec3A::splat(0.8)),
+            ),
+        ),
+    ];
+    for (name, c) in &wrong {
+        let o = warptest::run(c, 200_000, 7);
+        assert!(o.p_value < 1e-6, "{name}: p {}", o.p_value);
+    }
+}

@@ -6,7 +6,8 @@ pub mod plot;
 pub mod report;
 pub mod warptest;
 
-use crate::material::Model;
+use crate::material::microfacet::NormalSampling;
+use crate::material::{Bsdf, Material, Model};
 use crate::render::{RenderScene, film::Image, render};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
 use crate::shader::{Global, Path, Shader};
@@ -23,6 +24,8 @@ pub struct Rung {
     pub shader: Shader,
     /// Samples per pixel.
     pub spp: u32,
+    /// The microfacet normals every rough material samples in this rung, if not its own.
+    pub normals: Option<NormalSampling>,
 }
 
 /// The result of one rung.
@@ -72,6 +75,8 @@ pub fn reference_shader() -> Shader {
 /// sampling only), so that the plot shows what MIS buys; with point lights only, two or more of
 /// them, under the Physical model, one spp ladder per light choice (every light at every
 /// vertex, one by power, one by importance), so that the plot shows what each choice costs.
+/// With rough materials, one more spp ladder samples every microfacet distribution's full
+/// normals instead of the visible ones.
 pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
     let mut rungs = Vec::new();
     let rung = |family: &str, label: String, shader, spp| Rung {
@@ -79,6 +84,7 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
         label,
         shader,
         spp,
+        normals: None,
     };
     match scene.shader {
         Shader::Path(p) => {
@@ -109,6 +115,25 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
             for (family, path) in curves {
                 for spp in [1, 4, 16, 64, 256] {
                     rungs.push(rung(family, format!("spp={spp}"), Shader::Path(path), spp));
+                }
+            }
+            // Rough materials: the same spp ladder with every microfacet sampler drawing all
+            // normals instead of the visible ones, to show what visible normals buy.
+            if scene
+                .materials
+                .iter()
+                .any(|m| microfacet_sampling(m).is_some())
+            {
+                for spp in [1, 4, 16, 64, 256] {
+                    rungs.push(Rung {
+                        normals: Some(NormalSampling::Full),
+                        ..rung(
+                            "Path full normals",
+                            format!("spp={spp}"),
+                            Shader::Path(p),
+                            spp,
+                        )
+                    });
                 }
             }
             for d in [1, 2, 3, 5] {
@@ -163,6 +188,26 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
         }
     }
     rungs
+}
+
+/// How a material samples its microfacet normals, if it has any.
+fn microfacet_sampling(m: &Material) -> Option<NormalSampling> {
+    match m {
+        Material::Bsdf(Bsdf::RoughConductor(b)) => Some(b.microfacet.sampling),
+        Material::Bsdf(Bsdf::RoughDielectric(b)) => Some(b.microfacet.sampling),
+        Material::Bsdf(Bsdf::RoughPlastic(b)) => Some(b.microfacet.sampling),
+        _ => None,
+    }
+}
+
+/// Make a rough material sample its normals by `normals`.
+fn set_normal_sampling(m: &mut Material, normals: NormalSampling) {
+    match m {
+        Material::Bsdf(Bsdf::RoughConductor(b)) => b.microfacet.sampling = normals,
+        Material::Bsdf(Bsdf::RoughDielectric(b)) => b.microfacet.sampling = normals,
+        Material::Bsdf(Bsdf::RoughPlastic(b)) => b.microfacet.sampling = normals,
+        _ => {}
+    }
 }
 
 /// Render `scene` with another shader and spp.
@@ -238,7 +283,12 @@ pub fn sweep(
     rungs
         .iter()
         .map(|r| {
-            let s = with_settings(scene, r.shader, r.spp);
+            let mut s = with_settings(scene, r.shader, r.spp);
+            if let Some(normals) = r.normals {
+                s.materials
+                    .iter_mut()
+                    .for_each(|m| set_normal_sampling(m, normals));
+            }
             let mut times = Vec::new();
             let mut first = None;
             for _ in 0..runs.max(1) {

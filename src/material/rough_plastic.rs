@@ -53,15 +53,13 @@ impl RoughPlastic {
             let x = j as f32 / (TABLE - 1) as f32;
             1.0 - coating_albedo(&microfacet, (x * x).max(1e-6), 1.0 / eta)
         });
-        // F_dr seen from inside: 2 int R_c(mu) mu dmu by the midpoint rule on 32 cosines.
-        let internal = (0..TABLE)
-            .map(|j| {
-                let mu = (j as f32 + 0.5) / TABLE as f32;
+        // F_dr seen from inside: 2 int R_c(mu) mu dmu, by the midpoint rule on 16 cosines on
+        // each side of the critical cosine of total internal reflection (where a smooth
+        // coating's R_c jumps to 1: the rule stays second order on either side).
+        let internal = 2.0
+            * split_midpoint(critical_cosine(eta), |mu| {
                 coating_albedo(&microfacet, mu, eta) * mu
-            })
-            .sum::<f32>()
-            * 2.0
-            / TABLE as f32;
+            });
         RoughPlastic {
             microfacet,
             coating: Coating::new(
@@ -131,6 +129,27 @@ impl RoughPlastic {
         self.coating
             .specular_probability(1.0 - self.transmittance(cos_o))
     }
+}
+
+/// The cosine below which light inside a coating of relative index `eta` is totally
+/// reflected, `sqrt(1 - 1 / eta^2)`; 0 when there is none (`eta <= 1`).
+fn critical_cosine(eta: f32) -> f32 {
+    if eta > 1.0 {
+        (1.0 - 1.0 / (eta * eta)).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// `int_0^1 g(mu) dmu` by the midpoint rule on 16 points in `[0, c]` and 16 in `[c, 1]`.
+fn split_midpoint(c: f32, g: impl Fn(f32) -> f32) -> f32 {
+    const N: usize = 16;
+    let mut sum = 0.0;
+    for (a, b) in [(0.0, c), (c, 1.0)] {
+        let h = (b - a) / N as f32;
+        sum += (0..N).map(|j| g(a + (j as f32 + 0.5) * h)).sum::<f32>() * h;
+    }
+    sum
 }
 
 /// `R_c(mu)`: the share of light from a direction of cosine `mu` that a rough dielectric
