@@ -120,11 +120,11 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
         // Scatter: the next ray, its weight g(wi) / pdf(wi) and its kind.
         let (next_ray, weight, next) = match (si.material, model) {
             (Material::Phong(phong), _) => {
-                l += beta * next_event(tr, &si, &phong, p);
+                l += beta * next_event(tr, &si, phong, p);
                 if !tr.effects.indirect {
                     break;
                 }
-                let Some((wi, weight, pdf)) = sample_phong(tr, &phong, &si, model, p.sampling)
+                let Some((wi, weight, pdf)) = sample_phong(tr, phong, &si, model, p.sampling)
                 else {
                     break;
                 };

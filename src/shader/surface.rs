@@ -15,7 +15,7 @@ use std::f32::consts::PI;
 
 /// A hit seen from the ray that found it.
 #[derive(Clone, Copy, Debug)]
-pub struct Interaction {
+pub struct Interaction<'a> {
     /// The hit.
     pub hit: Hit,
     /// Unit direction back along the incoming ray (towards the viewer).
@@ -23,18 +23,19 @@ pub struct Interaction {
     /// Unit shading normal on the side of `wo` (two-sided shading): the geometric normal, or
     /// the interpolated vertex normal of a smooth triangle.
     pub n: Vec3A,
-    /// The surface's material.
-    pub material: Material,
+    /// The surface's material (in the render's table: an interaction does not copy it).
+    pub material: &'a Material,
     /// Where rays leaving the hit start.
     pub origins: Origins,
     /// The surface's area light, or [`NO_LIGHT`].
     pub light: u32,
 }
 
-impl Interaction {
+impl<'a> Interaction<'a> {
     /// The interaction of `ray` with its nearest hit.
     #[inline]
-    pub fn new(tr: &Tracer, ray: &Ray, hit: Hit) -> Self {
+    pub fn new(tr: &Tracer<'a>, ray: &Ray, hit: Hit) -> Self {
+        let materials: &'a [Material] = tr.materials;
         let wo = -ray.d;
         let prim = tr.geometry.prim(hit.prim);
         let ng = if hit.n.dot(wo) < 0.0 { -hit.n } else { hit.n };
@@ -45,7 +46,7 @@ impl Interaction {
             hit,
             wo,
             n,
-            material: tr.materials[prim.material as usize],
+            material: &materials[prim.material as usize],
             origins: Origins::new(&hit),
             light: prim.light,
         }
@@ -60,7 +61,7 @@ impl Interaction {
     /// The BSDF `bsdf` of this surface in its local frame: `z` the shading normal turned to
     /// the outside (the geometric normal's side), `x` the shape's tangent made orthogonal to it.
     #[inline]
-    pub fn shading(&self, tr: &Tracer, bsdf: Bsdf) -> Shading {
+    pub fn shading(&self, tr: &Tracer, bsdf: &'a Bsdf) -> Shading<'a> {
         let n = if self.n.dot(self.hit.n) < 0.0 {
             -self.n
         } else {
@@ -82,9 +83,9 @@ impl Interaction {
 
 /// A BSDF at a hit, with the local frame it is evaluated in.
 #[derive(Clone, Copy, Debug)]
-pub struct Shading {
+pub struct Shading<'a> {
     /// The material.
-    pub bsdf: Bsdf,
+    pub bsdf: &'a Bsdf,
     /// Its local frame.
     pub frame: Frame,
 }
@@ -126,7 +127,7 @@ impl Lobe for Phong {
 
 /// A BSDF's weights are `f |cos(theta_i)|` and its own sampler's density under every model and
 /// sampling strategy: the strategies and the course's reflectance are Phong's.
-impl Lobe for Shading {
+impl Lobe for Shading<'_> {
     #[inline]
     fn is_black(&self) -> bool {
         false
@@ -436,11 +437,11 @@ pub fn specular_bounce(si: &Interaction, effects: Effects) -> Option<(Ray, Vec3A
     reason = "returned by value and matched at once by the caller; boxing the Phong variant \
               would allocate once per chain"
 )]
-pub enum ChainEnd {
+pub enum ChainEnd<'a> {
     /// At a Phong surface, reached with throughput `beta` (the product of the tints).
     Phong {
         /// The Phong hit.
-        si: Interaction,
+        si: Interaction<'a>,
         /// Its material.
         phong: Phong,
         /// Throughput of the chain.
@@ -449,9 +450,9 @@ pub enum ChainEnd {
     /// At a surface with a BSDF, reached with throughput `beta`.
     Bsdf {
         /// The hit.
-        si: Interaction,
+        si: Interaction<'a>,
         /// Its BSDF and frame.
-        shading: Shading,
+        shading: Shading<'a>,
         /// Throughput of the chain.
         beta: Vec3A,
     },
@@ -473,13 +474,13 @@ pub enum ChainEnd {
 /// an indirect ray's emitter is the direct light of the vertex it left, already counted); after
 /// a mirror or glass every emitter counts, as no light sample reaches through them.
 #[inline]
-pub fn follow_specular(
-    tr: &mut Tracer,
+pub fn follow_specular<'a>(
+    tr: &mut Tracer<'a>,
     ray: &Ray,
     kind: RayKind,
     max_specular: u32,
     see_first: bool,
-) -> (ChainEnd, Vec3A) {
+) -> (ChainEnd<'a>, Vec3A) {
     let (mut ray, mut kind, mut beta) = (*ray, kind, Vec3A::ONE);
     let mut le = Vec3A::ZERO;
     // `chain` counts the specular bounces that led to this ray.
@@ -492,7 +493,10 @@ pub fn follow_specular(
             le += beta * emitted(tr, &si);
         }
         match si.material {
-            Material::Phong(phong) => return (ChainEnd::Phong { si, phong, beta }, le),
+            Material::Phong(phong) => {
+                let phong = *phong;
+                return (ChainEnd::Phong { si, phong, beta }, le);
+            }
             Material::Bsdf(bsdf) => {
                 let shading = si.shading(tr, bsdf);
                 return (ChainEnd::Bsdf { si, shading, beta }, le);

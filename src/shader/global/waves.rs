@@ -347,8 +347,8 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
     if !phong.is_black() {
         let index = s.phongs.len() as u32;
         s.ends
-            .push(End::new(&si, &phong, index, tr.model, s.lit.len() as u32));
-        s.phongs.push(phong);
+            .push(End::new(&si, phong, index, tr.model, s.lit.len() as u32));
+        s.phongs.push(*phong);
     }
     // Eq. 2 at depth D ends the path; above it, task 2: Eq. 4 with the directions fixed to
     // the normal w_n and the reflection w_r, weighted by 1 / (4 pi).
@@ -366,7 +366,7 @@ fn shade(tr: &mut Tracer, g: &Global, s: &mut Scratch, depth: u32, k: usize, hit
     s.kids[i as usize] = first;
     let (wo, n) = (si.wo, si.n);
     for (k, w) in [n, reflect(wo, n)].into_iter().enumerate() {
-        let b = beta * reflectance(tr.model, &phong, w, wo, n) / (4.0 * PI);
+        let b = beta * reflectance(tr.model, phong, w, wo, n) / (4.0 * PI);
         s.add_node(b);
         let ray = si.spawn(w);
         s.children.push(first + k as u32, ray);

@@ -126,8 +126,8 @@ impl Columns {
 pub(super) struct Slot {
     /// The primitive.
     prim: u32,
-    /// Its material.
-    material: Material,
+    /// Its material's index in the render's table.
+    material: u32,
     /// Its area light, or [`NO_LIGHT`].
     light: u32,
     /// A Phong material's parameters (black for the others, whose lanes never read them: the
@@ -148,14 +148,13 @@ fn slot_table(tr: &Tracer, slots: &mut Vec<Slot>) {
     let geometry = tr.geometry;
     while let Some(prim) = geometry.slot_prim(slots.len() as u32) {
         let p = geometry.prim(prim);
-        let material = tr.materials[p.material as usize];
-        let phong = match material {
+        let phong = match tr.materials[p.material as usize] {
             Material::Phong(phong) => Some(phong),
             _ => None,
         };
         slots.push(Slot {
             prim,
-            material,
+            material: p.material,
             light: p.light,
             phong: phong.unwrap_or(Phong {
                 kd: Vec3A::ZERO,
@@ -388,6 +387,7 @@ unsafe fn chunk<L: Floats>(
         for (c, x) in d.into_iter().enumerate() {
             x.write_to(&mut dv[c]);
         }
+        let materials = tr.materials;
         let mut bits = whole;
         while bits != 0 {
             let i = bits.trailing_zeros() as usize;
@@ -404,7 +404,7 @@ unsafe fn chunk<L: Floats>(
                 },
                 wo: -vec3(&dv, 0, i),
                 n: vec3(&v, NS, i),
-                material: e.material,
+                material: &materials[e.material as usize],
                 origins: Origins {
                     front: vec3(&v, FRONT, i),
                     back: vec3(&v, BACK, i),
