@@ -98,12 +98,12 @@ pub fn extract(scene: &Scene) -> RenderScene {
             }
         }
     }
-    // Planes that no ray crosses (not glass) keep every ray on the camera's side; a point
-    // light there needs no plane tested on its shadow rays.
+    // Planes that no ray crosses (not glass, smooth or rough) keep every ray on the camera's
+    // side; a point light there needs no plane tested on its shadow rays.
     let starts = camera.starts();
     for p in &mut prims {
         if let Shape::Plane(plane) = p.shape
-            && !matches!(materials[p.material as usize], Material::Transmissive(_))
+            && !materials[p.material as usize].transmits()
         {
             p.shape = Shape::Plane(plane.oriented(plane.facing(&starts)));
         }

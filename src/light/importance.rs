@@ -14,9 +14,10 @@ use glam::Vec3A;
 /// The unshadowed irradiance `I cos(theta) / d^2` that `light` sends to `p` across the unit
 /// normal `n`, with `I` its largest channel, in double precision (finite for every finite
 /// input: `I <= f32::MAX` and `d^2 >= 2^-149`). Zero when the light is below the surface or
-/// coincides with `p`, exactly when [`Light::incident`] gives no light facing `n`.
+/// coincides with `p`, exactly when [`Light::incident`] gives no light facing `n`; with
+/// `transmits` (a surface that passes light, as rough glass), `|cos(theta)|` on either side.
 #[inline]
-pub fn importance(light: &Light, p: Vec3A, n: Vec3A) -> f64 {
+pub fn importance(light: &Light, p: Vec3A, n: Vec3A, transmits: bool) -> f64 {
     let ((wi, _, d2), i_max) = match light {
         Light::Point(l) => (l.toward(p), l.intensity.max_element()),
     };
@@ -24,7 +25,11 @@ pub fn importance(light: &Light, p: Vec3A, n: Vec3A) -> f64 {
     // so that a light with a term has a weight. Computed whatever the case and then selected:
     // whether a light is above the surface varies from vertex to vertex, and a branch on it
     // would be mispredicted.
-    let cos = wi.dot(n);
+    let cos = if transmits {
+        wi.dot(n).abs()
+    } else {
+        wi.dot(n)
+    };
     let lit = d2 != 0.0 && d2.is_finite() && cos > 0.0;
     let w = f64::from(i_max.max(0.0)) * f64::from(cos) / f64::from(d2);
     if lit { w } else { 0.0 }
@@ -35,15 +40,22 @@ pub fn importance(light: &Light, p: Vec3A, n: Vec3A) -> f64 {
 const CACHED: usize = 16;
 
 /// The point light that `u`, uniform in [0, 1), picks among `lights` at `p` with normal `n`,
-/// each in proportion to its [`importance`], with the probability of picking it; `None` when
-/// no light has any importance there (none lights the point).
+/// each in proportion to its [`importance`] (from both sides when the surface `transmits`), with
+/// the probability of picking it; `None` when no light has any importance there (none lights
+/// the point).
 #[inline]
-pub fn choose_by_importance(lights: &[Light], p: Vec3A, n: Vec3A, u: f64) -> Option<(usize, f64)> {
+pub fn choose_by_importance(
+    lights: &[Light],
+    p: Vec3A,
+    n: Vec3A,
+    transmits: bool,
+    u: f64,
+) -> Option<(usize, f64)> {
     // Total importance, keeping the first lights' weights for the second pass.
     let mut cached = [0.0f64; CACHED];
     let mut total = 0.0;
     for (k, light) in lights.iter().enumerate() {
-        let w = importance(light, p, n);
+        let w = importance(light, p, n, transmits);
         if let Some(c) = cached.get_mut(k) {
             *c = w;
         }
@@ -54,7 +66,7 @@ pub fn choose_by_importance(lights: &[Light], p: Vec3A, n: Vec3A, u: f64) -> Opt
     }
     let weight = |k: usize| match cached.get(k) {
         Some(&w) => w,
-        None => importance(&lights[k], p, n),
+        None => importance(&lights[k], p, n, transmits),
     };
     // The first light whose cumulative weight exceeds u * total: the number of lights whose
     // cumulative weight does not (a prefix, as the sums never decrease), counted without a
@@ -98,7 +110,7 @@ mod tests {
             point(-1.0, 0.5, 2.0, 0.5),
         ];
         let (p, n) = (Vec3A::ZERO, Vec3A::Y);
-        let w: Vec<f64> = lights.iter().map(|l| importance(l, p, n)).collect();
+        let w: Vec<f64> = lights.iter().map(|l| importance(l, p, n, false)).collect();
         let total: f64 = w.iter().sum();
         assert_eq!(w[2], 0.0);
         // Light 0: I = 2, d = 1, cos = 1.
@@ -107,7 +119,7 @@ mod tests {
         let mut counts = [0usize; 4];
         for k in 0..steps {
             let u = (k as f64 + 0.5) / steps as f64;
-            let (j, pmf) = choose_by_importance(&lights, p, n, u).unwrap();
+            let (j, pmf) = choose_by_importance(&lights, p, n, false, u).unwrap();
             assert_eq!(pmf, w[j] / total);
             counts[j] += 1;
         }
@@ -131,7 +143,7 @@ mod tests {
             point(0.0, -1.0, 0.0, 9.0), // below the surface: weight 0
         ];
         let (p, n) = (Vec3A::ZERO, Vec3A::Y);
-        let (j, pmf) = choose_by_importance(&lights, p, n, 1.0).unwrap();
+        let (j, pmf) = choose_by_importance(&lights, p, n, false, 1.0).unwrap();
         assert_eq!(j, 1);
         assert!(pmf > 0.0);
     }
@@ -153,11 +165,11 @@ mod tests {
             })
             .collect();
         let (p, n) = (Vec3A::new(0.1, 0.0, -0.2), Vec3A::Y);
-        let w: Vec<f64> = lights.iter().map(|l| importance(l, p, n)).collect();
+        let w: Vec<f64> = lights.iter().map(|l| importance(l, p, n, false)).collect();
         let total: f64 = w.iter().sum();
         for k in 0..1000 {
             let u = (k as f64 + 0.5) / 1000.0;
-            let (j, pmf) = choose_by_importance(&lights, p, n, u).unwrap();
+            let (j, pmf) = choose_by_importance(&lights, p, n, false, u).unwrap();
             let mut acc = 0.0;
             let first = w
                 .iter()
@@ -177,15 +189,25 @@ mod tests {
     fn nothing_to_choose() {
         let below = [point(0.0, -1.0, 0.0, 1.0), point(0.0, 0.0, 0.0, 1.0)];
         assert_eq!(
-            choose_by_importance(&below, Vec3A::ZERO, Vec3A::Y, 0.3),
+            choose_by_importance(&below, Vec3A::ZERO, Vec3A::Y, false, 0.3),
             None
         );
-        assert_eq!(choose_by_importance(&[], Vec3A::ZERO, Vec3A::Y, 0.3), None);
+        assert_eq!(
+            choose_by_importance(&[], Vec3A::ZERO, Vec3A::Y, false, 0.3),
+            None
+        );
+        // Through a surface that transmits, the light below counts, by |cos|: it is the only
+        // one with a weight (the other sits at the point).
+        assert_eq!(
+            choose_by_importance(&below, Vec3A::ZERO, Vec3A::Y, true, 0.3),
+            Some((0, 1.0))
+        );
+        assert_eq!(importance(&below[0], Vec3A::ZERO, Vec3A::Y, true), 1.0);
         // The largest u below 1 still picks a light.
         let one = [point(0.0, 1.0, 0.0, 1.0), point(0.0, 2.0, 0.0, 1.0)];
         let u = 1.0 - f64::EPSILON / 2.0;
         assert_eq!(
-            choose_by_importance(&one, Vec3A::ZERO, Vec3A::Y, u).map(|c| c.0),
+            choose_by_importance(&one, Vec3A::ZERO, Vec3A::Y, false, u).map(|c| c.0),
             Some(1)
         );
     }
@@ -205,10 +227,11 @@ mod tests {
             in_room: false,
         });
         for l in [near, far] {
-            let w = importance(&l, Vec3A::ZERO, Vec3A::Y);
+            let w = importance(&l, Vec3A::ZERO, Vec3A::Y, false);
             assert!(w.is_finite() && w > 0.0, "{w}");
         }
-        let (j, pmf) = choose_by_importance(&[near, far], Vec3A::ZERO, Vec3A::Y, 0.5).unwrap();
+        let (j, pmf) =
+            choose_by_importance(&[near, far], Vec3A::ZERO, Vec3A::Y, false, 0.5).unwrap();
         assert_eq!((j, pmf), (0, 1.0));
     }
 }

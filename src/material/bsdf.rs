@@ -59,6 +59,7 @@ impl Bsdf {
     /// u2)`; `None` when it carries nothing.
     #[inline]
     pub fn sample(&self, wo: Vec3A, uc: f32, u1: f32, u2: f32) -> Option<BsdfSample> {
+        let below = wo.z < 0.0 && !self.transmits();
         let (up, _) = self.facing(wo, wo);
         let mut s = match self {
             Bsdf::RoughConductor(b) => b.sample(up, u1, u2),
@@ -67,7 +68,7 @@ impl Bsdf {
             Bsdf::Plastic(b) => b.sample(up, uc, u1, u2),
         }?;
         // A two-sided material seen from below: turn wi back to wo's side.
-        if up != wo {
+        if below {
             s.wi.z = -s.wi.z;
         }
         Some(s)

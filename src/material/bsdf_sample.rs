@@ -11,6 +11,9 @@ pub struct BsdfSample {
     pub weight: Vec3A,
     /// The density of `wi` per solid angle; for a delta lobe, the chance of choosing it.
     pub pdf: f32,
+    /// `eta' = n_i / n_o`, the index on `wi`'s side over `wo`'s, for a direction through a
+    /// dielectric (its weight then holds the radiance scaling `1 / eta'^2`); 1 otherwise.
+    pub eta: f32,
     /// True when `wi` comes from a delta lobe (a smooth coating's mirror), which `eval` and
     /// `pdf` leave out: no light sample can find it.
     pub delta: bool,
@@ -29,6 +32,7 @@ impl BsdfSample {
             wi,
             weight,
             pdf,
+            eta: 1.0,
             delta: false,
         })
     }

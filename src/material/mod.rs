@@ -59,6 +59,16 @@ impl Material {
         }
     }
 
+    /// True for materials that let light through (smooth and rough glass): rays cross them.
+    #[inline]
+    pub fn transmits(&self) -> bool {
+        match self {
+            Material::Transmissive(_) => true,
+            Material::Bsdf(b) => b.transmits(),
+            Material::Phong(_) | Material::Mirror(_) | Material::Conductor(_) => false,
+        }
+    }
+
     /// True for materials that only scatter into one direction (mirror, metal, glass).
     #[inline]
     pub fn is_specular(&self) -> bool {

@@ -64,6 +64,7 @@ impl Plastic {
                 wi,
                 weight: c.specular_reflectance * (f / ps),
                 pdf: ps,
+                eta: 1.0,
                 delta: true,
             });
         }

@@ -38,8 +38,8 @@ pub struct RoughDielectric {
     pub specular_transmittance: Vec3A,
 }
 
-/// The value and density of one way through the interface.
-struct Lobe {
+/// The value and density of one way through the interface (reflected or refracted).
+struct Way {
     /// `f |cos(theta_i)|`.
     f: Vec3A,
     /// The sampler's density per solid angle.
@@ -96,13 +96,22 @@ impl RoughDielectric {
             let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
             -wo / etap + (cos_om / etap - cos_t) * n
         };
-        let lobe = self.lobe(wo, wi, wm)?;
-        BsdfSample::glossy(wi, lobe.f, lobe.pdf)
+        // Drawn by the way it was meant to be (a reflection that ends below the surface, or a
+        // refraction above it, is not a sample), wi's value and density are those `eval` and
+        // `pdf` find (from the half vector of wo and wi, not the sampled normal), so that MIS
+        // weighs this sample and a light sample of the same direction with one density.
+        self.lobe(wo, wi, wm)?; // the way it was drawn exists (wi on the side it was meant for)
+        let way = self.through(wo, wi)?;
+        let mut s = BsdfSample::glossy(wi, way.f, way.pdf)?;
+        if wi.z * cos_o < 0.0 {
+            s.eta = etap;
+        }
+        Some(s)
     }
 
     /// The lobe that takes `wo` to `wi`, with its microfacet normal found from the two.
     #[inline]
-    fn through(&self, wo: Vec3A, wi: Vec3A) -> Option<Lobe> {
+    fn through(&self, wo: Vec3A, wi: Vec3A) -> Option<Way> {
         let (cos_o, cos_i) = (wo.z, wi.z);
         if cos_o == 0.0 || cos_i == 0.0 {
             return None;
@@ -125,7 +134,7 @@ impl RoughDielectric {
     /// `f |cos(theta_i)|` and the density of the way from `wo` to `wi` through the facet of
     /// normal `wm` (facing +z); `None` where the facet faces away from either direction.
     #[inline]
-    fn lobe(&self, wo: Vec3A, wi: Vec3A, wm: Vec3A) -> Option<Lobe> {
+    fn lobe(&self, wo: Vec3A, wi: Vec3A, wm: Vec3A) -> Option<Way> {
         let (cos_o, cos_i) = (wo.z, wi.z);
         let (om, im) = (wo.dot(wm), wi.dot(wm));
         // Each direction must see the facet's side it lies on.
@@ -139,7 +148,7 @@ impl RoughDielectric {
         let pdf_m = m.pdf_normal(wo * cos_o.signum(), wm);
         let lobe = if cos_o * cos_i > 0.0 {
             // Reflection (eq. 20) and the half-vector Jacobian 1 / (4 |wo.wm|) (eq. 14).
-            Lobe {
+            Way {
                 f: self.specular_reflectance * (f * dg / (4.0 * cos_o.abs())),
                 pdf: f * pdf_m / (4.0 * om.abs()),
             }
@@ -148,7 +157,7 @@ impl RoughDielectric {
             let denom = im + om / etap;
             let denom2 = denom * denom;
             let ft = (1.0 - f) * dg * (im * om / (cos_o * denom2)).abs() / (etap * etap);
-            Lobe {
+            Way {
                 f: self.specular_transmittance * ft,
                 pdf: (1.0 - f) * pdf_m * im.abs() / denom2,
             }

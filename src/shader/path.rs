@@ -89,6 +89,10 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     let mut ray = *camera_ray;
     let mut kind = RayKind::Camera;
     let mut depth = 0;
+    // The product of eta'^2 over the dielectric interfaces crossed: beta * eta_scale is the
+    // throughput without the radiance scaling 1 / eta'^2, which Russian roulette reads, so
+    // that a path inside glass is not ended for its lower radiance (pbrt-v4's `etaScale`).
+    let mut eta_scale = 1.0f32;
     // The Phong vertex the ray left, if it was BRDF-sampled there (None for camera rays and
     // after mirrors and glass).
     let mut scattered: Option<Scattered> = None;
@@ -152,6 +156,7 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                     p: si.hit.p,
                     pdf: s.pdf,
                 });
+                eta_scale *= s.eta * s.eta;
                 (si.spawn(frame.to_world(s.wi)), s.weight, RayKind::Indirect)
             }
             // Fresnel-weighted choice between reflection and refraction.
@@ -164,6 +169,7 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                 } else {
                     // Radiance crossing into the wo side is scaled by (n_wo / n_wi)^2 = eta^2.
                     let w = g.color * (r.eta * r.eta);
+                    eta_scale /= r.eta * r.eta;
                     (r.wt, w, RayKind::Refraction, tr.effects.refraction)
                 };
                 // An effect that is off ends the path.
@@ -186,7 +192,7 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
         depth += 1;
         // Russian roulette: survive with probability q, divide by q to stay unbiased.
         if depth >= p.rr_depth {
-            let q = beta.max_element().min(0.95);
+            let q = (beta * eta_scale).max_element().min(0.95);
             if q <= 0.0 || tr.sampler.next_f32() >= q {
                 break;
             }

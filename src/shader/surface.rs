@@ -92,8 +92,11 @@ pub struct Shading<'a> {
 
 /// What next-event estimation needs of the surface at a vertex: how it reflects light from
 /// a light's direction towards the viewer, and the density with which the path's own sampler
-/// would have chosen that direction (for MIS). Phong and the BSDFs answer it; the functions
-/// below are generic over it, so that Phong's code is what it was.
+/// would have chosen that direction (for MIS). Phong and the BSDFs answer it.
+///
+/// A trait over a closed set of two, not an enum: the functions below are generic over it, so
+/// that each is compiled once for Phong, exactly the code it was before the BSDFs (same
+/// speed, same pixels: `bench/commit_compare.py`), and once for a BSDF in its frame.
 pub trait Lobe {
     /// True if the surface reflects nothing (no shadow ray can change that).
     fn is_black(&self) -> bool;
@@ -301,7 +304,8 @@ pub fn one_light<L: Lobe>(
             let (start, share) = tr.emitters.point_share();
             let v = ((u - start) / share).clamp(0.0, 1.0 - f64::EPSILON / 2.0);
             let lights = tr.lights;
-            let Some((j, p)) = choose_by_importance(lights, si.hit.p, si.n, v) else {
+            let Some((j, p)) = choose_by_importance(lights, si.hit.p, si.n, lobe.transmits(), v)
+            else {
                 return Vec3A::ZERO;
             };
             // A light chosen with a chance below f32's range (about 1e-38) would weigh inf, and
