@@ -184,7 +184,9 @@ fn broken_scene_is_located_with_nonzero_exit() {
         assert_eq!(o.status.code(), Some(1));
         let e = stderr(&o);
         assert!(
-            e.contains("broken.ron:3:47: must be a length from 1e-9 to 1e9 scene units, got -1"),
+            e.contains(
+                "broken.ron:3:47: `radius` must be a length from 1e-9 to 1e9 scene units, got -1"
+            ),
             "{e}"
         );
         assert!(!e.contains("panicked"), "{e}");

@@ -54,3 +54,21 @@ fn readme_error_example_is_real() {
         example.trim_end()
     );
 }
+
+/// The README's first scene loads as written, and renders without a dropped sample.
+#[test]
+fn readme_first_scene_loads() {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let section = &readme[readme
+        .find("### Your first scene")
+        .expect("the walk-through")..];
+    let start = section.find("```ron\n").expect("its scene") + "```ron\n".len();
+    let end = start + section[start..].find("```").unwrap();
+    let mut scene = rtis::scene::load_str(&section[start..end], "first.ron", None)
+        .unwrap_or_else(|e| panic!("{e}"));
+    scene.settings.film.width = 32;
+    scene.settings.film.height = 24;
+    scene.settings.film.spp = 2;
+    let r = rtis::render::render(&rtis::extract(&scene), &|| {});
+    assert_eq!(r.stats.dropped, 0);
+}

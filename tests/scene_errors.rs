@@ -46,6 +46,10 @@ const CASES: &[(&str, &str)] = &[
         "Scene(entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: Conductor(eta: (-1, 1, 1), k: (1, 1, 1)))])",
     ),
     (
+        "camera looking straight down with the default up",
+        "Scene(camera: Orthographic(position: (0, 5, 0), look_at: (0, 0, 0), height: 2))",
+    ),
+    (
         "roughness below its range",
         "Scene(model: Physical, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 5), radius: 1), material: RoughConductor(alpha: 1e-5))])",
     ),

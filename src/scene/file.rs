@@ -204,21 +204,46 @@ impl CameraFields {
 impl TryFrom<CameraFields> for CameraDesc {
     type Error = String;
     fn try_from(c: CameraFields) -> Result<Self, String> {
-        let (position, look_at, up) = c.frame();
+        Ok(CameraDesc(c))
+    }
+}
+
+impl CameraDesc {
+    /// Why this camera has no view: the field to blame (`look_at` or `up`) and the message
+    /// with a fix; `None` when it is sound. Checked after parsing, where the field's place in
+    /// the file is known (`super::load`).
+    pub fn degenerate(&self) -> Option<(&'static str, String)> {
+        let (position, look_at, up) = self.0.frame();
         let forward = look_at - position;
         if forward.length_squared() == 0.0 {
-            return Err(
-                "degenerate camera: look_at equals position, so there is no view \
-                        direction"
+            return Some((
+                "look_at",
+                "degenerate camera: look_at equals position, so there is no view direction: \
+                 move look_at to the point the camera should face"
                     .into(),
-            );
+            ));
         }
-        if forward.normalize().cross(up.normalize()).length() < 1e-6 {
-            return Err("degenerate camera: up is parallel to the view direction \
-                        (look_at - position)"
-                .into());
+        let f = forward.normalize();
+        if f.cross(up.normalize()).length() < 1e-6 {
+            // Suggest the world axis least aligned with the view.
+            let a = f.abs();
+            let axis = if a.x <= a.y && a.x <= a.z {
+                "(1, 0, 0)"
+            } else if a.y <= a.z {
+                "(0, 1, 0)"
+            } else {
+                "(0, 0, 1)"
+            };
+            return Some((
+                "up",
+                format!(
+                    "degenerate camera: up is parallel to the view direction (look_at - \
+                     position), so the image has no vertical: choose another, e.g. \
+                     `up: {axis}`"
+                ),
+            ));
         }
-        Ok(CameraDesc(c))
+        None
     }
 }
 

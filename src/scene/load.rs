@@ -71,7 +71,12 @@ fn parse(src: &mut Source) -> Result<SceneFile, SceneError> {
     let file = ron_options()
         .from_str::<SceneFile>(&src.text)
         .map_err(|e| {
-            let start = offset_of(&src.text, e.span.start.line, e.span.start.col);
+            let mut start = offset_of(&src.text, e.span.start.line, e.span.start.col);
+            // A value its type refused is reported at its end: point at its start instead (a
+            // tuple's opening bracket), where its field's name is.
+            if matches!(e.code, ron::Error::Message(_)) {
+                start = super::messages::value_start(&src.text, start);
+            }
             let end = offset_of(&src.text, e.span.end.line, e.span.end.col);
             src.error(start, explain(&e.code, &src.text, start, end))
         })?;
@@ -80,8 +85,9 @@ fn parse(src: &mut Source) -> Result<SceneFile, SceneError> {
     Ok(file)
 }
 
-/// Duplicate material keys, duplicate entity names, and transforms on entities without a
-/// shape, each at the second occurrence (or the transform) and naming the first.
+/// A degenerate camera (at `look_at` or `up`), duplicate material keys, duplicate entity names,
+/// and transforms on entities without a shape, each at the second occurrence (or the
+/// transform) and naming the first.
 fn check(src: &Source, file: &SceneFile) -> Result<(), SceneError> {
     let text = &src.text;
     let tree = src.tree.as_ref();
@@ -108,6 +114,16 @@ fn check(src: &Source, file: &SceneFile) -> Result<(), SceneError> {
             }
             seen.insert(name, key.start);
         }
+    }
+    // A camera without a view, at the field to blame (`up` is absent when defaulted: then the
+    // camera itself).
+    if let Some((field, why)) = file.camera.as_ref().and_then(|c| c.degenerate()) {
+        let camera = tree.and_then(|t| t.get("camera", text));
+        let at = camera
+            .and_then(|c| c.get(field, text))
+            .or(camera)
+            .map_or(0, |n| n.start);
+        return Err(src.error(at, why));
     }
     let entities = file.entities.as_deref().unwrap_or_default();
     let mut seen: BTreeMap<&str, usize> = BTreeMap::new();

@@ -627,7 +627,12 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
         Error::UnclosedBlockComment => "a `/*` comment is not closed: end it with `*/`".into(),
         Error::ExpectedStringEnd => "a string is not closed: end it with `\"`".into(),
         Error::ExceededRecursionLimit => "brackets nested too deeply (more than 128 levels)".into(),
-        Error::Message(m) => m.clone(),
+        // A value its type refused: name the field it was given for.
+        Error::Message(m) => match field_before(text, start) {
+            Some(f) if m.starts_with("must be") => format!("`{f}` {m}"),
+            Some(f) => format!("`{f}`: {m}"),
+            None => m.clone(),
+        },
         other => {
             let m = other.to_string();
             let mut c = m.chars();
@@ -637,6 +642,44 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
             }
         }
     }
+}
+
+/// Where the value that ends at `end` starts: for a tuple whose closing bracket is at `end`,
+/// its opening bracket; otherwise `end` itself.
+pub fn value_start(text: &str, end: usize) -> usize {
+    if text.as_bytes().get(end) != Some(&b')') {
+        return end;
+    }
+    let mut depth = 0usize;
+    for (i, c) in text[..=end].char_indices().rev() {
+        match c {
+            ')' => depth += 1,
+            '(' => {
+                depth -= 1;
+                if depth == 0 {
+                    return i;
+                }
+            }
+            _ => {}
+        }
+    }
+    end
+}
+
+/// The name of the field whose value starts at `start` (`radius` in `radius: 0`), if the
+/// text before it is `name:`.
+fn field_before(text: &str, start: usize) -> Option<&str> {
+    let before = text.get(..start)?.trim_end();
+    let before = before.strip_suffix(':')?.trim_end();
+    let name_start = before
+        .char_indices()
+        .rev()
+        .take_while(|(_, c)| c.is_ascii_alphanumeric() || *c == '_')
+        .last()?
+        .0;
+    let name = &before[name_start..];
+    name.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+        .then_some(name)
 }
 
 #[cfg(test)]
