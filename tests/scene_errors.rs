@@ -541,3 +541,53 @@ fn unreadable_mesh_gives_the_os_reason_at_its_path() {
     );
     assert!(e.message.contains("No such file or directory"), "{e}");
 }
+
+/// The warnings for scenes that render but cannot show what was meant, each located at the
+/// entity to blame: shapes lit by nothing, and a point light inside a sphere. Neither fires
+/// when the scene is lit (a light, an emitter, a sky, or Global's ambient term), nor for a
+/// light outside the sphere or a shader that does not shade.
+#[test]
+fn silent_mistakes_are_warned_at_their_place() {
+    let warnings = |text: &str| {
+        load_str(text, "w.ron", Some(Path::new("")))
+            .unwrap_or_else(|e| panic!("{e}"))
+            .warnings
+    };
+    let dark = "Scene(shader: Path(), model: Physical, entities: [\n  (shape: Sphere(center: (0, 0, 5), radius: 1), material: Mirror()),\n])";
+    let w = warnings(dark);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with(
+            "w.ron:2:11: the scene has shapes but no light, no emitter and a black background"
+        ),
+        "{w:?}"
+    );
+    for lit in [
+        dark.replace("entities: [", "background: (0.1, 0.1, 0.1), entities: ["),
+        dark.replace(
+            "])",
+            "  (light: Point(position: (0, 3, 5), intensity: (1, 1, 1))),\n])",
+        ),
+        dark.replace(
+            "radius: 1), material: Mirror())",
+            "radius: 1), emitter: Emitter(radiance: (1, 1, 1)))",
+        ),
+        dark.replace(
+            "shader: Path(), model: Physical",
+            "shader: Global(ambient: (0.2, 0.2, 0.2))",
+        ),
+        dark.replace("shader: Path()", "shader: Depth(max_distance: 10)"),
+    ] {
+        assert!(warnings(&lit).is_empty(), "{lit}: {:?}", warnings(&lit));
+    }
+    let inside = "Scene(entities: [\n  (shape: Sphere(center: (0, 0, 5), radius: 1), material: Mirror()),\n  (light: Point(position: (0, 0.5, 5), intensity: (1, 1, 1))),\n])";
+    let w = warnings(inside);
+    assert_eq!(
+        w,
+        [
+            "w.ron:3:11: this point light is inside the sphere at w.ron:2:11: only the sphere's inside \
+          sees it, and its shadow rays are wasted elsewhere"
+        ],
+    );
+    assert!(warnings(&inside.replace("(0, 0.5, 5)", "(0, 1.5, 5)")).is_empty());
+}

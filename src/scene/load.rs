@@ -4,8 +4,8 @@
 use super::SceneError;
 use super::error::{clip, line_col};
 use super::file::{
-    CameraDesc, EffectsDesc, EntityDesc, FilmDesc, MaterialDesc, Model, SceneFile, ShaderDesc,
-    TableMaterial,
+    CameraDesc, EffectsDesc, EntityDesc, FilmDesc, LightDesc, MaterialDesc, Model, SceneFile,
+    ShaderDesc, ShapeDesc, TableMaterial,
 };
 use super::messages::{explain, offset_of};
 use super::spans::{self, Node};
@@ -336,6 +336,70 @@ fn resolve(
 }
 
 impl Resolved {
+    /// Warnings, located, for scenes that render but cannot show what was meant:
+    ///
+    /// - shapes lit by nothing: no point light, no emitter, a black background, and a shader
+    ///   that shades (Direct, Path, or Global without an ambient term);
+    /// - a point light inside a sphere (as written, without a `transform`): the sphere's
+    ///   outside never sees it.
+    ///
+    /// Not detected (documented in docs/scene-format.md): a light enclosed by a closed mesh or
+    /// by a transformed sphere, and an emitter that faces away from everything the camera sees.
+    fn silent_mistakes(&self, settings: &Settings) -> Vec<String> {
+        let mut warnings = Vec::new();
+        let at = |idx: usize, i: usize, field: &str| {
+            let src = &self.sources[idx];
+            let node = src.entity(i);
+            let off = node
+                .and_then(|n| n.get(field, &src.text))
+                .or(node)
+                .map_or_else(|| src.top_field("entities"), |n| n.start);
+            let (line, col) = line_col(&src.text, off);
+            format!("{}:{line}:{col}", src.name)
+        };
+        let shades = match settings.shader {
+            Shader::Direct { .. } | Shader::Path(_) => true,
+            Shader::Global(g) => g.ambient == glam::Vec3A::ZERO,
+            _ => false,
+        };
+        let lit = self
+            .entities
+            .iter()
+            .any(|(EntityDesc(e), ..)| e.light.is_some() || e.emitter.is_some());
+        if let Some((_, idx, i)) = self
+            .entities
+            .iter()
+            .find(|(EntityDesc(e), ..)| e.shape.is_some())
+            && shades
+            && !lit
+            && settings.background == glam::Vec3A::ZERO
+        {
+            warnings.push(format!(
+                "{}: the scene has shapes but no light, no emitter and a black background: every \
+                 shaded pixel is black; add a `light: Point(...)`, an `emitter` or a `background`",
+                at(*idx, *i, "shape")
+            ));
+        }
+        for (EntityDesc(light), lidx, li) in &self.entities {
+            let Some(LightDesc::Point { position, .. }) = &light.light else {
+                continue;
+            };
+            for (EntityDesc(e), sidx, si) in &self.entities {
+                if let (Some(ShapeDesc::Sphere { center, radius }), None) = (&e.shape, &e.transform)
+                    && (position.0 - center.0).length() < radius.0
+                {
+                    warnings.push(format!(
+                        "{}: this point light is inside the sphere at {}: only the sphere's \
+                         inside sees it, and its shadow rays are wasted elsewhere",
+                        at(*lidx, *li, "light"),
+                        at(*sidx, *si, "shape")
+                    ));
+                }
+            }
+        }
+        warnings
+    }
+
     fn into_scene(self, origin: String) -> Result<Scene, SceneError> {
         let mut world = hecs::World::new();
         let mut warnings = Vec::new();
@@ -436,6 +500,7 @@ impl Resolved {
         if self.entities.is_empty() {
             warnings.push("the scene has no entities: every pixel shows the background".into());
         }
+        warnings.extend(self.silent_mistakes(&settings));
         Ok(Scene {
             world,
             settings,
