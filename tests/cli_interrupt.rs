@@ -223,3 +223,55 @@ fn sigterm_during_the_write_waits_for_it() {
     assert_eq!((img.width(), img.height()), (64, 48));
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// Ctrl-C during `rtis converge` finishes the rung in flight and writes the rungs done
+/// (converge.csv and converge.md, beside the reference), then exits 130; no rung after it runs.
+#[test]
+fn ctrl_c_during_converge_keeps_the_rungs_done() {
+    let d = tmp("converge");
+    let s = scene(&d, "Global(samples: 4, max_depth: 1)");
+    let out = d.join("out");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rtis"))
+        .args([
+            "converge",
+            s.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .args([
+            "--width",
+            "48",
+            "--runs",
+            "1",
+            "--seeds",
+            "1",
+            "--reference-spp",
+            "8",
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run rtis");
+    let err = child.stderr.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(err).lines() {
+            let Ok(line) = line else { break };
+            let _ = tx.send(line);
+        }
+    });
+    // The first rung's line: the ladder is running.
+    wait_for(&rx, "direct");
+    signal(&child, "-INT");
+    let status = child.wait().unwrap();
+    let err = rest(&rx);
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted: wrote the"), "{err}");
+    let csv = std::fs::read_to_string(out.join("converge.csv")).unwrap();
+    let rows = csv.lines().count() - 1;
+    assert!(rows >= 1, "{csv}");
+    // The ladder of a Global scene has 15 rungs; far fewer ran.
+    assert!(rows < 15, "{csv}");
+    assert!(out.join("converge.md").exists() && out.join("reference.exr").exists());
+    assert!(!out.join("report.html").exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}

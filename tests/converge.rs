@@ -46,7 +46,7 @@ fn course_ladder_sweeps_and_path_converges() {
         &|| {},
     )
     .image;
-    let measured = converge::sweep(&s, &reference, 0.0, &rungs, 1, 4, &mut |_| {});
+    let measured = converge::sweep(&s, &reference, 0.0, &rungs, 1, 4, &mut |_| true);
     let rows: Vec<converge::Row> = measured.iter().map(|m| m.row.clone()).collect();
     let err = |fam: &str, label: &str| {
         rows.iter()
@@ -319,10 +319,11 @@ fn light_choice_curves_for_point_lit_path_scenes() {
         .into_iter()
         .filter(|r| r.label == "spp=16" && r.family != "Path 16 spp")
         .collect();
-    let rows: Vec<converge::Row> = converge::sweep(&s, &reference, 0.0, &at_16, 1, 4, &mut |_| {})
-        .into_iter()
-        .map(|m| m.row)
-        .collect();
+    let rows: Vec<converge::Row> =
+        converge::sweep(&s, &reference, 0.0, &at_16, 1, 4, &mut |_| true)
+            .into_iter()
+            .map(|m| m.row)
+            .collect();
     let err = |fam: &str| rows.iter().find(|r| r.family == fam).unwrap().rmse;
     let (all, one, importance) = (
         err("Path all lights"),

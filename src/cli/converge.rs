@@ -1,11 +1,13 @@
 //! `rtis converge`: error against time for a ladder of shader settings.
 
+use super::interrupt::{self, Graceful};
 use super::{CliError, load};
 use clap::Args;
 use rtis::converge::{self, plot, report};
 use rtis::render::pass::Pass;
 use rtis::render::{self, output};
 use std::path::PathBuf;
+use std::sync::atomic::Ordering;
 
 /// Arguments of `rtis converge`.
 #[derive(Args, Debug)]
@@ -128,6 +130,8 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
         "{:<16} {:<10} {:>9} {:>10} {:>9} {:>9}",
         "family", "setting", "seconds", "Mrays", "RMSE", "FLIP"
     );
+    // Ctrl-C while the rungs run finishes the rung in flight and writes what is done.
+    let graceful = Graceful::begin("finishing the rung in flight, then writing the rungs done");
     let measured = converge::sweep(
         &prepared,
         &reference,
@@ -144,10 +148,39 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
                 r.rays as f64 / 1e6,
                 r.rmse,
                 r.flip
-            )
+            );
+            !interrupt::STOP.load(Ordering::SeqCst)
         },
     );
+    drop(graceful);
     let rows: Vec<converge::Row> = measured.iter().map(|m| m.row.clone()).collect();
+    if interrupt::STOP.load(Ordering::SeqCst) {
+        // Interrupted: the table and plot of the rungs done, then exit 130 as a quit would.
+        output::write_file(
+            &a.out.join("converge.csv"),
+            converge::to_csv(&rows).as_bytes(),
+        )?;
+        output::write_file(
+            &a.out.join("converge.md"),
+            converge::to_markdown(&rows, prepared.model).as_bytes(),
+        )?;
+        if !rows.is_empty() {
+            plot::plot(&rows, "interrupted", &a.out.join("converge.png"))?;
+        }
+        eprintln!(
+            "interrupted: wrote the {} of {} rungs done to {}/converge.csv, converge.md{} and \
+             reference.exr",
+            rows.len(),
+            rungs.len(),
+            a.out.display(),
+            if rows.is_empty() {
+                ""
+            } else {
+                ", converge.png"
+            }
+        );
+        std::process::exit(130);
+    }
     // Say so when the reference's noise is not small against the errors measured.
     let smallest = rows.iter().map(|r| r.rmse).fold(f64::MAX, f64::min);
     if reference_noise.sqrt() > 0.3 * smallest {

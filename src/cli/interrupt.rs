@@ -18,6 +18,9 @@ pub static STOP: AtomicBool = AtomicBool::new(false);
 /// Whether a render that keeps its partial image is running (the first Ctrl-C then stops it).
 static GRACEFUL: AtomicBool = AtomicBool::new(false);
 
+/// What the first Ctrl-C of the running [`Graceful`] section does, said when it comes.
+static WHAT: std::sync::Mutex<&str> = std::sync::Mutex::new("");
+
 /// Start the signal thread. Call once, before any output file is written.
 pub fn install() -> std::io::Result<()> {
     let mut signals = Signals::new([SIGINT, SIGTERM])?;
@@ -29,10 +32,8 @@ pub fn install() -> std::io::Result<()> {
                     && GRACEFUL.load(Ordering::SeqCst)
                     && !STOP.swap(true, Ordering::SeqCst)
                 {
-                    eprintln!(
-                        "\ninterrupted: finishing the tiles in flight, then writing the image so \
-                         far; press Ctrl-C again to quit at once"
-                    );
+                    let what = *WHAT.lock().unwrap_or_else(|e| e.into_inner());
+                    eprintln!("\ninterrupted: {what}; press Ctrl-C again to quit at once");
                     continue;
                 }
                 quit(sig);
@@ -52,8 +53,10 @@ fn quit(sig: i32) -> ! {
 pub struct Graceful;
 
 impl Graceful {
-    /// Enter a stoppable render.
-    pub fn begin() -> Self {
+    /// Enter a stoppable section; the first Ctrl-C will say it is `what` (as "finishing the
+    /// tiles in flight, then writing the image so far").
+    pub fn begin(what: &'static str) -> Self {
+        *WHAT.lock().unwrap_or_else(|e| e.into_inner()) = what;
         GRACEFUL.store(true, Ordering::SeqCst);
         Graceful
     }

@@ -266,7 +266,8 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         return Ok(());
     }
     let result = {
-        let _graceful = Graceful::begin();
+        let _graceful =
+            Graceful::begin("finishing the tiles in flight, then writing the image so far");
         eprintln!(
             "rendering {} tiles; Ctrl-C keeps the image so far, twice quits",
             render::tile_count(&prepared)

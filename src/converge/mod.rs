@@ -270,7 +270,9 @@ pub struct Measured {
 
 /// Time and measure every rung: `seeds` independent renders (seeds `scene.seed + k`), the
 /// first timed as the median of `runs`. `reference_noise` is the reference's own noise
-/// variance per pixel and channel, removed from the bias estimate.
+/// variance per pixel and channel, removed from the bias estimate. `on_rung` sees each row as
+/// it is measured and says whether to go on (a Ctrl-C stops after the rung in flight): the
+/// result holds the rungs done.
 pub fn sweep(
     scene: &RenderScene,
     reference: &Image,
@@ -278,60 +280,66 @@ pub fn sweep(
     rungs: &[Rung],
     runs: usize,
     seeds: u32,
-    on_rung: &mut dyn FnMut(&Row),
+    on_rung: &mut dyn FnMut(&Row) -> bool,
 ) -> Vec<Measured> {
-    rungs
-        .iter()
-        .map(|r| {
-            let mut s = with_settings(scene, r.shader, r.spp);
-            if let Some(normals) = r.normals {
-                s.materials
-                    .iter_mut()
-                    .for_each(|m| set_normal_sampling(m, normals));
-            }
-            let mut times = Vec::new();
-            let mut first = None;
-            for _ in 0..runs.max(1) {
-                let out = render(&s, &|| {});
-                times.push(out.seconds);
-                first.get_or_insert(out);
-            }
-            times.sort_by(f64::total_cmp);
-            let out = first.expect("at least one run");
-            let mut images = vec![out.image.clone()];
-            for k in 1..seeds.max(1) {
-                let other = RenderScene {
-                    seed: scene.seed.wrapping_add(k as u64),
-                    ..s.clone()
-                };
-                images.push(render(&other, &|| {}).image);
-            }
-            let parts = metrics::bias_and_variance(&images, reference, reference_noise);
-            let k = images.len() as f64;
-            let mean_mse = images
-                .iter()
-                .map(|i| metrics::rmse(i, reference).powi(2))
-                .sum::<f64>()
-                / k;
-            let row = Row {
-                family: r.family.clone(),
-                label: r.label.clone(),
-                seconds: times[times.len() / 2],
-                rays: out.stats.total(),
-                rmse: mean_mse.sqrt(),
-                rel_mse: metrics::rel_mse(&out.image, reference),
-                flip: metrics::flip(&out.image, reference).mean,
-                seeds: images.len() as u32,
-                variance: parts.variance,
-                bias2: parts.bias2,
+    let measure = |r: &Rung| {
+        let mut s = with_settings(scene, r.shader, r.spp);
+        if let Some(normals) = r.normals {
+            s.materials
+                .iter_mut()
+                .for_each(|m| set_normal_sampling(m, normals));
+        }
+        let mut times = Vec::new();
+        let mut first = None;
+        for _ in 0..runs.max(1) {
+            let out = render(&s, &|| {});
+            times.push(out.seconds);
+            first.get_or_insert(out);
+        }
+        times.sort_by(f64::total_cmp);
+        let out = first.expect("at least one run");
+        let mut images = vec![out.image.clone()];
+        for k in 1..seeds.max(1) {
+            let other = RenderScene {
+                seed: scene.seed.wrapping_add(k as u64),
+                ..s.clone()
             };
-            on_rung(&row);
-            Measured {
-                row,
-                image: out.image,
-            }
-        })
-        .collect()
+            images.push(render(&other, &|| {}).image);
+        }
+        let parts = metrics::bias_and_variance(&images, reference, reference_noise);
+        let k = images.len() as f64;
+        let mean_mse = images
+            .iter()
+            .map(|i| metrics::rmse(i, reference).powi(2))
+            .sum::<f64>()
+            / k;
+        let row = Row {
+            family: r.family.clone(),
+            label: r.label.clone(),
+            seconds: times[times.len() / 2],
+            rays: out.stats.total(),
+            rmse: mean_mse.sqrt(),
+            rel_mse: metrics::rel_mse(&out.image, reference),
+            flip: metrics::flip(&out.image, reference).mean,
+            seeds: images.len() as u32,
+            variance: parts.variance,
+            bias2: parts.bias2,
+        };
+        Measured {
+            row,
+            image: out.image,
+        }
+    };
+    let mut done = Vec::new();
+    for r in rungs {
+        let m = measure(r);
+        let go_on = on_rung(&m.row);
+        done.push(m);
+        if !go_on {
+            break;
+        }
+    }
+    done
 }
 
 /// The rows as CSV.
