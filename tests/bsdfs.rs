@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{render_scene, scene, scenes_dir};
+use common::{block, render_scene, scene, scenes_dir};
 use glam::Vec3A;
 use proptest::prelude::*;
 use rtis::material::conductor::{Conductor, Metal};
@@ -418,15 +418,6 @@ fn blocks_agree(
     a: [&rtis::render::film::Image; 2],
     b: [&rtis::render::film::Image; 2],
 ) -> (f64, f64) {
-    let block = |img: &rtis::render::film::Image, bx: u32, by: u32| {
-        let mut s = Vec3A::ZERO;
-        for y in 0..4 {
-            for x in 0..4 {
-                s += img.get(bx * 4 + x, by * 4 + y);
-            }
-        }
-        s / 16.0
-    };
     let (mut d, mut va, mut vb, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for by in 0..a[0].height / 4 {
         for bx in 0..a[0].width / 4 {

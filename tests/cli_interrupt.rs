@@ -25,8 +25,13 @@ fn scene(dir: &Path, shader: &str) -> PathBuf {
 
 /// Start `rtis render`; the receiver gets each stderr line (progress redraws split at '\r').
 fn start(args: &[&str]) -> (Child, mpsc::Receiver<String>) {
+    start_command("render", args)
+}
+
+/// Start `rtis COMMAND ARGS`, as [`start`].
+fn start_command(command: &str, args: &[&str]) -> (Child, mpsc::Receiver<String>) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_rtis"))
-        .arg("render")
+        .arg(command)
         .args(args)
         .stderr(Stdio::piped())
         .spawn()
@@ -231,14 +236,12 @@ fn ctrl_c_during_converge_keeps_the_rungs_done() {
     let d = tmp("converge");
     let s = scene(&d, "Global(samples: 4, max_depth: 1)");
     let out = d.join("out");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_rtis"))
-        .args([
-            "converge",
+    let (mut child, rx) = start_command(
+        "converge",
+        &[
             s.to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
-        ])
-        .args([
             "--width",
             "48",
             "--runs",
@@ -247,18 +250,8 @@ fn ctrl_c_during_converge_keeps_the_rungs_done() {
             "1",
             "--reference-spp",
             "8",
-        ])
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run rtis");
-    let err = child.stderr.take().unwrap();
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(err).lines() {
-            let Ok(line) = line else { break };
-            let _ = tx.send(line);
-        }
-    });
+        ],
+    );
     // The first rung's line: the ladder is running.
     wait_for(&rx, "direct");
     signal(&child, "-INT");

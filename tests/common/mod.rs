@@ -47,6 +47,17 @@ pub fn close(a: Vec3A, b: Vec3A, rel: f32) -> bool {
     (a - b).abs().max_element() <= rel * b.abs().max_element().max(1e-6)
 }
 
+/// The mean of the 4x4 block `(bx, by)` of `img`.
+pub fn block(img: &rtis::render::film::Image, bx: u32, by: u32) -> Vec3A {
+    let mut s = Vec3A::ZERO;
+    for y in 0..4 {
+        for x in 0..4 {
+            s += img.get(bx * 4 + x, by * 4 + y);
+        }
+    }
+    s / 16.0
+}
+
 /// Two renders `a` and `b` of one scene with different seeds against an independent reference
 /// `r` whose per-pixel noise RMSE is `ref_noise`, on 4 x 4 blocks (blocks where `skip` holds
 /// are left out): returns the block MSE of `(a + b) / 2` against `r`, and what noise alone
@@ -60,15 +71,6 @@ pub fn block_mse(
     skip: &dyn Fn(u32, u32) -> bool,
 ) -> (f64, f64) {
     assert_eq!((a.width, a.height), (r.width, r.height));
-    let block = |img: &rtis::render::film::Image, bx: u32, by: u32| {
-        let mut s = Vec3A::ZERO;
-        for y in 0..4 {
-            for x in 0..4 {
-                s += img.get(bx * 4 + x, by * 4 + y);
-            }
-        }
-        s / 16.0
-    };
     let (mut d_ab, mut d_ref, mut n) = (0.0f64, 0.0f64, 0.0f64);
     for by in 0..a.height / 4 {
         for bx in 0..a.width / 4 {
