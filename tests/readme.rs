@@ -66,6 +66,7 @@ fn readme_first_scene_loads() {
     let end = start + section[start..].find("```").unwrap();
     let mut scene = rtis::scene::load_str(&section[start..end], "first.ron", None)
         .unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     scene.settings.film.width = 32;
     scene.settings.film.height = 24;
     scene.settings.film.spp = 2;

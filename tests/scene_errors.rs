@@ -580,7 +580,26 @@ fn silent_mistakes_are_warned_at_their_place() {
     ] {
         assert!(warnings(&lit).is_empty(), "{lit}: {:?}", warnings(&lit));
     }
+    // A sky or an emitter switched off lights nothing.
+    for dark_again in [
+        dark.replace(
+            "entities: [",
+            "background: (0.1, 0.1, 0.1), effects: (background: false), entities: [",
+        ),
+        dark.replace(
+            "radius: 1), material: Mirror())",
+            "radius: 1), emitter: Emitter(radiance: (1, 1, 1)))",
+        )
+        .replace("entities: [", "effects: (emission: false), entities: ["),
+    ] {
+        assert_eq!(warnings(&dark_again).len(), 1, "{dark_again}");
+    }
     let inside = "Scene(entities: [\n  (shape: Sphere(center: (0, 0, 5), radius: 1), material: Mirror()),\n  (light: Point(position: (0, 0.5, 5), intensity: (1, 1, 1))),\n])";
+    // Not where no shadow ray is traced.
+    for quiet in ["effects: (shadows: false), ", "shader: Normal, "] {
+        let text = inside.replace("Scene(", &format!("Scene({quiet}"));
+        assert!(warnings(&text).is_empty(), "{text}: {:?}", warnings(&text));
+    }
     let w = warnings(inside);
     assert_eq!(
         w,
@@ -590,4 +609,21 @@ fn silent_mistakes_are_warned_at_their_place() {
         ],
     );
     assert!(warnings(&inside.replace("(0, 0.5, 5)", "(0, 1.5, 5)")).is_empty());
+}
+
+/// The repository's scenes load without a warning.
+#[test]
+fn the_scenes_load_without_warnings() {
+    for entry in std::fs::read_dir("scenes").unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "ron") {
+            let scene = load_path(&path).unwrap_or_else(|e| panic!("{e}"));
+            assert!(
+                scene.warnings.is_empty(),
+                "{}: {:?}",
+                path.display(),
+                scene.warnings
+            );
+        }
+    }
 }

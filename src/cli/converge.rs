@@ -167,6 +167,8 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
         if !rows.is_empty() {
             plot::plot(&rows, "interrupted", &a.out.join("converge.png"))?;
         }
+        // A report of an earlier run would not match these rungs.
+        let _ = std::fs::remove_file(a.out.join("report.html"));
         eprintln!(
             "interrupted: wrote the {} of {} rungs done to {}/converge.csv, converge.md{} and \
              reference.exr",
@@ -193,8 +195,7 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
         eprintln!("warning: {warning}");
         note = format!("{note}. <strong class=\"note\">Warning: {warning}.</strong>");
     }
-    eprintln!("the price of each effect of the scene's own shader...");
-    let effects = converge::effect_prices(&prepared, &reference, a.runs as usize);
+    // The table and plot first: a Ctrl-C during the effects' prices keeps them.
     let write = |name: &str, text: String| output::write_file(&a.out.join(name), text.as_bytes());
     write("converge.csv", converge::to_csv(&rows))?;
     write("converge.md", converge::to_markdown(&rows, prepared.model))?;
@@ -207,6 +208,8 @@ pub fn run(a: ConvergeArgs) -> Result<(), CliError> {
         prepared.film.width, prepared.film.height, prepared.model
     );
     plot::plot(&rows, &title, &a.out.join("converge.png"))?;
+    eprintln!("the price of each effect of the scene's own shader...");
+    let effects = converge::effect_prices(&prepared, &reference, a.runs as usize);
     let html = report::html(&report::Report {
         title,
         reference: &reference,

@@ -338,10 +338,11 @@ fn resolve(
 impl Resolved {
     /// Warnings, located, for scenes that render but cannot show what was meant:
     ///
-    /// - shapes lit by nothing: no point light, no emitter, a black background, and a shader
-    ///   that shades (Direct, Path, or Global without an ambient term);
-    /// - a point light inside a sphere (as written, without a `transform`): the sphere's
-    ///   outside never sees it.
+    /// - shapes lit by nothing: a shader that shades (Direct, Global, Path), and no point
+    ///   light, no emitter, no sky and no Global ambient term (or each switched off in
+    ///   `effects`);
+    /// - a point light inside a sphere (as written, without a `transform`), where shadows are
+    ///   traced: the sphere's outside never sees it.
     ///
     /// Not detected (documented in docs/scene-format.md): a light enclosed by a closed mesh or
     /// by a transformed sphere, and an emitter that faces away from everything the camera sees.
@@ -357,22 +358,25 @@ impl Resolved {
             let (line, col) = line_col(&src.text, off);
             format!("{}:{line}:{col}", src.name)
         };
-        let shades = match settings.shader {
-            Shader::Direct { .. } | Shader::Path(_) => true,
-            Shader::Global(g) => g.ambient == glam::Vec3A::ZERO,
-            _ => false,
-        };
-        let lit = self
-            .entities
-            .iter()
-            .any(|(EntityDesc(e), ..)| e.light.is_some() || e.emitter.is_some());
+        let on = |switch: Option<bool>| switch != Some(false);
+        let fx = &settings.effects;
+        let shades = matches!(
+            settings.shader,
+            Shader::Direct { .. } | Shader::Path(_) | Shader::Global(_)
+        );
+        let ambient = matches!(settings.shader, Shader::Global(g) if g.ambient != glam::Vec3A::ZERO)
+            && on(fx.ambient);
+        let lit = self.entities.iter().any(|(EntityDesc(e), ..)| {
+            e.light.is_some() || (e.emitter.is_some() && on(fx.emission))
+        });
         if let Some((_, idx, i)) = self
             .entities
             .iter()
             .find(|(EntityDesc(e), ..)| e.shape.is_some())
             && shades
             && !lit
-            && settings.background == glam::Vec3A::ZERO
+            && !ambient
+            && (settings.background == glam::Vec3A::ZERO || !on(fx.background))
         {
             warnings.push(format!(
                 "{}: the scene has shapes but no light, no emitter and a black background: every \
@@ -380,7 +384,9 @@ impl Resolved {
                 at(*idx, *i, "shape")
             ));
         }
-        for (EntityDesc(light), lidx, li) in &self.entities {
+        // Shadow rays exist only where the shader shades with shadows on.
+        let shadows = shades && on(fx.shadows);
+        for (EntityDesc(light), lidx, li) in self.entities.iter().filter(|_| shadows) {
             let Some(LightDesc::Point { position, .. }) = &light.light else {
                 continue;
             };

@@ -644,26 +644,20 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
     }
 }
 
-/// Where the value that ends at `end` starts: for a tuple whose closing bracket is at `end`,
-/// its opening bracket; otherwise `end` itself.
-pub fn value_start(text: &str, end: usize) -> usize {
-    if text.as_bytes().get(end) != Some(&b')') {
-        return end;
+/// Where the value that a refused-value error points into starts: for a tuple whose closing
+/// bracket is at `at`, its opening bracket (strings and comments skipped); for a signed number
+/// (reported after its sign), the sign; otherwise `at` itself.
+pub fn value_start(text: &str, at: usize) -> usize {
+    if text.as_bytes().get(at) == Some(&b')') {
+        return match super::spans::open_brackets(text, at).last() {
+            Some(&('(', open)) => open,
+            _ => at,
+        };
     }
-    let mut depth = 0usize;
-    for (i, c) in text[..=end].char_indices().rev() {
-        match c {
-            ')' => depth += 1,
-            '(' => {
-                depth -= 1;
-                if depth == 0 {
-                    return i;
-                }
-            }
-            _ => {}
-        }
+    match at.checked_sub(1).and_then(|b| text.as_bytes().get(b)) {
+        Some(b'-' | b'+') => at - 1,
+        _ => at,
     }
-    end
 }
 
 /// The name of the field whose value starts at `start` (`radius` in `radius: 0`), if the
