@@ -106,6 +106,11 @@ fn any_bsdf() -> impl Strategy<Value = Bsdf> {
         })
 }
 
+/// A BSDF's smallest roughness (1 for the smooth plastic, whose base is diffuse).
+fn smallest_alpha(b: &Bsdf) -> f32 {
+    b.microfacet().map_or(1.0, |m| m.alpha_x.min(m.alpha_y))
+}
+
 /// The index of refraction on the side of `w` for a dielectric of relative index `eta` (1
 /// outside, `eta` inside); 1 on both sides for the others.
 fn index(b: &Bsdf, w: Vec3A) -> f32 {
@@ -147,12 +152,7 @@ proptest! {
     ) {
         let Some(s) = b.sample(wo, uc, u1, u2) else { return Ok(()) };
         let wi = s.wi;
-        let alpha = match b {
-            Bsdf::RoughConductor(r) => r.microfacet.alpha_x.min(r.microfacet.alpha_y),
-            Bsdf::RoughDielectric(r) => r.microfacet.alpha_x.min(r.microfacet.alpha_y),
-            Bsdf::RoughPlastic(r) => r.microfacet.alpha_x,
-            Bsdf::Plastic(_) => 1.0,
-        };
+        let alpha = smallest_alpha(&b);
         // An index within 5% of 1 refracts almost straight on, where the generalised half
         // vector `wo + eta' wi` cancels to a length near |eta' - 1|: its rounding, about
         // 1e-7 / |eta' - 1| (1e-3 at 1.0001), differs between the two orders.
@@ -185,12 +185,7 @@ proptest! {
         }
         let (pdf, f) = (b.pdf(wo, s.wi), b.eval(wo, s.wi));
         prop_assert!(pdf.is_finite() && f.is_finite());
-        let rough = match b {
-            Bsdf::RoughConductor(r) => r.microfacet.alpha_x.min(r.microfacet.alpha_y),
-            Bsdf::RoughDielectric(r) => r.microfacet.alpha_x.min(r.microfacet.alpha_y),
-            Bsdf::RoughPlastic(r) => r.microfacet.alpha_x,
-            Bsdf::Plastic(_) => 1.0,
-        };
+        let rough = smallest_alpha(&b);
         // The dielectric's sample takes its value and density from `eval` and `pdf` themselves
         // (MIS needs one density per direction), so they agree at any index.
         let exact = matches!(b, Bsdf::RoughDielectric(_));
@@ -368,8 +363,7 @@ fn rough_dielectric_conserves_energy() {
 }
 
 /// The rough plastic keeps at most what it receives (white base and coating: 5 standard
-/// errors of 200,000 samples), less as the coating roughens (its single scattering loses
-/// light), and as alpha goes to 0 its albedo becomes the smooth plastic's (to 5e-3: the
+/// errors of 200,000 samples), and as alpha goes to 0 its albedo becomes the smooth plastic's (to 5e-3: the
 /// coating's transmittance is tabulated on 32 cosines, each by quadrature over normals).
 #[test]
 fn rough_plastic_albedo_is_at_most_one() {

@@ -6,8 +6,8 @@ pub mod plot;
 pub mod report;
 pub mod warptest;
 
-use crate::material::microfacet::NormalSampling;
-use crate::material::{Bsdf, Material, Model};
+use crate::material::microfacet::{Microfacet, NormalSampling};
+use crate::material::{Material, Model};
 use crate::render::{RenderScene, film::Image, render};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
 use crate::shader::{Global, Path, Shader};
@@ -122,7 +122,7 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
             if scene
                 .materials
                 .iter()
-                .any(|m| microfacet_sampling(m).is_some())
+                .any(|m| matches!(m, Material::Bsdf(b) if b.microfacet().is_some()))
             {
                 for spp in [1, 4, 16, 64, 256] {
                     rungs.push(Rung {
@@ -190,23 +190,11 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
     rungs
 }
 
-/// How a material samples its microfacet normals, if it has any.
-fn microfacet_sampling(m: &Material) -> Option<NormalSampling> {
+/// A rough material's distribution of microfacet normals, to change how it is sampled.
+fn microfacet_mut(m: &mut Material) -> Option<&mut Microfacet> {
     match m {
-        Material::Bsdf(Bsdf::RoughConductor(b)) => Some(b.microfacet.sampling),
-        Material::Bsdf(Bsdf::RoughDielectric(b)) => Some(b.microfacet.sampling),
-        Material::Bsdf(Bsdf::RoughPlastic(b)) => Some(b.microfacet.sampling),
+        Material::Bsdf(b) => b.microfacet_mut(),
         _ => None,
-    }
-}
-
-/// Make a rough material sample its normals by `normals`.
-fn set_normal_sampling(m: &mut Material, normals: NormalSampling) {
-    match m {
-        Material::Bsdf(Bsdf::RoughConductor(b)) => b.microfacet.sampling = normals,
-        Material::Bsdf(Bsdf::RoughDielectric(b)) => b.microfacet.sampling = normals,
-        Material::Bsdf(Bsdf::RoughPlastic(b)) => b.microfacet.sampling = normals,
-        _ => {}
     }
 }
 
@@ -285,9 +273,9 @@ pub fn sweep(
     let measure = |r: &Rung| {
         let mut s = with_settings(scene, r.shader, r.spp);
         if let Some(normals) = r.normals {
-            s.materials
-                .iter_mut()
-                .for_each(|m| set_normal_sampling(m, normals));
+            for m in s.materials.iter_mut().filter_map(microfacet_mut) {
+                m.sampling = normals;
+            }
         }
         let mut times = Vec::new();
         let mut first = None;

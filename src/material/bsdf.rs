@@ -10,6 +10,7 @@
 //! `match`, which the compiler names), and the scene file's `MaterialDesc` with its conversion.
 
 pub use super::bsdf_sample::BsdfSample;
+use super::microfacet::Microfacet;
 use super::plastic::Plastic;
 use super::rough_conductor::RoughConductor;
 use super::rough_dielectric::RoughDielectric;
@@ -72,6 +73,27 @@ impl Bsdf {
             s.wi.z = -s.wi.z;
         }
         Some(s)
+    }
+
+    /// The distribution of microfacet normals of a rough material; `None` for the smooth
+    /// plastic.
+    pub fn microfacet(&self) -> Option<&Microfacet> {
+        match self {
+            Bsdf::RoughConductor(b) => Some(&b.microfacet),
+            Bsdf::RoughDielectric(b) => Some(&b.microfacet),
+            Bsdf::RoughPlastic(b) => Some(&b.microfacet),
+            Bsdf::Plastic(_) => None,
+        }
+    }
+
+    /// [`Bsdf::microfacet`], to change (how it is sampled).
+    pub fn microfacet_mut(&mut self) -> Option<&mut Microfacet> {
+        match self {
+            Bsdf::RoughConductor(b) => Some(&mut b.microfacet),
+            Bsdf::RoughDielectric(b) => Some(&mut b.microfacet),
+            Bsdf::RoughPlastic(b) => Some(&mut b.microfacet),
+            Bsdf::Plastic(_) => None,
+        }
     }
 
     /// The material's name in scene files.

@@ -11,7 +11,7 @@
 
 use super::bsdf_sample::BsdfSample;
 use super::conductor::Conductor;
-use super::microfacet::Microfacet;
+use super::microfacet::{Microfacet, half_vector};
 use glam::Vec3A;
 
 /// A rough conductor: a microfacet distribution of a [`Conductor`]'s mirrors.
@@ -61,12 +61,4 @@ impl RoughConductor {
         let (wi, pdf) = self.microfacet.sample_reflection(wo, u1, u2)?;
         BsdfSample::glossy(wi, self.eval(wo, wi), pdf)
     }
-}
-
-/// The unit half vector of two unit directions, `None` when they are opposite.
-#[inline]
-fn half_vector(wo: Vec3A, wi: Vec3A) -> Option<Vec3A> {
-    let h = wo + wi;
-    let len2 = h.length_squared();
-    (len2 > 0.0).then(|| h / len2.sqrt())
 }

@@ -86,7 +86,8 @@ impl RoughDielectric {
         }
         let etap = self.etap(cos_o);
         let f = fresnel_dielectric(cos_om, 1.0 / etap);
-        let wi = if uc < f {
+        let reflected = uc < f;
+        let wi = if reflected {
             // Reflection about wm.
             2.0 * wo.dot(wm) * wm - wo
         } else {
@@ -100,7 +101,9 @@ impl RoughDielectric {
         // refraction above it, is not a sample), wi's value and density are those `eval` and
         // `pdf` find (from the half vector of wo and wi, not the sampled normal), so that MIS
         // weighs this sample and a light sample of the same direction with one density.
-        self.lobe(wo, wi, wm)?; // the way it was drawn exists (wi on the side it was meant for)
+        if wi.z == 0.0 || (wi.z * cos_o > 0.0) != reflected {
+            return None;
+        }
         let way = self.through(wo, wi)?;
         let mut s = BsdfSample::glossy(wi, way.f, way.pdf)?;
         if wi.z * cos_o < 0.0 {

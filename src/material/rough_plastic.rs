@@ -20,7 +20,7 @@
 use super::bsdf_sample::BsdfSample;
 use super::coating::Coating;
 use super::fresnel_dielectric;
-use super::microfacet::Microfacet;
+use super::microfacet::{Microfacet, half_vector};
 use glam::Vec3A;
 use std::f32::consts::FRAC_1_PI;
 
@@ -90,8 +90,9 @@ impl RoughPlastic {
             return Vec3A::ZERO;
         }
         let c = &self.coating;
-        let h = wo + wi;
-        let wm = h / h.length();
+        let Some(wm) = half_vector(wo, wi) else {
+            return Vec3A::ZERO;
+        };
         let m = &self.microfacet;
         let specular = c.fresnel(wo.dot(wm)) * m.d(wm) * m.g(wo, wi, wm) / (4.0 * cos_o);
         let base = FRAC_1_PI * c.inv_eta2 * self.transmittance(cos_o) * self.transmittance(cos_i);

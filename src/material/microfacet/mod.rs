@@ -192,12 +192,9 @@ impl Microfacet {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let h = wo + wi;
-        let len2 = h.length_squared();
-        if len2 == 0.0 {
+        let Some(wm) = half_vector(wo, wi) else {
             return 0.0;
-        }
-        let wm = h / len2.sqrt();
+        };
         let cos_om = wo.dot(wm);
         if cos_om <= 0.0 {
             return 0.0;
@@ -230,6 +227,14 @@ impl Microfacet {
         }
         acc
     }
+}
+
+/// The unit half vector of two unit directions, `None` when they are opposite.
+#[inline]
+pub fn half_vector(wo: Vec3A, wi: Vec3A) -> Option<Vec3A> {
+    let h = wo + wi;
+    let len2 = h.length_squared();
+    (len2 > 0.0).then(|| h / len2.sqrt())
 }
 
 /// The unit normal of the microfacet with slopes `(sx, sy)`: `(-sx, -sy, 1)` normalised.
