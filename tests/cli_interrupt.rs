@@ -88,6 +88,7 @@ fn rest(rx: &mpsc::Receiver<String>) -> String {
     rx.iter().collect::<Vec<_>>().join("\n")
 }
 
+/// A scene of one spp stopped in its only round keeps the tiles finished.
 #[test]
 fn first_ctrl_c_writes_the_partial_image_and_exits_130() {
     let d = tmp("partial");
@@ -95,16 +96,18 @@ fn first_ctrl_c_writes_the_partial_image_and_exits_130() {
     let out = d.join("box.png");
     let (mut child, rx) = start(&[s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     // The render has started (and Ctrl-C keeps its image) once it says so.
-    wait_for(&rx, "Ctrl-C keeps the image so far");
+    wait_for(&rx, "Ctrl-C keeps");
     std::thread::sleep(Duration::from_millis(300));
     signal(&child, "-INT");
     let status = child.wait().unwrap();
     let err = rest(&rx);
     assert_eq!(status.code(), Some(130), "{err}");
+    // One round of one spp: the tiles it finished are kept.
     assert!(
-        err.contains("tiles rendered") && err.contains("box.partial.png"),
+        err.contains("in the first round") && err.contains("tiles rendered"),
         "{err}"
     );
+    assert!(err.contains("box.partial.png"), "{err}");
     // Only the partial image, whole, under its own name.
     assert_eq!(files(&d), vec!["box.partial.png".to_string()]);
     let img = image::open(d.join("box.partial.png")).unwrap().to_rgb8();
@@ -135,7 +138,7 @@ fn second_ctrl_c_quits_at_once() {
     let s = scene(&d, "Global(samples: 64, max_depth: 3)");
     let out = d.join("box.png");
     let (mut child, rx) = start(&[s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
-    wait_for(&rx, "Ctrl-C keeps the image so far");
+    wait_for(&rx, "Ctrl-C keeps");
     signal(&child, "-INT");
     wait_for(&rx, "press Ctrl-C again");
     signal(&child, "-INT");
@@ -266,5 +269,126 @@ fn ctrl_c_during_converge_keeps_the_rungs_done() {
     assert!(rows < 15, "{csv}");
     assert!(out.join("converge.md").exists() && out.join("reference.exr").exists());
     assert!(!out.join("report.html").exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// The linear pixels of an EXR, as bits.
+fn exr_bits(path: &Path) -> Vec<u32> {
+    let img = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb32f();
+    img.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect()
+}
+
+/// A render of many spp is progressive: Ctrl-C after a round writes the whole frame at the
+/// spp of the rounds done (a PNG that says so, and its pass NAME.partial.exr), and `--resume`
+/// from it ends with the bits of a render never stopped. `--time` stops after the round that
+/// fits, writes the image with its spp, and resumes the same way.
+#[test]
+fn progressive_render_stops_resumes_and_keeps_its_bits() {
+    let d = tmp("progressive");
+    let s = scene(&d, "Path(max_depth: 3)");
+    let s = s.to_str().unwrap();
+    let size = ["--width", "64", "--height", "48", "--spp", "4096"];
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_rtis"))
+            .arg("render")
+            .arg(s)
+            .args(size)
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{args:?}: {err}");
+        err
+    };
+    let full = d.join("full.exr");
+    run(&["-o", full.to_str().unwrap()]);
+    let want = exr_bits(&full);
+
+    // Ctrl-C after a round.
+    let out = d.join("box.png");
+    let mut args = vec![s];
+    args.extend(size);
+    args.extend(["-o", out.to_str().unwrap()]);
+    let (mut child, rx) = start(&args);
+    wait_for(&rx, "round: samples 1..2");
+    signal(&child, "-INT");
+    let status = child.wait().unwrap();
+    let err = rest(&rx);
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(err.contains("the whole frame at"), "{err}");
+    let mut names = files(&d);
+    names.retain(|n| n != "full.exr");
+    assert_eq!(names, vec!["box.partial.exr", "box.partial.png"], "{err}");
+    // The preview is a whole frame: no black pixel in the lit box.
+    let png = image::open(d.join("box.partial.png")).unwrap().to_rgb8();
+    assert!(
+        png.pixels().filter(|p| p.0 == [0, 0, 0]).count() < 64,
+        "{err}"
+    );
+    // It says its spp.
+    let decoder = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(d.join("box.partial.png")).unwrap(),
+    ));
+    let reader = decoder.read_info().unwrap();
+    let note = &reader.info().uncompressed_latin1_text[0];
+    assert_eq!(note.keyword, "Comment");
+    assert!(
+        note.text.contains("samples per pixel") && note.text.contains("of 4096"),
+        "{}",
+        note.text
+    );
+    let resumed = d.join("resumed.exr");
+    let partial = d.join("box.partial.exr");
+    let err = run(&[
+        "--resume",
+        partial.to_str().unwrap(),
+        "-o",
+        resumed.to_str().unwrap(),
+    ]);
+    assert!(err.contains("resuming from"), "{err}");
+    assert!(
+        exr_bits(&resumed) == want,
+        "resumed after Ctrl-C: other bits\n{err}"
+    );
+
+    // A time budget too short for more than the first round.
+    let timed = d.join("timed.png");
+    let err = run(&["--time", "1ms", "-o", timed.to_str().unwrap()]);
+    assert!(
+        err.contains("time budget spent: the whole frame at 1 of 4096 spp"),
+        "{err}"
+    );
+    assert!(timed.exists() && d.join("timed.exr").exists(), "{err}");
+    let finished = d.join("finished.exr");
+    run(&[
+        "--resume",
+        d.join("timed.exr").to_str().unwrap(),
+        "-o",
+        finished.to_str().unwrap(),
+    ]);
+    assert!(
+        exr_bits(&finished) == want,
+        "resumed after --time: other bits"
+    );
+
+    // A pass of another render is refused, located at the file.
+    let other = Command::new(env!("CARGO_BIN_EXE_rtis"))
+        .args([
+            "render", s, "--width", "64", "--height", "48", "--spp", "8", "--resume",
+        ])
+        .arg(&partial)
+        .arg("-o")
+        .arg(d.join("never.png"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(!other.status.success());
+    assert!(
+        err.contains("box.partial.exr: cannot resume") && err.contains("another spp"),
+        "{err}"
+    );
+    assert!(!d.join("never.png").exists());
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -6,10 +6,13 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rtis::accel::Isa;
 use rtis::render::estimate::{self, MAX_RAYS_UNFORCED, human_seconds};
+use rtis::render::film::Image;
 use rtis::render::output::Transfer;
 use rtis::render::pass::{self, Pass};
+use rtis::render::progressive::{self, Ending};
 use rtis::render::{self, Film, output};
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 /// Arguments of `rtis render`.
 #[derive(Args, Debug)]
@@ -48,6 +51,16 @@ pub struct RenderArgs {
     /// a pass EXR of exact sums for `rtis merge` (default name NAME.pass-I-of-N.exr).
     #[arg(long, value_parser = pass::parse_pass, value_name = "I/N")]
     pass: Option<(u32, u32)>,
+    /// Stop after the round of samples that fits this much tracing time (e.g. 30s, 2m, 1h,
+    /// 500ms; a bare number is seconds). The image then holds fewer spp and says so; its pass
+    /// (NAME.partial.exr, or the .exr output itself) resumes with --resume.
+    #[arg(long, value_parser = parse_duration, value_name = "DURATION")]
+    time: Option<Duration>,
+    /// Continue the render held by this pass file (written by a stopped or timed render, or by
+    /// --pass): the scene, film, seed and settings must be the ones it was rendered with. The
+    /// image then has the bits of a render never stopped.
+    #[arg(long, value_name = "PASS.exr", conflicts_with = "pass")]
+    resume: Option<PathBuf>,
     /// Instruction set of the SIMD code: the widest this CPU runs (auto), or one named, to
     /// measure what it is worth. The image is the same in each.
     #[arg(long, value_enum, default_value_t = IsaChoice::Auto)]
@@ -131,6 +144,63 @@ pub fn partial_path(out: &Path) -> PathBuf {
     out.with_file_name(format!("{stem}.partial.{ext}"))
 }
 
+/// Parse a duration: a number with `ms`, `s`, `m` or `h`, or a bare number of seconds.
+pub fn parse_duration(s: &str) -> Result<Duration, String> {
+    let t = s.trim();
+    let (number, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
+        Some(i) => t.split_at(i),
+        None => (t, "s"),
+    };
+    let scale = match unit {
+        "ms" => 1e-3,
+        "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        _ => return Err(format!("`{s}`: write a duration as 30s, 2m, 1h or 500ms")),
+    };
+    match number.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v * scale <= 1e9 => {
+            Ok(Duration::from_secs_f64(v * scale))
+        }
+        _ => Err(format!(
+            "`{s}`: a duration is a positive number with a unit, as 30s, 2m, 1h or 500ms"
+        )),
+    }
+}
+
+/// Where the pass of an unfinished render goes, for `--resume`: the output itself when it is an
+/// .exr (a pass file is an EXR whose R, G, B show the image), else `NAME.partial.exr`.
+fn resume_path(image: &Path) -> PathBuf {
+    if is_exr(image) {
+        image.to_path_buf()
+    } else {
+        image.with_extension("exr")
+    }
+}
+
+fn is_exr(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+/// Write an image that holds fewer samples than the film asks (a stopped or timed render):
+/// as a pass file when `image` is an .exr, else as the image with a note of its spp and, beside
+/// it, its pass (`NAME.exr`) for `--resume`. Returns the pass file's path.
+fn save_unfinished(pass: &Pass, image: &Path, transfer: Transfer) -> Result<PathBuf, CliError> {
+    let resume = resume_path(image);
+    pass.write(&resume)?;
+    if !is_exr(image) {
+        let note = format!(
+            "rtis: {} of {} samples per pixel (samples {})",
+            pass.samples(),
+            pass.spp,
+            pass::describe_held(pass)
+        );
+        output::save_noted(&pass.image(), image, transfer, &note)?;
+    }
+    Ok(resume)
+}
+
 fn parse_transfer(s: &str) -> Result<Transfer, String> {
     match s.to_ascii_lowercase().as_str() {
         "srgb" => Ok(Transfer::Srgb),
@@ -171,10 +241,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     output::check_writable(&out)?;
     let samples = match a.pass {
         Some((i, n)) => {
-            if !out
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-            {
+            if !is_exr(&out) {
                 return Err(format!(
                     "{}: a pass is written as an .exr file of exact sums (see rtis merge)",
                     out.display()
@@ -213,9 +280,29 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;
+    // The samples a resumed render already holds.
+    let start = match &a.resume {
+        Some(path) => {
+            let held = Pass::read(path)?;
+            progressive::check_resumable(&prepared, &held)
+                .map_err(|e| format!("{}: cannot resume: {e}", path.display()))?;
+            eprintln!(
+                "resuming from {}: {} of {} spp held",
+                path.display(),
+                held.samples(),
+                held.spp
+            );
+            held
+        }
+        None => Pass::empty(&prepared),
+    };
+    let to_render = match a.pass {
+        Some(_) => samples.len() as u32,
+        None => prepared.film.spp - start.samples() as u32,
+    };
 
     // What it will cost: the shader's rule and a short calibration (for a pass, its share).
-    let est = estimate::estimate(&prepared).share(samples.len() as u32, prepared.film.spp);
+    let est = estimate::estimate(&prepared).share(to_render, prepared.film.spp);
     eprintln!(
         "estimate: {:.3e} rays, about {} on {threads} threads (calibrated on {} samples{})",
         est.rays(),
@@ -265,48 +352,111 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         );
         return Ok(());
     }
-    let result = {
-        let _graceful =
-            Graceful::begin("finishing the tiles in flight, then writing the image so far");
-        eprintln!(
-            "rendering {} tiles; Ctrl-C keeps the image so far, twice quits",
-            render::tile_count(&prepared)
+    if to_render == 0 {
+        eprintln!("every sample is held already: writing the image");
+    }
+    // Progressive rounds over the whole frame; the bar counts pixel-samples.
+    bar.set_length(render::tile_count(&prepared) * to_render as u64);
+    let tick = |samples: u32| bar.inc(samples as u64);
+    let film = prepared.film;
+    let progress = {
+        let _graceful = Graceful::begin(
+            "dropping the round in flight, then writing the image of the rounds done",
         );
-        pool.install(|| render::render_until(&prepared, &tick, &interrupt::STOP))
+        eprintln!(
+            "rendering in rounds of doubling spp; Ctrl-C keeps the last whole round, twice quits"
+        );
+        let mut on_round = |_: &Pass, r: &progressive::Round| {
+            bar.suspend(|| {
+                eprintln!(
+                    "round: samples {}..{}, {} of {} spp after {:.2} s",
+                    r.samples.start, r.samples.end, r.held, film.spp, r.seconds
+                )
+            });
+            true
+        };
+        pool.install(|| {
+            progressive::refine(
+                &prepared,
+                start,
+                a.time,
+                &tick,
+                &interrupt::STOP,
+                &mut on_round,
+            )
+        })
     };
     bar.finish_and_clear();
-
-    if !result.is_complete() {
-        // Interrupted: keep what the render has, under a name that says so.
-        let partial = partial_path(&out);
-        output::save(&result.image, &partial, prepared.film.transfer)?;
-        eprintln!(
-            "interrupted after {:.2} s: {} of {} tiles rendered ({:.1}% of the pixels, each with \
-             all {} spp; the rest is black) -> {}",
-            result.seconds,
-            result.tiles_done,
-            result.tiles,
-            100.0 * result.tiles_done as f64 / result.tiles as f64,
-            prepared.film.spp,
-            partial.display()
-        );
-        return Err(Box::new(Interrupted));
+    let pass = &progress.pass;
+    match progress.ending {
+        Ending::Stopped | Ending::Declined => {
+            // Interrupted: keep the last whole round, under a name that says so.
+            let partial = partial_path(&out);
+            if pass.samples() == 0 {
+                // Stopped in the first round (a scene of few spp, as the course's 1 spp with
+                // Global): keep its finished tiles, each with all the round's samples.
+                let Some((samples, tiles)) = &progress.dropped else {
+                    eprintln!("interrupted before the first round began: no image written");
+                    return Err(Box::new(Interrupted));
+                };
+                let n = samples.len() as u64;
+                let image = Image {
+                    width: film.width,
+                    height: film.height,
+                    pixels: tiles.pixels.iter().map(|s| s.mean(n)).collect(),
+                };
+                output::save(&image, &partial, film.transfer)?;
+                eprintln!(
+                    "interrupted after {:.2} s in the first round: {} of {} tiles rendered \
+                     ({:.1}% of the pixels, each with {n} spp; the rest is black) -> {}",
+                    tiles.seconds,
+                    tiles.tiles_done,
+                    tiles.tiles,
+                    100.0 * tiles.tiles_done as f64 / tiles.tiles as f64,
+                    partial.display()
+                );
+                return Err(Box::new(Interrupted));
+            }
+            let resume = save_unfinished(pass, &partial, film.transfer)?;
+            eprintln!(
+                "interrupted after {:.2} s: the whole frame at {} of {} spp -> {}; continue with \
+                 --resume {}",
+                progress.seconds,
+                pass.samples(),
+                film.spp,
+                partial.display(),
+                resume.display()
+            );
+            return Err(Box::new(Interrupted));
+        }
+        Ending::OutOfTime => {
+            let resume = save_unfinished(pass, &out, film.transfer)?;
+            eprintln!(
+                "time budget spent: the whole frame at {} of {} spp; continue with --resume {}",
+                pass.samples(),
+                film.spp,
+                resume.display()
+            );
+        }
+        Ending::Complete => output::save(&pass.image(), &out, film.transfer)?,
     }
-    output::save(&result.image, &out, prepared.film.transfer)?;
+    let mrays_per_second = progress.stats.total() as f64 / progress.seconds.max(1e-9) / 1e6;
     if let Some(path) = &a.stats {
         let json = serde_json::to_string_pretty(&serde_json::json!({
-            "seconds": result.seconds,
+            "seconds": progress.seconds,
             "threads": pool.current_num_threads(),
-            "rays": result.stats,
+            "spp": pass.samples(),
+            "rounds": progress.rounds,
+            "rays": progress.stats,
             "effects": prepared.effects,
-            "total_rays": result.stats.total(),
+            "total_rays": progress.stats.total(),
             "estimated_rays": est.rays(),
-            "mrays_per_second": result.mrays_per_second(),
+            "mrays_per_second": mrays_per_second,
         }))?;
         output::write_file(path, json.as_bytes())
             .map_err(|e| format!("cannot write stats: {e}"))?;
     }
-    let s = &result.stats;
+    let s = &progress.stats;
     if s.dropped > 0 {
         eprintln!(
             "warning: {} sample(s) came out NaN, infinite or negative and were dropped \
@@ -319,8 +469,8 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
          refraction {}, indirect {}), {} dropped samples, {:.1} Mrays/s -> {}",
         prepared.film.width,
         prepared.film.height,
-        prepared.film.spp,
-        result.seconds,
+        pass.samples(),
+        progress.seconds,
         pool.current_num_threads(),
         s.total(),
         s.camera,
@@ -329,7 +479,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         s.refraction,
         s.indirect,
         s.dropped,
-        result.mrays_per_second(),
+        mrays_per_second,
         out.display()
     );
     Ok(())

@@ -8,6 +8,7 @@ pub mod exact;
 pub mod film;
 pub mod output;
 pub mod pass;
+pub mod progressive;
 mod scene;
 
 pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};

@@ -197,6 +197,34 @@ pub fn save(img: &Image, path: &Path, transfer: Transfer) -> Result<(), OutputEr
     })
 }
 
+/// [`save`], with `note` in the file: a PNG `Comment` text chunk (what `identify -verbose` or
+/// `exiftool` shows). For other formats the note is not written.
+pub fn save_noted(
+    img: &Image,
+    path: &Path,
+    transfer: Transfer,
+    note: &str,
+) -> Result<(), OutputError> {
+    if format_of(path)? != ImageFormat::Png {
+        return save(img, path, transfer);
+    }
+    let rgb = to_rgb8(img, transfer);
+    write_via_temp(path, |tmp| {
+        let file = std::fs::File::create(tmp).map_err(|e| e.to_string())?;
+        let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), img.width, img.height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder
+            .add_text_chunk("Comment".into(), note.into())
+            .map_err(|e| e.to_string())?;
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer
+            .write_image_data(rgb.as_raw())
+            .map_err(|e| e.to_string())?;
+        writer.finish().map_err(|e| e.to_string())
+    })
+}
+
 /// Read a linear float image (EXR, or PNG taken as sRGB-encoded).
 pub fn load(path: &Path) -> Result<Image, OutputError> {
     let err = |e: image::ImageError| OutputError::Read {

@@ -332,6 +332,52 @@ impl Pass {
         gaps
     }
 
+    /// A pass of `scene` holding no sample yet, with its fingerprint: the start of a
+    /// progressive render ([`super::progressive`]).
+    pub fn empty(scene: &RenderScene) -> Pass {
+        Pass::from_render(
+            scene,
+            0..0,
+            vec![RgbSum::default(); scene.film.width as usize * scene.film.height as usize],
+        )
+    }
+
+    /// Add the exact sums `sums` of the samples `samples`, which this pass must not hold yet.
+    ///
+    /// # Panics
+    /// If `samples` overlaps a range held, reaches past the spp, or `sums` is not one per
+    /// pixel (callers' bugs: [`super::progressive`] draws its rounds from [`Pass::missing`]).
+    pub fn add(&mut self, samples: Range<u32>, sums: &[RgbSum]) {
+        assert!(
+            samples.end <= self.spp
+                && self
+                    .ranges
+                    .iter()
+                    .all(|r| samples.end <= r.start || r.end <= samples.start)
+                && sums.len() == self.sums.len(),
+            "samples {samples:?} added to a pass holding {:?} of {} spp",
+            self.ranges,
+            self.spp
+        );
+        if samples.is_empty() {
+            return;
+        }
+        for (a, b) in self.sums.iter_mut().zip(sums) {
+            *a += *b;
+        }
+        let at = self.ranges.partition_point(|r| r.end <= samples.start);
+        self.ranges.insert(at, samples);
+        // Join adjacent ranges.
+        let mut joined: Vec<Range<u32>> = Vec::with_capacity(self.ranges.len());
+        for r in self.ranges.drain(..) {
+            match joined.last_mut() {
+                Some(last) if last.end == r.start => last.end = r.end,
+                _ => joined.push(r),
+            }
+        }
+        self.ranges = joined;
+    }
+
     /// A pass from the exact sums a render of `samples` made.
     pub fn from_render(scene: &RenderScene, samples: Range<u32>, sums: Vec<RgbSum>) -> Pass {
         Pass {
@@ -341,10 +387,19 @@ impl Pass {
             seed: scene.seed,
             spp: scene.film.spp,
             transfer: scene.film.transfer,
-            ranges: vec![samples],
+            ranges: if samples.is_empty() {
+                Vec::new()
+            } else {
+                vec![samples]
+            },
             sums,
         }
     }
+}
+
+/// The ranges held as text (`0..16,32..48`), for messages.
+pub fn describe_held(p: &Pass) -> String {
+    show_ranges(&p.ranges)
 }
 
 /// The missing ranges as text, for messages.

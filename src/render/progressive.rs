@@ -1,0 +1,173 @@
+//! Progressive rendering: the whole frame refined in rounds of samples.
+//!
+//! Round after round renders a further range of sample indices of every pixel and adds their
+//! exact sums ([`super::exact`]) to a [`Pass`]. The rounds double the samples held (1, 2, 4,
+//! 8, ... spp in all), so after every round the image is a valid render of the whole frame at
+//! fewer samples. Because the sums are exact, the image after the last round has the bits of a
+//! one-go [`super::render`], whatever the rounds were, and a render stopped after any round
+//! and resumed from its [`Pass`] ends with the same bits too.
+//!
+//! A time budget shortens the schedule: before each round, its time is predicted from the
+//! seconds per sample measured so far, and the round is cut to the samples that fit (or not
+//! started when not one fits). The first round of a render always runs, so there is an image.
+
+use super::exact::RgbSum;
+use super::pass::Pass;
+use super::{RenderScene, Tiled, render_pass};
+use crate::stats::RayStats;
+use std::ops::Range;
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+/// What a progressive render has after a round.
+#[derive(Clone, Debug)]
+pub struct Round {
+    /// The sample indices this round rendered.
+    pub samples: Range<u32>,
+    /// Samples per pixel held after it (this round's and every earlier one's).
+    pub held: u64,
+    /// Seconds this run has spent tracing so far.
+    pub seconds: f64,
+}
+
+/// How a progressive render ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ending {
+    /// Every sample of the film is held.
+    Complete,
+    /// `stop` was set: the round in flight was dropped, the earlier rounds are held.
+    Stopped,
+    /// The next round did not fit the time budget.
+    OutOfTime,
+    /// The `on_round` callback asked to end.
+    Declined,
+}
+
+/// The result of [`refine`].
+#[derive(Clone, Debug)]
+pub struct Progress {
+    /// The exact sums of the samples held (those resumed from, and those rendered).
+    pub pass: Pass,
+    /// Rays traced in this run, by kind.
+    pub stats: RayStats,
+    /// Seconds this run spent tracing.
+    pub seconds: f64,
+    /// Rounds completed in this run.
+    pub rounds: u32,
+    /// Why it ended.
+    pub ending: Ending,
+    /// When stopped: the round in flight, with the tiles it finished (the others hold no
+    /// sample). Not part of [`Progress::pass`]; a caller whose pass holds nothing yet may show
+    /// these tiles rather than no image.
+    pub dropped: Option<(Range<u32>, Tiled<RgbSum>)>,
+}
+
+/// Samples of the next round: as many as are held already (so the total doubles), at least
+/// one, taken from the first range the pass does not hold; `None` when every sample is held.
+pub fn next_round(pass: &Pass) -> Option<Range<u32>> {
+    let gap = pass.missing().into_iter().next()?;
+    let size = (pass.samples() as u32).clamp(1, gap.len() as u32);
+    Some(gap.start..gap.start + size)
+}
+
+/// Render rounds of `scene` into `pass` (an empty [`Pass::empty`], or one resumed from) until
+/// every sample is held, `stop` is set, the budget `budget` of tracing time is spent, or
+/// `on_round` returns false. `on_round` sees the pass after each completed round; `on_tile`
+/// is called after each tile of each round with the round's samples per pixel (progress).
+///
+/// A round stopped midway is dropped whole, so the pass only ever holds whole rounds: every
+/// pixel always has the same samples.
+pub fn refine(
+    scene: &RenderScene,
+    mut pass: Pass,
+    budget: Option<Duration>,
+    on_tile: &(dyn Fn(u32) + Sync),
+    stop: &AtomicBool,
+    on_round: &mut dyn FnMut(&Pass, &Round) -> bool,
+) -> Progress {
+    let start = Instant::now();
+    let (mut stats, mut seconds, mut rounds) = (RayStats::default(), 0.0, 0);
+    let mut traced: u64 = 0;
+    let mut dropped = None;
+    let ending = loop {
+        let Some(mut samples) = next_round(&pass) else {
+            break Ending::Complete;
+        };
+        // Fit the round to what is left of the budget, at the rate measured so far.
+        if let Some(budget) = budget {
+            let left = budget.as_secs_f64() - start.elapsed().as_secs_f64();
+            if rounds > 0 {
+                let per_sample = seconds / traced as f64;
+                let fit = (left / per_sample).floor().min(samples.len() as f64);
+                if fit < 1.0 {
+                    break Ending::OutOfTime;
+                }
+                samples.end = samples.start + fit as u32;
+            }
+        }
+        let size = samples.len() as u32;
+        let part = render_pass(scene, samples.clone(), &|| on_tile(size), stop);
+        if part.tiles_done < part.tiles {
+            dropped = Some((samples, part));
+            break Ending::Stopped;
+        }
+        pass.add(samples.clone(), &part.pixels);
+        stats += part.stats;
+        seconds += part.seconds;
+        traced += samples.len() as u64;
+        rounds += 1;
+        let round = Round {
+            samples,
+            held: pass.samples(),
+            seconds,
+        };
+        if !on_round(&pass, &round) {
+            break if pass.is_complete() {
+                Ending::Complete
+            } else {
+                Ending::Declined
+            };
+        }
+    };
+    Progress {
+        pass,
+        stats,
+        seconds,
+        rounds,
+        ending,
+        dropped,
+    }
+}
+
+/// Check that `pass` (read from a file) belongs to `scene` and may be resumed by [`refine`]:
+/// the same size, fingerprint, seed and spp. The message names what differs.
+pub fn check_resumable(scene: &RenderScene, pass: &Pass) -> Result<(), String> {
+    let fresh = Pass::empty(scene);
+    let differ = |what: &str, file: String, now: String| {
+        Err(format!(
+            "it is a render of another {what} ({file}, the scene now gives {now}): resume only \
+             with the scene, film, seed and settings it was rendered with"
+        ))
+    };
+    if (pass.width, pass.height) != (fresh.width, fresh.height) {
+        return differ(
+            "film size",
+            format!("{}x{}", pass.width, pass.height),
+            format!("{}x{}", fresh.width, fresh.height),
+        );
+    }
+    if pass.spp != fresh.spp {
+        return differ("spp", pass.spp.to_string(), fresh.spp.to_string());
+    }
+    if pass.seed != fresh.seed {
+        return differ("seed", pass.seed.to_string(), fresh.seed.to_string());
+    }
+    if pass.fingerprint != fresh.fingerprint {
+        return differ(
+            "scene",
+            format!("fingerprint {:016x}", pass.fingerprint),
+            format!("{:016x}", fresh.fingerprint),
+        );
+    }
+    Ok(())
+}
