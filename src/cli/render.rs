@@ -10,6 +10,7 @@ use rtis::render::film::Image;
 use rtis::render::output::Transfer;
 use rtis::render::pass::{self, Pass};
 use rtis::render::progressive::{self, Ending};
+use rtis::render::tev::Display;
 use rtis::render::{self, Film, output};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -61,6 +62,10 @@ pub struct RenderArgs {
     /// image then has the bits of a render never stopped.
     #[arg(long, value_name = "PASS.exr", conflicts_with = "pass")]
     resume: Option<PathBuf>,
+    /// Stream each progressive round to the tev image viewer listening at HOST:PORT (tev's
+    /// default is 127.0.0.1:14158), as pbrt-v4's --display-server does.
+    #[arg(long, value_name = "HOST:PORT")]
+    display: Option<String>,
     /// Instruction set of the SIMD code: the widest this CPU runs (auto), or one named, to
     /// measure what it is worth. The image is the same in each.
     #[arg(long, value_enum, default_value_t = IsaChoice::Auto)]
@@ -352,6 +357,17 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         );
         return Ok(());
     }
+    let mut display = match &a.display {
+        Some(address) => {
+            let name = out
+                .file_name()
+                .map_or_else(|| stem.clone(), |n| n.to_string_lossy().into_owned());
+            let d = Display::connect(address, &name, prepared.film.width, prepared.film.height)?;
+            eprintln!("streaming each round to tev at {address} as `{name}`");
+            Some(d)
+        }
+        None => None,
+    };
     if to_render == 0 {
         eprintln!("every sample is held already: writing the image");
     }
@@ -366,13 +382,19 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         eprintln!(
             "rendering in rounds of doubling spp; Ctrl-C keeps the last whole round, twice quits"
         );
-        let mut on_round = |_: &Pass, r: &progressive::Round| {
+        let mut on_round = |held: &Pass, r: &progressive::Round| {
             bar.suspend(|| {
                 eprintln!(
                     "round: samples {}..{}, {} of {} spp after {:.2} s",
                     r.samples.start, r.samples.end, r.held, film.spp, r.seconds
                 )
             });
+            if let Some(d) = &mut display
+                && let Err(e) = d.show(&held.image())
+            {
+                bar.suspend(|| eprintln!("warning: tev stopped taking images ({e}); rendering on"));
+                display = None;
+            }
             true
         };
         pool.install(|| {

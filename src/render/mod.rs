@@ -10,6 +10,7 @@ pub mod output;
 pub mod pass;
 pub mod progressive;
 mod scene;
+pub mod tev;
 
 pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};
 
