@@ -43,7 +43,11 @@ impl Fields<'_> {
         i64::from_le_bytes(self.take(8).try_into().unwrap())
     }
     fn string(&mut self) -> String {
-        let end = self.0.iter().position(|&b| b == 0).expect("a terminated string");
+        let end = self
+            .0
+            .iter()
+            .position(|&b| b == 0)
+            .expect("a terminated string");
         let s = String::from_utf8(self.take(end).to_vec()).unwrap();
         self.take(1);
         s
@@ -79,11 +83,10 @@ fn read_packet(stream: &mut impl Read) -> Option<Packet> {
             let region = [f.i32(), f.i32(), f.i32(), f.i32()];
             let offsets: Vec<i64> = (0..n).map(|_| f.i64()).collect();
             let strides: Vec<i64> = (0..n).map(|_| f.i64()).collect();
-            let data: Vec<f32> = f
-                .0
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
-                .collect();
+            let data: Vec<f32> =
+                f.0.chunks_exact(4)
+                    .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+                    .collect();
             // Channel-major values of the region, read by the offsets and strides.
             let pixels = (region[2] * region[3]) as usize;
             let mut values = Vec::new();
@@ -132,7 +135,15 @@ fn render_streams_each_round_to_a_tev_server() {
     let run = Command::new(env!("CARGO_BIN_EXE_rtis"))
         .arg("render")
         .arg(&scene)
-        .args(["--width", "200", "--height", "150", "--spp", "4", "--display"])
+        .args([
+            "--width",
+            "200",
+            "--height",
+            "150",
+            "--spp",
+            "4",
+            "--display",
+        ])
         .arg(format!("127.0.0.1:{port}"))
         .arg("-o")
         .arg(&out)
@@ -178,9 +189,15 @@ fn render_streams_each_round_to_a_tev_server() {
             }
         }
     }
-    assert!(covered.iter().all(|&c| c == 1), "each pixel sent once per round");
+    assert!(
+        covered.iter().all(|&c| c == 1),
+        "each pixel sent once per round"
+    );
     let written = image::open(&out).unwrap().to_rgb32f();
-    let want: Vec<u32> = written.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect();
+    let want: Vec<u32> = written
+        .pixels()
+        .flat_map(|p| p.0.map(f32::to_bits))
+        .collect();
     let got: Vec<u32> = image.iter().map(|v| v.to_bits()).collect();
     assert!(got == want, "the last round sent is the image written");
     std::fs::remove_dir_all(&d).unwrap();

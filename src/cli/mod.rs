@@ -9,6 +9,7 @@ pub mod interrupt;
 mod merge;
 mod render;
 mod warptest;
+mod watch;
 
 use clap::{Parser, Subcommand};
 use rtis::scene::{self, Scene, SceneError};
@@ -26,6 +27,8 @@ pub struct Cli {
 enum Command {
     /// Render a scene to a PNG or EXR file.
     Render(render::RenderArgs),
+    /// Render a scene live in a local web page, again whenever it or a file it reads changes.
+    Watch(watch::WatchArgs),
     /// Validate a scene and print what it contains.
     Check {
         /// The scene file (RON).
@@ -57,6 +60,7 @@ pub struct Interrupted;
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Watch(args) => watch::run(args),
         Command::Check { scene } => check::run(&scene),
         Command::Converge(args) => converge::run(args),
         Command::Diff(args) => diff::run(args),

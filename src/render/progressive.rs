@@ -28,6 +28,8 @@ pub struct Round {
     pub held: u64,
     /// Seconds this run has spent tracing so far.
     pub seconds: f64,
+    /// Rays this run has traced so far, by kind.
+    pub stats: RayStats,
 }
 
 /// How a progressive render ended.
@@ -120,6 +122,7 @@ pub fn refine(
             samples,
             held: pass.samples(),
             seconds,
+            stats,
         };
         if !on_round(&pass, &round) {
             break if pass.is_complete() {

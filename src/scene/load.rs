@@ -29,6 +29,8 @@ struct Source {
     text: String,
     dir: Option<PathBuf>,
     tree: Option<Node>,
+    /// The file it was read from (none for text given in memory).
+    file: Option<PathBuf>,
 }
 
 impl Source {
@@ -38,6 +40,7 @@ impl Source {
             text,
             dir,
             tree: None,
+            file: None,
         }
     }
 
@@ -204,11 +207,9 @@ fn read(path: &Path) -> Result<Source, ReadError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(ReadError::Io)?;
     let text = decode(&name, bytes).map_err(ReadError::Located)?;
-    Ok(Source::new(
-        name,
-        text,
-        path.parent().map(Path::to_path_buf),
-    ))
+    let mut src = Source::new(name, text, path.parent().map(Path::to_path_buf));
+    src.file = Some(path.to_path_buf());
+    Ok(src)
 }
 
 /// The text of a file, or an error at the line and column of its first byte that is not UTF-8.
@@ -409,6 +410,7 @@ impl Resolved {
     fn into_scene(self, origin: String) -> Result<Scene, SceneError> {
         let mut world = hecs::World::new();
         let mut warnings = Vec::new();
+        let mut files: Vec<PathBuf> = self.sources.iter().filter_map(|s| s.file.clone()).collect();
         let d = Settings::default();
         let settings = Settings {
             film: self.film.map_or(d.film, |f| f.0),
@@ -443,6 +445,7 @@ impl Resolved {
                 let shape = shape
                     .to_world(|path| {
                         let file = src.dir.clone().unwrap_or_default().join(path);
+                        files.push(file.clone());
                         crate::mesh::load_obj(&file)
                     })
                     .map_err(|m| src.error(place("shape", Some("path")), m))?;
@@ -512,6 +515,7 @@ impl Resolved {
             settings,
             origin,
             warnings,
+            files,
         })
     }
 }

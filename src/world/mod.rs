@@ -86,4 +86,7 @@ pub struct Scene {
     pub origin: String,
     /// Things worth telling the user that do not stop the render.
     pub warnings: Vec<String>,
+    /// The files it was read from: the scene file, the bases it extends and the meshes it
+    /// loads (what `rtis watch` follows). Empty for a scene given as text.
+    pub files: Vec<std::path::PathBuf>,
 }
