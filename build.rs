@@ -1,6 +1,6 @@
 //! Build script: tells the tests whether QEMU's user-mode emulator (`qemu-x86_64`, Debian's
 //! qemu-user) is on the PATH, as the `rtis_qemu` cfg, so that the emulated test of
-//! `tests/cpu_dispatch.rs` is listed as ignored, with its reason, where it cannot run (instead
+//! `tests/integration/cpu_dispatch.rs` is listed as ignored, with its reason, where it cannot run (instead
 //! of passing without testing anything). With `RTIS_REQUIRE_QEMU=1` (set by `.ci/run`) a
 //! missing emulator fails the build.
 //!

@@ -164,7 +164,7 @@ def rtis_material(m):
 def rtis_scene(variant, spp):
     lines = [
         f"// Written by bench/mitsuba_materials_reference.py ({variant}); Mitsuba 3's image of the",
-        "// same scene is in tests/data (tests/bsdfs.rs compares them). Rows, front to back: rough",
+        "// same scene is in tests/data (tests/integration/bsdfs.rs compares them). Rows, front to back: rough",
         "// gold, frosted glass and blue rough plastic; roughness 0.03, 0.15 and 0.5 from left to",
         "// right in rtis's image (Mitsuba's is mirrored left-right). The floor is a smooth plastic.",
         "Scene(",

@@ -29,7 +29,7 @@ that this script rewrites from a run of `rtis render --stats`, `rtis bench --jso
 
 Needs only Python 3 and a release build (built here if missing). About 6 minutes on 2 cores;
 `--only NAME[,NAME]` regenerates some blocks. `--check` only verifies that README.md has every
-block, each opened by its generated-by line (tests/readme.rs runs it in CI).
+block, each opened by its generated-by line (tests/integration/readme.rs runs it in CI).
 
 Usage:
     python3 bench/readme_figures.py [--only hero,cornell] [--runs 3]

@@ -2,7 +2,7 @@
 //! (`glam::Vec4`). Planes always live here; spheres too when a scene has few of them, where a
 //! BVH costs more than it saves. The arithmetic is the scalar tests' (`shape::Sphere`,
 //! `shape::Plane`), including their rule for a ray that starts on the surface, so a packet
-//! finds the hits the scalar code would (`tests/shapes.rs` checks that they agree).
+//! finds the hits the scalar code would (`tests/integration/shapes.rs` checks that they agree).
 //!
 //! The same tests run the other way round: a ray per lane ([`RayLanes::gather`]) against one
 //! primitive in all of them ([`SphereLanes::splat`]), as a batch of rays needs, four lanes in

@@ -6,7 +6,7 @@
 //! half vector of `wo` and `wi`. Only single scattering is modelled, as in Mitsuba 3 and
 //! pbrt-v4: the light that would bounce between microfacets is lost, so a rough metal reflects
 //! less than its Fresnel reflectance. A GGX mirror keeps 99% at alpha 0.1 seen from the
-//! normal, 88% at alpha 0.3 and 31% at alpha 1 (57% at 85 degrees); `tests/materials.rs`
+//! normal, 88% at alpha 0.3 and 31% at alpha 1 (57% at 85 degrees); `tests/integration/materials.rs`
 //! integrates these (`albedo_table`) and checks the sampler against them.
 
 use super::bsdf_sample::BsdfSample;

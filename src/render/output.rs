@@ -28,7 +28,7 @@ pub fn remove_pending() {
 }
 
 /// A test hook: with `RTIS_TEST_WRITE_PAUSE_MS` set, hold a finished temporary file that long
-/// before renaming it, so that `tests/cli_interrupt.rs` can interrupt a write at a known moment.
+/// before renaming it, so that `tests/integration/cli_interrupt.rs` can interrupt a write at a known moment.
 fn pause_for_tests() {
     if let Some(ms) = std::env::var("RTIS_TEST_WRITE_PAUSE_MS")
         .ok()

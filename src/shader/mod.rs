@@ -60,7 +60,7 @@ pub enum Shader {
 
 /// An observer of every ray a shader traces, told each ray with its kind where the ray is
 /// counted ([`RayStats`]), whichever code traces it: the one-ray queries, the waves' batches and
-/// their rays in lanes. For tests (`tests/origins.rs` checks that every spawned ray starts on
+/// their rays in lanes. For tests (`tests/integration/origins.rs` checks that every spawned ray starts on
 /// the side of the surface it leaves towards); renders leave it unset, at the cost of one
 /// predictable branch per ray.
 pub type RayAudit = fn(&Ray, RayKind);

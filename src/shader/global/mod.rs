@@ -149,7 +149,7 @@ impl Order {
 
 /// `L_i` along each of `rays` (indirect rays leaving the first Phong hit, traced at depth 1)
 /// in `order`, with no random numbers drawn between them. Where `order` applies, every order
-/// gives the same bits and counts the same rays (`tests/global_waves.rs` checks it).
+/// gives the same bits and counts the same rays (`tests/integration/global_waves.rs` checks it).
 pub fn incident_all(tr: &mut Tracer, g: &Global, rays: &[Ray], order: Order) -> Vec<Vec3A> {
     debug_assert!(order.applies(tr, g), "{order:?} does not apply");
     match order {

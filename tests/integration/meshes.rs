@@ -1,8 +1,8 @@
 //! Meshes: OBJ loading, smooth shading, transforms, watertightness and the BVH.
 
-mod common;
+use crate::common;
 
-use common::{render_str, scene};
+use crate::common::{render_str, scene};
 use glam::{Vec3, Vec3A};
 use rtis::RenderScene;
 use rtis::geometry::Ray;

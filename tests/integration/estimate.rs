@@ -2,9 +2,7 @@
 //! a Phong surface, the calibration is close on the course's box, and `render` refuses a
 //! ruinous estimate without `--force`.
 
-mod common;
-
-use common::{render_scene, scene};
+use crate::common::{render_scene, scene};
 use rtis::render::estimate::{estimate, rule_rays_per_sample};
 
 /// A closed sphere room of Phong walls around the camera, with `lights` point lights inside:

@@ -1,13 +1,13 @@
-//! The Global shader's weights, checked a second way (`tests/transport.rs` is the first): Eq. 4's
+//! The Global shader's weights, checked a second way (`tests/integration/transport.rs` is the first): Eq. 4's
 //! `1 / (2 pi n)` and the n-bounce rule's `1 / (4 pi)` over both of its rays, in configurations
 //! other than that file's, exact where the answer is a constant and statistical where it is an
 //! expectation, each through every order of tracing: the trees in waves, by the kernel of
 //! packed scenes and by that of scenes with a BVH, and the depth-first walk (which the scene
 //! is made to take by 65 point lights that add nothing).
 
-mod common;
+use crate::common;
 
-use common::{render_scene, scene};
+use crate::common::{render_scene, scene};
 use glam::Vec3A;
 use rtis::render::Rendered;
 use rtis::sampling::Sampler;

@@ -13,7 +13,7 @@
 //! error plus two roundings of its coordinates, some 1e-7 of the scene's scale, and `f64`
 //! rounds at 1e-16 of it).
 
-mod common;
+use crate::common;
 
 use glam::{DVec3, Vec3A};
 use rtis::RenderScene;
@@ -359,7 +359,7 @@ fn check(rs: &RenderScene, tally: &mut Tally, order: &'static str, what: &str) {
         // it leaves and any neighbour within reach, lies behind it): a plane or triangle not
         // at all, a sphere only where the line crosses it away from the start. The nearest hit
         // is asked of the one-ray query; the batches and lanes the waves trace with give its
-        // answers field for field (`tests/batch.rs`, on rays leaving hits among others).
+        // answers field for field (`tests/integration/batch.rs`, on rays leaving hits among others).
         if let Some(hit) = rs.geometry.intersect(&ray)
             && let Some(&(_, shape, surface, ..)) = near.iter().find(|n| n.0 == hit.prim)
         {

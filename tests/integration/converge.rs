@@ -1,8 +1,6 @@
 //! The converge sweep: rungs, metrics and outputs.
 
-mod common;
-
-use common::scene;
+use crate::common::scene;
 use rtis::RenderScene;
 use rtis::converge::{self, metrics};
 use rtis::render::{film::Image, render};

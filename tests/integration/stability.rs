@@ -1,9 +1,9 @@
 //! Hard cases stay numerically stable: the empty-room invariant at every size, scale and
 //! offset, and random scenes at extreme scales (proptest).
 
-mod common;
+use crate::common;
 
-use common::scene;
+use crate::common::scene;
 use glam::DVec3;
 use rtis::render;
 
@@ -41,7 +41,7 @@ fn room(width: u32, height: u32, s: f64, t: DVec3, shadows: bool) -> String {
 
 /// Pixels that differ between the room rendered with shadow rays and without. The shadow
 /// rays test the planes even though the lights are in the room (where the renderer skips them,
-/// `tests/room.rs`): that is what puts the planes' error bands to the test.
+/// `tests/integration/room.rs`): that is what puts the planes' error bands to the test.
 fn seam_pixels(width: u32, height: u32, s: f64, t: DVec3) -> usize {
     let mut lit = rtis::extract(&scene(&room(width, height, s, t, true)));
     common::lights_out_of_room(&mut lit);

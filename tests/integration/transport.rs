@@ -1,8 +1,8 @@
 //! Exact answers of the course's shaders, derived by hand (see each test's comment).
 
-mod common;
+use crate::common;
 
-use common::{close, render_str};
+use crate::common::{close, render_str};
 use glam::Vec3A;
 use std::f32::consts::PI;
 

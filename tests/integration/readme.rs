@@ -3,7 +3,7 @@
 //! checks that every block is there with its stamp, and that the README's two commands are the
 //! ones the project promises.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

@@ -3,7 +3,7 @@
 //! any-hit answer), on rays aimed at random points, vertices and edges, rays that start on a
 //! triangle of the block, and blocks that mix spheres with triangles.
 
-mod common;
+use crate::common;
 
 use glam::{Vec3, Vec3A};
 use rtis::accel::Prim;

@@ -1,9 +1,9 @@
 //! The physically based model and the reference integrator, checked against known answers and
 //! an independent renderer (Mitsuba 3).
 
-mod common;
+use crate::common;
 
-use common::{render_str, scene, scenes_dir};
+use crate::common::{render_str, scene, scenes_dir};
 use glam::Vec3A;
 use proptest::prelude::*;
 use rtis::converge::warptest;

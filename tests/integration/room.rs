@@ -2,9 +2,9 @@
 //! camera is in, and shadow rays towards a light in that room skip the planes without changing
 //! a pixel.
 
-mod common;
+use crate::common;
 
-use common::{scene, scenes_dir};
+use crate::common::{scene, scenes_dir};
 use glam::{DVec3, Vec3A};
 use rtis::geometry::{Origins, Ray};
 use rtis::light::Light;

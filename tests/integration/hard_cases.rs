@@ -1,9 +1,7 @@
 //! Hard cases stay numerically stable: each renders, asserts that no pixel is NaN or infinite,
 //! and checks its specific expectation.
 
-mod common;
-
-use common::{render_scene, render_str, scene, scenes_dir};
+use crate::common::{render_scene, render_str, scene, scenes_dir};
 use glam::{DVec3, Vec3A};
 use rtis::render::Rendered;
 use rtis::scene::{Scene, load_path};

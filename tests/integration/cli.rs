@@ -1,7 +1,7 @@
 //! The command line: renders, checks, and fails cleanly (message, location, non-zero exit, no
 //! panic, no half-written file).
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::process::{Command, Output};

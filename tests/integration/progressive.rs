@@ -2,9 +2,9 @@
 //! frame, each a valid render at fewer samples; the last has the bits of a one-go render, and a
 //! render stopped after any round and resumed from its pass file ends with the same bits.
 
-mod common;
+use crate::common;
 
-use common::scene;
+use crate::common::scene;
 use rtis::render::pass::Pass;
 use rtis::render::progressive::{Ending, check_resumable, next_round, refine};
 use rtis::render::render;

@@ -1,6 +1,6 @@
 //! The rounding-error bounds of the shapes (src/shape/*.rs, src/accel/lanes.rs) are safe and
 //! consistent: rays that start on a surface (within rounding) never meet it at their start
-//! (planes here are not oriented; `tests/room.rs` and `tests/shapes.rs` test oriented ones),
+//! (planes here are not oriented; `tests/integration/room.rs` and `tests/integration/shapes.rs` test oriented ones),
 //! in every code path (scalar, SIMD lanes, BVH); every hit point lies within its bounds; and
 //! the bounds scale exactly with the scene. Scaling every coordinate by a power of two changes
 //! no rounding, so a bound that is a sum of terms of the right dimension (lengths, or squared

@@ -2,9 +2,9 @@
 //! below a first hit traced in waves give the depth-first walk's `L_i` to the bit, and count
 //! the same rays, in every scene where the waves apply; where they would not, they stand aside.
 
-mod common;
+use crate::common;
 
-use common::{lights_out_of_room, scene, scenes_dir};
+use crate::common::{lights_out_of_room, scene, scenes_dir};
 use glam::Vec3A;
 use rtis::RenderScene;
 use rtis::geometry::Ray;

@@ -2,9 +2,9 @@
 //! rough dielectrics, rough plastics and plastics. Reciprocity, samples that agree with their
 //! pdf, energy (white furnaces), the smooth limits, and Mitsuba 3's images of the same scenes.
 
-mod common;
+use crate::common;
 
-use common::{block, render_scene, scene, scenes_dir};
+use crate::common::{block, render_scene, scene, scenes_dir};
 use glam::Vec3A;
 use proptest::prelude::*;
 use rtis::material::conductor::{Conductor, Metal};

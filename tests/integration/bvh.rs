@@ -1,9 +1,9 @@
 //! The BVH's structure and quality (src/accel/bvh.rs): every primitive in exactly one leaf,
 //! boxes nested, and a surface-area-heuristic cost no worse than a plain object-median split
-//! of the same primitives. A wrong split still gives right images (tests/meshes.rs compares
+//! of the same primitives. A wrong split still gives right images (tests/integration/meshes.rs compares
 //! hits with brute force) but a slower tree; the SAH cost sees it without timing anything.
 
-mod common;
+use crate::common;
 
 use glam::{Vec3, Vec3A};
 use rtis::accel::{Bvh, Isa, Prim, WideBvh, require_all_isas, wide};

@@ -2,9 +2,9 @@
 //! in any number and order give the bits of one render; parts that do not belong together, or
 //! do not hold every sample exactly once, are refused with a message that names them.
 
-mod common;
+use crate::common;
 
-use common::scene;
+use crate::common::scene;
 use rtis::render::pass::{Pass, pass_range};
 use rtis::render::{render, render_pass};
 use std::process::Command;

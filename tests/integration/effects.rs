@@ -1,8 +1,6 @@
 //! Only the effects a scene calls for are simulated, and the derived effects change no pixel.
 
-mod common;
-
-use common::{render_scene, scene, scenes_dir};
+use crate::common::{render_scene, scene, scenes_dir};
 use rtis::render::render;
 use rtis::scene::load_path;
 use rtis::shape::Shape;

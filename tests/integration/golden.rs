@@ -11,9 +11,7 @@
 //! snapshot again: it promotes `NAME.new.png` to `NAME.png` and removes the diff. After a
 //! rejection and a revert, the next run removes the stale new and diff images.
 
-mod common;
-
-use common::{render_scene, scenes_dir};
+use crate::common::{render_scene, scenes_dir};
 use image::RgbImage;
 use rtis::converge::metrics::{flip_rgb8, fnv1a};
 use rtis::render::output::to_rgb8;
@@ -224,7 +222,7 @@ fn every_scene_has_a_golden_test() {
     listed.sort();
     assert_eq!(
         files, listed,
-        "add the new scene to golden_tests! in tests/golden.rs"
+        "add the new scene to golden_tests! in tests/integration/golden.rs"
     );
 }
 

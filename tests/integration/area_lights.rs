@@ -2,9 +2,9 @@
 //! answers from closed forms, statistical tests with stated tolerances, properties of the
 //! sampling densities and MIS weights, and Mitsuba 3's Cornell box with its rectangle light.
 
-mod common;
+use crate::common;
 
-use common::{mean_and_se, render_scene, scene, scenes_dir};
+use crate::common::{mean_and_se, render_scene, scene, scenes_dir};
 use glam::Vec3A;
 use proptest::prelude::*;
 use rtis::converge::warptest::{self, Case, direction_bin, integrate_pdf_with_edges};

@@ -1,7 +1,7 @@
 //! `rtis warptest` (src/converge/warptest.rs): every sampler passes its chi-squared test, a
 //! sampler with the wrong pdf fails it, and the p-values are right where tables give them.
 
-mod common;
+use crate::common;
 
 use glam::Vec3A;
 use rtis::converge::warptest::{self, Case, direction_bin, gamma_q, integrate_pdf};

@@ -1,0 +1,41 @@
+//! The integration tests, one module per file, mirroring `src/` (see README.md, "Tests"): one
+//! test binary, so that `cargo test` links the library into one executable rather than one per
+//! file.
+
+mod common;
+
+mod architecture;
+mod area_lights;
+mod batch;
+mod block;
+mod bounds;
+mod bsdfs;
+mod bvh;
+mod cli;
+mod cli_interrupt;
+mod converge;
+mod cpu_dispatch;
+mod effects;
+mod estimate;
+mod global_waves;
+mod global_weights;
+mod golden;
+mod hard_cases;
+mod materials;
+mod meshes;
+mod origins;
+mod output;
+mod passes;
+mod physical;
+mod progressive;
+mod readme;
+mod room;
+mod sampling;
+mod scene_errors;
+mod scene_fuzz;
+mod shapes;
+mod stability;
+mod tev;
+mod transport;
+mod warptest;
+mod watch;
