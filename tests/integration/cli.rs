@@ -444,3 +444,53 @@ fn a_child_past_its_time_limit_is_killed() {
     );
     assert!(start.elapsed().as_secs() < 10, "{:?}", start.elapsed());
 }
+
+/// `check` and `render` estimate one scene alike: the same rays (the shader's rule and the
+/// calibration's count, which are deterministic) on the same threads. The seconds come from
+/// timing the calibration and vary from run to run with the machine; they are not compared.
+#[test]
+fn check_and_render_estimate_the_same_rays() {
+    let d = tmp("estimate");
+    let scene = d.join("small.ron");
+    let cornell = common::scenes_dir().join("cornell.ron");
+    std::fs::write(
+        &scene,
+        format!("Scene(extends: {cornell:?}, film: (width: 40, height: 32, spp: 2))\n"),
+    )
+    .unwrap();
+    let s = scene.to_str().unwrap();
+    let check = rtis(&["check", s]);
+    let out = String::from_utf8_lossy(&check.stdout).into_owned();
+    let from_check = out
+        .lines()
+        .find_map(|l| {
+            l.strip_prefix("// cost: ")?
+                .rsplit_once("), ")
+                .map(|(_, t)| t.to_string())
+        })
+        .unwrap_or_else(|| panic!("no cost line: {out}"));
+    let png = d.join("small.png");
+    let render = rtis(&["render", s, "--threads", "2", "-o", png.to_str().unwrap()]);
+    let err = stderr(&render);
+    let from_render = err
+        .lines()
+        .find_map(|l| l.strip_prefix("estimate: "))
+        .unwrap_or_else(|| panic!("no estimate line: {err}"));
+    // "3.746e4 rays in all, about ... on 2 threads" against "3.746e4 rays, about ... on 2 threads".
+    let rays = |t: &str| t.split(" rays").next().unwrap().to_string();
+    let threads = |t: &str| {
+        t.split(" on ")
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(rays(&from_check), rays(from_render), "{out}\n{err}");
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if cores == 2 {
+        assert_eq!(threads(&from_check), threads(from_render), "{out}\n{err}");
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
