@@ -7,7 +7,7 @@ mod orthographic;
 mod perspective;
 
 pub use orthographic::Orthographic;
-pub use perspective::Perspective;
+pub use perspective::{Perspective, ThinLens};
 
 use crate::geometry::Ray;
 use glam::{DVec3, Vec3A};
@@ -15,16 +15,29 @@ use glam::{DVec3, Vec3A};
 /// How a camera projects: the part of a [`WorldCamera`] that is not its frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
-    /// Pinhole perspective with vertical field of view `fov` in degrees, in (0, 180).
+    /// Perspective with vertical field of view `fov` in degrees, in (0, 180): a pinhole, or a
+    /// thin lens.
     Perspective {
         /// Vertical field of view, degrees.
         fov: f64,
+        /// The lens: aperture radius and focus distance, scene units, both > 0; `None` for a
+        /// pinhole.
+        lens: Option<WorldLens>,
     },
     /// Parallel projection of an image rectangle `height` scene units tall.
     Orthographic {
         /// Vertical extent, scene units, > 0.
         height: f64,
     },
+}
+
+/// A thin lens as the world holds it (see [`ThinLens`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldLens {
+    /// Aperture radius, scene units, > 0.
+    pub radius: f64,
+    /// Distance to the plane in focus along the viewing direction, scene units, > 0.
+    pub focus_distance: f64,
 }
 
 /// A camera as the world holds it: scene units, double precision.
@@ -49,11 +62,15 @@ impl WorldCamera {
             self.up.as_vec3a(),
         );
         match self.projection {
-            Projection::Perspective { fov } => Camera::Perspective(Perspective {
+            Projection::Perspective { fov, lens } => Camera::Perspective(Perspective {
                 origin: Vec3A::ZERO,
                 basis,
                 tan_half_fov: (fov.to_radians() * 0.5).tan() as f32,
                 aspect,
+                lens: lens.map(|l| ThinLens {
+                    radius: l.radius as f32,
+                    focus_distance: l.focus_distance as f32,
+                }),
             }),
             Projection::Orthographic { height } => Camera::Orthographic(Orthographic {
                 origin: Vec3A::ZERO,
@@ -99,21 +116,27 @@ pub enum Camera {
 
 impl Camera {
     /// The corners of the region camera rays start from: every primary ray's origin is a
-    /// convex combination of them (the centre of projection, four times, for a pinhole).
+    /// convex combination of them (the centre of projection, four times, for a pinhole; the
+    /// square around the lens for a thin lens).
     pub fn starts(&self) -> [Vec3A; 4] {
         match self {
-            Camera::Perspective(c) => [c.origin; 4],
+            Camera::Perspective(c) => match c.lens {
+                None => [c.origin; 4],
+                Some(l) => [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)]
+                    .map(|(x, y)| c.origin + l.radius * (x * c.basis.right + y * c.basis.up)),
+            },
             Camera::Orthographic(c) => {
                 [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(u, v)| c.ray(u, v).o)
             }
         }
     }
 
-    /// The primary ray through image point `(u, v)`, both in `[0, 1]`, `(0, 0)` the top-left.
+    /// The primary ray through image point `(u, v)`, both in `[0, 1]`, `(0, 0)` the top-left;
+    /// a thin lens draws its point on the lens from `lens_sample` (the others draw nothing).
     #[inline]
-    pub fn ray(&self, u: f32, v: f32) -> Ray {
+    pub fn ray(&self, u: f32, v: f32, lens_sample: impl FnOnce() -> (f32, f32)) -> Ray {
         match self {
-            Camera::Perspective(c) => c.ray(u, v),
+            Camera::Perspective(c) => c.ray(u, v, lens_sample),
             Camera::Orthographic(c) => c.ray(u, v),
         }
     }

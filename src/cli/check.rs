@@ -205,7 +205,18 @@ pub fn to_ron(scene: &Scene) -> String {
     );
     let c = &s.camera;
     let (kind, extent) = match c.projection {
-        Projection::Perspective { fov } => ("Perspective", format!("fov: {}", num(fov))),
+        Projection::Perspective { fov, lens: None } => {
+            ("Perspective", format!("fov: {}", num(fov)))
+        }
+        Projection::Perspective { fov, lens: Some(l) } => (
+            "Perspective",
+            format!(
+                "fov: {}, aperture_radius: {}, focus_distance: {}",
+                num(fov),
+                num(l.radius),
+                num(l.focus_distance)
+            ),
+        ),
         Projection::Orthographic { height } => ("Orthographic", format!("height: {}", num(height))),
     };
     let _ = writeln!(

@@ -22,7 +22,7 @@ use crate::material::rough_conductor::RoughConductor;
 use crate::material::rough_dielectric::RoughDielectric;
 use crate::material::rough_plastic::RoughPlastic;
 use crate::material::{Bsdf, Coating, Phong, fresnel_dielectric, reflect};
-use crate::sampling::{Sampler, Sampling, hemisphere};
+use crate::sampling::{Sampler, Sampling, hemisphere, warp};
 use crate::shader::path;
 use crate::shape::{Sphere, Triangle};
 use glam::Vec3A;
@@ -497,7 +497,41 @@ fn light_cases() -> Vec<Case> {
     ]
 }
 
-/// Every sampler rtis uses: uniform and cosine hemisphere, the Phong lobe at three exponents,
+/// Rings (of equal area) and sectors of the unit disk's bins.
+const DISK_RINGS: usize = 8;
+/// Sectors of the unit disk's bins.
+const DISK_SECTORS: usize = 16;
+
+/// The bin of a point of the unit disk: its ring of equal area (`r^2` in eighths) and its
+/// sector of `phi`; `None` outside the disk.
+pub fn disk_bin(x: f32, y: f32) -> Option<usize> {
+    let r2 = (x as f64).powi(2) + (y as f64).powi(2);
+    if r2 > 1.0 {
+        return None;
+    }
+    let ring = ((r2 * DISK_RINGS as f64) as usize).min(DISK_RINGS - 1);
+    let phi = (y as f64).atan2(x as f64).rem_euclid(2.0 * PI);
+    let sector = ((phi / (2.0 * PI) * DISK_SECTORS as f64) as usize).min(DISK_SECTORS - 1);
+    Some(ring * DISK_SECTORS + sector)
+}
+
+/// A sampler of points on the unit disk (`warp` of two uniform numbers) against the uniform
+/// density `1 / pi`: each equal-area bin expects the same share.
+pub fn disk_case(name: &str, warp: fn(f32, f32) -> (f32, f32)) -> Case {
+    let bins = DISK_RINGS * DISK_SECTORS;
+    Case {
+        name: name.to_string(),
+        draw: Box::new(move |s: &mut Sampler| {
+            let (u1, u2) = s.next_2d();
+            let (x, y) = warp(u1, u2);
+            disk_bin(x, y)
+        }),
+        expected: vec![1.0 / bins as f64; bins],
+        columns: DISK_SECTORS,
+    }
+}
+
+/// Every sampler rtis uses: the thin lens's points, uniform and cosine hemisphere, the Phong lobe at three exponents,
 /// the BRDF mixture of Path at two materials and views, the Fresnel choice of glass, the
 /// area-light samplers, the microfacet reflection samplers ([`microfacet_cases`]) and the
 /// BSDFs' ([`bsdf_cases`]).
@@ -508,6 +542,7 @@ pub fn cases() -> Vec<Case> {
         shininess: 1.0,
     };
     vec![
+        disk_case("thin lens (concentric disk)", warp::concentric_disk),
         direction_case("uniform hemisphere", white, Vec3A::Z, Sampling::Uniform),
         direction_case("cosine hemisphere", white, Vec3A::Z, Sampling::Cosine),
         lobe_case(1.0),

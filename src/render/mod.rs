@@ -97,7 +97,7 @@ pub fn render_sample(
     let (dx, dy) = pixel_sample(s, film.spp, scene.seed ^ pixel, &mut sampler);
     let u = (col as f32 + dx) / film.width as f32;
     let v = (row as f32 + dy) / film.height as f32;
-    let ray = scene.camera.ray(u, v);
+    let ray = scene.camera.ray(u, v, || sampler.next_2d());
     let mut tracer = scene.tracer(sampler, stats);
     let l = radiance(&scene.shader, &mut tracer, &ray);
     if l.is_finite() && l.min_element() >= 0.0 {

@@ -1,5 +1,5 @@
-//! Warps onto shapes, for sampling area lights: the whole sphere, a cone of directions, and a
-//! triangle, each uniform in its own measure.
+//! Warps onto shapes, for sampling area lights and lenses: the whole sphere, a cone of
+//! directions, a triangle and a disk, each uniform in its own measure.
 
 use glam::Vec3A;
 use std::f32::consts::TAU;
@@ -25,6 +25,28 @@ pub fn uniform_triangle(u1: f32, u2: f32) -> [f32; 3] {
         (u1 - b1, b1)
     };
     [b0, b1, (1.0 - b0 - b1).max(0.0)]
+}
+
+/// A uniform point on the unit disk by Shirley and Chiu's concentric map ("A Low Distortion Map
+/// Between Disk and Square", 1997, as pbrt-v4's `SampleUniformDiskConcentric`): the square
+/// `[-1, 1]^2` is cut into four triangles and each is mapped to a quarter of the disk, so
+/// nearby samples stay nearby. Density `1 / pi`.
+#[inline]
+pub fn concentric_disk(u1: f32, u2: f32) -> (f32, f32) {
+    let (a, b) = (2.0 * u1 - 1.0, 2.0 * u2 - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, theta) = if a.abs() > b.abs() {
+        (a, std::f32::consts::FRAC_PI_4 * (b / a))
+    } else {
+        (
+            b,
+            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (a / b),
+        )
+    };
+    let (sin_t, cos_t) = theta.sin_cos();
+    (r * cos_t, r * sin_t)
 }
 
 /// `1 - cos(theta_max)` of the cone a sphere of radius `r` subtends from a point at squared

@@ -6,10 +6,10 @@
 //! type (`to_world`), which `super::load` puts into the world.
 
 use super::values::{
-    Count, Direction, Fov, Ior, IorPart, MetalName, NonNegative, Point, Positive, Reflectance, Rgb,
-    Roughness, Scale, UpTo,
+    Aperture, Count, Direction, Fov, Ior, IorPart, MetalName, NonNegative, Point, Positive,
+    Reflectance, Rgb, Roughness, Scale, UpTo,
 };
-use crate::camera::{Projection, WorldCamera};
+use crate::camera::{Projection, WorldCamera, WorldLens};
 use crate::effects::Switches;
 use crate::geometry::Transform;
 use crate::light::{Emitter, WorldLight};
@@ -159,6 +159,14 @@ pub enum CameraFields {
         /// Vertical field of view in degrees, in (0, 180) (default 60).
         #[serde(default = "fov60")]
         fov: Fov,
+        /// Radius of the lens's aperture in scene units, from 0 (default: a pinhole, every
+        /// depth sharp) to 1e9: a thin lens, as Mitsuba 3's `thinlens`.
+        #[serde(default)]
+        aperture_radius: Aperture,
+        /// Distance from the lens to the plane in focus, along the viewing direction, in
+        /// scene units (default: the distance to `look_at`). Used with `aperture_radius`.
+        #[serde(default)]
+        focus_distance: Option<Positive>,
     },
     /// A parallel projection.
     Orthographic {
@@ -252,7 +260,18 @@ impl CameraDesc {
     pub fn to_world(&self) -> WorldCamera {
         let (position, look_at, up) = self.0.frame();
         let projection = match self.0 {
-            CameraFields::Perspective { fov, .. } => Projection::Perspective { fov: fov.0 },
+            CameraFields::Perspective {
+                fov,
+                aperture_radius,
+                focus_distance,
+                ..
+            } => Projection::Perspective {
+                fov: fov.0,
+                lens: (aperture_radius.0 > 0.0).then(|| WorldLens {
+                    radius: aperture_radius.0,
+                    focus_distance: focus_distance.map_or((look_at - position).length(), |f| f.0),
+                }),
+            },
             CameraFields::Orthographic { height, .. } => {
                 Projection::Orthographic { height: height.0 }
             }

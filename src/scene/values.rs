@@ -291,6 +291,31 @@ impl From<Positive> for f64 {
     }
 }
 
+/// A lens's aperture radius in scene units: 0 (a pinhole, the default) or from
+/// [`MIN_LENGTH`] to [`MAX_COORD`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct Aperture(pub f64);
+
+impl TryFrom<f64> for Aperture {
+    type Error = String;
+    fn try_from(v: f64) -> Result<Self, String> {
+        if v == 0.0 || (MIN_LENGTH..=MAX_COORD).contains(&v) {
+            Ok(Aperture(v))
+        } else {
+            Err(format!(
+                "must be 0 (a pinhole) or a radius from 1e-9 to 1e9 scene units, got {}",
+                show(v)
+            ))
+        }
+    }
+}
+impl From<Aperture> for f64 {
+    fn from(a: Aperture) -> Self {
+        a.0
+    }
+}
+
 /// A Phong exponent, from 0 to [`MAX_SHININESS`].
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "f64", into = "f64")]

@@ -85,9 +85,12 @@ fn shadows_off_equals_no_occluders() {
     let (mut floor, mut shadowed) = (0, 0);
     for row in 0..30 {
         for col in 0..40 {
-            let ray = prepared
-                .camera
-                .ray((col as f32 + 0.5) / 40.0, (row as f32 + 0.5) / 30.0);
+            let ray =
+                prepared
+                    .camera
+                    .ray((col as f32 + 0.5) / 40.0, (row as f32 + 0.5) / 30.0, || {
+                        panic!("a pinhole draws no lens sample")
+                    });
             let Some(hit) = prepared.geometry.intersect(&ray) else {
                 continue;
             };

@@ -11,6 +11,7 @@ mod block;
 mod bounds;
 mod bsdfs;
 mod bvh;
+mod cameras;
 mod cli;
 mod cli_interrupt;
 mod converge;

@@ -171,7 +171,10 @@ fn random_walks_stay_in_the_room() {
             let walls = planes(&r);
             let mut outside = 0;
             for _ in 0..20_000 {
-                let mut ray = r.camera.ray(rng.next_f32(), rng.next_f32());
+                let (u, v) = (rng.next_f32(), rng.next_f32());
+                let mut ray = r
+                    .camera
+                    .ray(u, v, || panic!("a pinhole draws no lens sample"));
                 for _ in 0..8 {
                     let Some(hit) = r.geometry.intersect(&ray) else {
                         break;

@@ -287,3 +287,21 @@ fn a_wrong_bsdf_pdf_is_rejected() {
         assert!(o.p_value < 1e-6, "{name}: p {}", o.p_value);
     }
 }
+
+/// The thin lens's sampler has power against the classic mistake: the polar map with
+/// `r = u1` (not `sqrt(u1)`) crowds the centre and is rejected; the concentric map passes.
+#[test]
+fn a_lens_sampler_crowding_the_centre_is_rejected() {
+    fn naive_polar(u1: f32, u2: f32) -> (f32, f32) {
+        let (sin_p, cos_p) = (std::f32::consts::TAU * u2).sin_cos();
+        (u1 * cos_p, u1 * sin_p)
+    }
+    let wrong = warptest::run(&warptest::disk_case("r = u1", naive_polar), 200_000, 3);
+    assert!(wrong.p_value < 1e-6, "p {}", wrong.p_value);
+    let right = warptest::run(
+        &warptest::disk_case("concentric", rtis::sampling::warp::concentric_disk),
+        200_000,
+        3,
+    );
+    assert!(right.p_value > 1e-3, "p {}", right.p_value);
+}

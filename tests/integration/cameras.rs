@@ -1,0 +1,184 @@
+//! Cameras (src/camera/): the thin lens. With aperture 0 it is the pinhole to the bit; every
+//! ray through the lens for an image point meets the plane in focus at the pinhole ray's point
+//! there; the blur of a point off that plane is the thin-lens circle of confusion, measured in
+//! a render.
+
+use crate::common::{render_str, scene};
+use glam::{DVec3, Vec3A};
+use rtis::camera::{Camera, Projection, WorldCamera, WorldLens};
+use rtis::sampling::Sampler;
+
+fn camera(lens: Option<WorldLens>) -> Camera {
+    WorldCamera {
+        projection: Projection::Perspective { fov: 40.0, lens },
+        position: DVec3::ZERO,
+        look_at: DVec3::new(0.3, -0.2, 1.0),
+        up: DVec3::Y,
+    }
+    .extract(1.5)
+}
+
+fn bits(img: &rtis::render::film::Image) -> Vec<[u32; 3]> {
+    img.pixels
+        .iter()
+        .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+        .collect()
+}
+
+/// `aperture_radius: 0` (and any focus distance) is no lens: the image has the bits of the
+/// scene without the fields.
+#[test]
+fn a_zero_aperture_is_the_pinhole_to_the_bit() {
+    let base = "film: (width: 24, height: 18, spp: 4), shader: Path(max_depth: 3)";
+    let pinhole = render_str(&format!("Scene(extends: \"cornell.ron\", {base})"));
+    let zero = render_str(&format!(
+        "Scene(extends: \"cornell.ron\", {base},
+               camera: Perspective(position: (0, 0, -3.3), look_at: (0, 0, 0), fov: 60,
+                                   aperture_radius: 0, focus_distance: 2))"
+    ));
+    let s = scene(&format!("Scene(extends: \"cornell.ron\", {base})"));
+    let Projection::Perspective { lens, .. } = s.settings.camera.projection else {
+        panic!("the box has a perspective camera");
+    };
+    assert_eq!(lens, None);
+    // The box's own camera, written out with a zero aperture, renders the same bits.
+    let c = s.settings.camera;
+    let Projection::Perspective { fov, .. } = c.projection else {
+        panic!("the box's camera is a perspective one");
+    };
+    let written = render_str(&format!(
+        "Scene(extends: \"cornell.ron\", {base},
+               camera: Perspective(position: ({}, {}, {}), look_at: ({}, {}, {}),
+                                   up: ({}, {}, {}), fov: {}, aperture_radius: 0))",
+        c.position.x,
+        c.position.y,
+        c.position.z,
+        c.look_at.x,
+        c.look_at.y,
+        c.look_at.z,
+        c.up.x,
+        c.up.y,
+        c.up.z,
+        fov
+    ));
+    assert_eq!(bits(&written.image), bits(&pinhole.image));
+    assert_ne!(
+        bits(&zero.image),
+        bits(&pinhole.image),
+        "another camera position"
+    );
+}
+
+/// Every ray through the lens for an image point meets the plane in focus where the pinhole
+/// ray does, and leaves from a point on the lens disk.
+#[test]
+fn points_on_the_focus_plane_are_sharp() {
+    let (radius, focus) = (0.25, 4.0);
+    let lens = camera(Some(WorldLens {
+        radius,
+        focus_distance: focus,
+    }));
+    let pinhole = camera(None);
+    let Camera::Perspective(p) = lens else {
+        panic!("a perspective camera")
+    };
+    let forward = p.basis.forward;
+    let on_plane = |o: Vec3A, d: Vec3A| o + d * ((focus as f32 - o.dot(forward)) / d.dot(forward));
+    let mut s = Sampler::new(1, 2, 3);
+    for (u, v) in [(0.5, 0.5), (0.0, 0.0), (1.0, 0.3), (0.2, 0.9)] {
+        let want = {
+            let r = pinhole.ray(u, v, || panic!("a pinhole draws no lens sample"));
+            on_plane(r.o, r.d)
+        };
+        for _ in 0..1000 {
+            let r = lens.ray(u, v, || s.next_2d());
+            assert!(r.o.length() <= radius as f32 * (1.0 + 1e-6), "{:?}", r.o);
+            assert!(
+                r.o.dot(forward).abs() < 1e-6,
+                "the lens is in the plane of right and up"
+            );
+            let got = on_plane(r.o, r.d);
+            assert!(
+                (got - want).length() < 1e-5 * focus as f32,
+                "({u}, {v}): {got} against {want}"
+            );
+        }
+    }
+}
+
+/// An emitting sphere on the axis, behind the plane in focus, blurs into the convolution of
+/// its image (a disk of radius `a = s / sqrt(z^2 - s^2)` on the image plane at distance 1) with
+/// the thin-lens circle of confusion (radius `c = r |z - f| / (f z)`, by similar triangles from
+/// the lens of radius `r` to the point in focus at `f`). Within `c - a` of the centre a pixel
+/// sees the sphere through a fraction `(a / c)^2` of the lens; beyond `c + a`, not at all.
+/// With a pinhole the same sphere is a sharp disk of radius `a`.
+#[test]
+fn the_blur_of_a_point_off_focus_is_the_circle_of_confusion() {
+    let (r, f, z, s, fov, side) = (0.5f64, 5.0f64, 10.0f64, 0.3f64, 30.0f64, 101u32);
+    let text = |lens: &str| {
+        format!(
+            "Scene(film: (width: {side}, height: {side}, spp: 256), shader: Path(max_depth: 1),
+                   model: Physical,
+                   camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), fov: {fov}{lens}),
+                   entities: [(shape: Sphere(center: (0, 0, {z}), radius: {s}),
+                               material: Phong(kd: (0, 0, 0)),
+                               emitter: Emitter(radiance: (1, 1, 1)))])"
+        )
+    };
+    let blurred = render_str(&text(&format!(
+        ", aperture_radius: {r}, focus_distance: {f}"
+    )));
+    let sharp = render_str(&text(""));
+    // Pixels per unit of the image plane at distance 1.
+    let px = side as f64 / 2.0 / (fov.to_radians() / 2.0).tan();
+    let c = r * (z - f).abs() / (f * z) * px;
+    let a = s / (z * z - s * s).sqrt() * px;
+    let centre = (side as f64 - 1.0) / 2.0;
+    // (distance of the pixel's centre from the image centre, its value)
+    let pixels = |img: &rtis::render::film::Image| -> Vec<(f64, f64)> {
+        (0..side * side)
+            .map(|i| {
+                let (x, y) = (i % side, i / side);
+                let d = ((x as f64 - centre).powi(2) + (y as f64 - centre).powi(2)).sqrt();
+                (d, img.get(x, y).x as f64)
+            })
+            .collect()
+    };
+    let half_diagonal = std::f64::consts::FRAC_1_SQRT_2;
+    let blur = pixels(&blurred.image);
+    // Nothing beyond c + a.
+    for &(d, v) in &blur {
+        assert!(
+            v == 0.0 || d - half_diagonal <= c + a,
+            "lit at {d:.2} px; c + a = {:.2}",
+            c + a
+        );
+    }
+    // Within c - a: every pixel lit, at (a / c)^2 on average (binomial noise of 256 samples a
+    // pixel, 5 standard deviations over the pixels averaged).
+    let inner: Vec<f64> = blur
+        .iter()
+        .filter(|(d, _)| d + half_diagonal < c - a)
+        .map(|&(_, v)| v)
+        .collect();
+    assert!(
+        inner.len() >= 9 && inner.iter().all(|&v| v > 0.0),
+        "{inner:?}"
+    );
+    let mean = inner.iter().sum::<f64>() / inner.len() as f64;
+    let p = (a / c).powi(2);
+    let sigma = (p * (1.0 - p) / (256.0 * inner.len() as f64)).sqrt();
+    assert!(
+        (mean - p).abs() < 5.0 * sigma,
+        "mean {mean:.4} against (a/c)^2 = {p:.4} +- {sigma:.4}"
+    );
+    // The pinhole: lit exactly where the sphere's disk of radius a is.
+    for (d, v) in pixels(&sharp.image) {
+        if d + half_diagonal < a {
+            assert_eq!(v, 1.0, "inside the sharp disk at {d:.2} px");
+        }
+        if d - half_diagonal > a {
+            assert_eq!(v, 0.0, "outside the sharp disk at {d:.2} px");
+        }
+    }
+}
