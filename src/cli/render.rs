@@ -12,6 +12,7 @@ use rtis::render::pass::{self, Pass};
 use rtis::render::progressive::{self, Ending};
 use rtis::render::tev::Display;
 use rtis::render::{self, Film, output};
+use rtis::stats::RayStats;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -52,10 +53,11 @@ pub struct RenderArgs {
     /// a pass EXR of exact sums for `rtis merge` (default name NAME.pass-I-of-N.exr).
     #[arg(long, value_parser = pass::parse_pass, value_name = "I/N")]
     pass: Option<(u32, u32)>,
-    /// Stop after the round of samples that fits this much tracing time (e.g. 30s, 2m, 1h,
-    /// 500ms; a bare number is seconds). The image then holds fewer spp and says so; its pass
-    /// (NAME.partial.exr, or the .exr output itself) resumes with --resume.
-    #[arg(long, value_parser = parse_duration, value_name = "DURATION")]
+    /// Stop after the round of samples that fits this much time of rendering rounds (e.g. 30s,
+    /// 2m, 1h, 500ms; a bare number is seconds). The image then holds fewer spp and says so;
+    /// its pass (NAME.partial.exr beside a PNG, or the .exr output itself) resumes with
+    /// --resume.
+    #[arg(long, value_parser = parse_duration, value_name = "DURATION", conflicts_with = "pass")]
     time: Option<Duration>,
     /// Continue the render held by this pass file (written by a stopped or timed render, or by
     /// --pass): the scene, film, seed and settings must be the ones it was rendered with. The
@@ -64,7 +66,7 @@ pub struct RenderArgs {
     resume: Option<PathBuf>,
     /// Stream each progressive round to the tev image viewer listening at HOST:PORT (tev's
     /// default is 127.0.0.1:14158), as pbrt-v4's --display-server does.
-    #[arg(long, value_name = "HOST:PORT")]
+    #[arg(long, value_name = "HOST:PORT", conflicts_with = "pass")]
     display: Option<String>,
     /// Instruction set of the SIMD code: the widest this CPU runs (auto), or one named, to
     /// measure what it is worth. The image is the same in each.
@@ -152,11 +154,13 @@ pub fn partial_path(out: &Path) -> PathBuf {
 /// Parse a duration: a number with `ms`, `s`, `m` or `h`, or a bare number of seconds.
 pub fn parse_duration(s: &str) -> Result<Duration, String> {
     let t = s.trim();
-    let (number, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
-        Some(i) => t.split_at(i),
-        None => (t, "s"),
+    let (number, unit) = match t.rfind(|c: char| c.is_ascii_digit() || c == '.') {
+        // A bare number (1e3 included) is seconds.
+        _ if t.parse::<f64>().is_ok() => (t, "s"),
+        Some(i) => t.split_at(i + 1),
+        None => (t, "?"),
     };
-    let scale = match unit {
+    let scale = match unit.trim() {
         "ms" => 1e-3,
         "s" => 1.0,
         "m" | "min" => 60.0,
@@ -173,28 +177,22 @@ pub fn parse_duration(s: &str) -> Result<Duration, String> {
     }
 }
 
-/// Where the pass of an unfinished render goes, for `--resume`: the output itself when it is an
-/// .exr (a pass file is an EXR whose R, G, B show the image), else `NAME.partial.exr`.
-fn resume_path(image: &Path) -> PathBuf {
-    if is_exr(image) {
-        image.to_path_buf()
-    } else {
-        image.with_extension("exr")
-    }
-}
-
 fn is_exr(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
-/// Write an image that holds fewer samples than the film asks (a stopped or timed render):
-/// as a pass file when `image` is an .exr, else as the image with a note of its spp and, beside
-/// it, its pass (`NAME.exr`) for `--resume`. Returns the pass file's path.
-fn save_unfinished(pass: &Pass, image: &Path, transfer: Transfer) -> Result<PathBuf, CliError> {
-    let resume = resume_path(image);
-    pass.write(&resume)?;
-    if !is_exr(image) {
+/// Write an image that holds fewer samples than the film asks (a stopped or timed render) and
+/// its pass `pass_file` for `--resume`: when `image` is an .exr it is that pass (a pass file is
+/// an EXR whose R, G, B show the image); a PNG notes its spp in a `Comment` text.
+fn save_unfinished(
+    pass: &Pass,
+    image: &Path,
+    pass_file: &Path,
+    transfer: Transfer,
+) -> Result<(), CliError> {
+    pass.write(pass_file)?;
+    if image != pass_file {
         let note = format!(
             "rtis: {} of {} samples per pixel (samples {})",
             pass.samples(),
@@ -203,7 +201,7 @@ fn save_unfinished(pass: &Pass, image: &Path, transfer: Transfer) -> Result<Path
         );
         output::save_noted(&pass.image(), image, transfer, &note)?;
     }
-    Ok(resume)
+    Ok(())
 }
 
 fn parse_transfer(s: &str) -> Result<Transfer, String> {
@@ -357,12 +355,27 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         );
         return Ok(());
     }
+    let film = prepared.film;
+    if film.width as u64 * film.height as u64 > progressive::MAX_PIXELS {
+        // Too large to hold a pass of exact sums: one go, as a pass-free render.
+        if a.time.is_some() || a.resume.is_some() || a.display.is_some() {
+            return Err(format!(
+                "--time, --resume and --display render progressively, which holds 120 bytes \
+                 per pixel: at most {} pixels, and this film has {}x{}",
+                progressive::MAX_PIXELS,
+                film.width,
+                film.height
+            )
+            .into());
+        }
+        return render_in_one_go(&prepared, &pool, &bar, &out, a.stats.as_deref(), &est);
+    }
     let mut display = match &a.display {
         Some(address) => {
             let name = out
                 .file_name()
                 .map_or_else(|| stem.clone(), |n| n.to_string_lossy().into_owned());
-            let d = Display::connect(address, &name, prepared.film.width, prepared.film.height)?;
+            let d = Display::connect(address, &name, film.width, film.height)?;
             eprintln!("streaming each round to tev at {address} as `{name}`");
             Some(d)
         }
@@ -374,7 +387,6 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     // Progressive rounds over the whole frame; the bar counts pixel-samples.
     bar.set_length(render::tile_count(&prepared) * to_render as u64);
     let tick = |samples: u32| bar.inc(samples as u64);
-    let film = prepared.film;
     let progress = {
         let _graceful = Graceful::begin(
             "dropping the round in flight, then writing the image of the rounds done",
@@ -410,36 +422,48 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     };
     bar.finish_and_clear();
     let pass = &progress.pass;
-    match progress.ending {
-        Ending::Stopped | Ending::Declined => {
-            // Interrupted: keep the last whole round, under a name that says so.
-            let partial = partial_path(&out);
-            if pass.samples() == 0 {
-                // Stopped in the first round (a scene of few spp, as the course's 1 spp with
-                // Global): keep its finished tiles, each with all the round's samples.
-                let Some((samples, tiles)) = &progress.dropped else {
-                    eprintln!("interrupted before the first round began: no image written");
-                    return Err(Box::new(Interrupted));
-                };
-                let n = samples.len() as u64;
-                let image = Image {
-                    width: film.width,
-                    height: film.height,
-                    pixels: tiles.pixels.iter().map(|s| s.mean(n)).collect(),
-                };
-                output::save(&image, &partial, film.transfer)?;
-                eprintln!(
-                    "interrupted after {:.2} s in the first round: {} of {} tiles rendered \
-                     ({:.1}% of the pixels, each with {n} spp; the rest is black) -> {}",
-                    tiles.seconds,
-                    tiles.tiles_done,
-                    tiles.tiles,
-                    100.0 * tiles.tiles_done as f64 / tiles.tiles as f64,
-                    partial.display()
-                );
+    // The pass of an unfinished render, for --resume: the output itself when it is an EXR,
+    // else NAME.partial.exr beside it.
+    let partial = partial_path(&out);
+    let pass_file = |image: &Path| {
+        if is_exr(image) {
+            image.to_path_buf()
+        } else {
+            partial.with_extension("exr")
+        }
+    };
+    match &progress.ending {
+        Ending::Stopped {
+            dropped: (samples, tiles),
+        } if pass.samples() == 0 => {
+            // Stopped in the first round (a scene of few spp, as the course's 1 spp with
+            // Global): keep its finished tiles, each with all the round's samples.
+            if tiles.tiles_done == 0 {
+                eprintln!("interrupted before a tile was finished: no image written");
                 return Err(Box::new(Interrupted));
             }
-            let resume = save_unfinished(pass, &partial, film.transfer)?;
+            let n = samples.len() as u64;
+            let image = Image {
+                width: film.width,
+                height: film.height,
+                pixels: tiles.pixels.iter().map(|s| s.mean(n)).collect(),
+            };
+            output::save(&image, &partial, film.transfer)?;
+            eprintln!(
+                "interrupted after {:.2} s in the first round: {} of {} tiles rendered ({:.1}% of \
+                 the pixels, each with {n} spp; the rest is black) -> {}",
+                tiles.seconds,
+                tiles.tiles_done,
+                tiles.tiles,
+                100.0 * tiles.tiles_done as f64 / tiles.tiles as f64,
+                partial.display()
+            );
+            return Err(Box::new(Interrupted));
+        }
+        Ending::Stopped { .. } => {
+            // Interrupted: keep the last whole round, under a name that says so.
+            let resume = pass_file(&partial);
+            save_unfinished(pass, &partial, &resume, film.transfer)?;
             eprintln!(
                 "interrupted after {:.2} s: the whole frame at {} of {} spp -> {}; continue with \
                  --resume {}",
@@ -451,34 +475,127 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
             );
             return Err(Box::new(Interrupted));
         }
-        Ending::OutOfTime => {
-            let resume = save_unfinished(pass, &out, film.transfer)?;
+        Ending::OutOfTime | Ending::Declined => {
+            let resume = pass_file(&out);
+            save_unfinished(pass, &out, &resume, film.transfer)?;
             eprintln!(
-                "time budget spent: the whole frame at {} of {} spp; continue with --resume {}",
+                "time budget spent: the whole frame at {} of {} spp -> {}; continue with \
+                 --resume {}",
                 pass.samples(),
                 film.spp,
+                out.display(),
                 resume.display()
             );
         }
         Ending::Complete => output::save(&pass.image(), &out, film.transfer)?,
     }
-    let mrays_per_second = progress.stats.total() as f64 / progress.seconds.max(1e-9) / 1e6;
-    if let Some(path) = &a.stats {
+    summary(
+        &prepared,
+        &pool,
+        &Summary {
+            spp: pass.samples(),
+            rounds: progress.rounds,
+            seconds: progress.seconds,
+            stats: progress.stats,
+        },
+        &out,
+        a.stats.as_deref(),
+        &est,
+    )
+}
+
+/// What a finished render reports.
+struct Summary {
+    /// Samples per pixel in the image written.
+    spp: u64,
+    /// Progressive rounds (1 for a render in one go).
+    rounds: u32,
+    /// Seconds spent tracing.
+    seconds: f64,
+    /// Rays by kind.
+    stats: RayStats,
+}
+
+/// A film too large for a progressive pass: tiles rendered once each with all their samples,
+/// as before progressive rendering; Ctrl-C keeps the tiles finished.
+fn render_in_one_go(
+    prepared: &rtis::RenderScene,
+    pool: &rayon::ThreadPool,
+    bar: &ProgressBar,
+    out: &Path,
+    stats: Option<&Path>,
+    est: &estimate::Estimate,
+) -> Result<(), CliError> {
+    let tick = || bar.inc(1);
+    let result = {
+        let _graceful =
+            Graceful::begin("finishing the tiles in flight, then writing the image so far");
+        eprintln!(
+            "rendering {} tiles in one go (a film above {} pixels is not progressive); Ctrl-C \
+             keeps the tiles finished, twice quits",
+            render::tile_count(prepared),
+            progressive::MAX_PIXELS
+        );
+        pool.install(|| render::render_until(prepared, &tick, &interrupt::STOP))
+    };
+    bar.finish_and_clear();
+    let film = prepared.film;
+    if !result.is_complete() {
+        let partial = partial_path(out);
+        output::save(&result.image, &partial, film.transfer)?;
+        eprintln!(
+            "interrupted after {:.2} s: {} of {} tiles rendered (each with all {} spp; the rest \
+             is black) -> {}",
+            result.seconds,
+            result.tiles_done,
+            result.tiles,
+            film.spp,
+            partial.display()
+        );
+        return Err(Box::new(Interrupted));
+    }
+    output::save(&result.image, out, film.transfer)?;
+    summary(
+        prepared,
+        pool,
+        &Summary {
+            spp: film.spp as u64,
+            rounds: 1,
+            seconds: result.seconds,
+            stats: result.stats,
+        },
+        out,
+        stats,
+        est,
+    )
+}
+
+/// Write the statistics file (if asked) and print the summary line.
+fn summary(
+    prepared: &rtis::RenderScene,
+    pool: &rayon::ThreadPool,
+    run: &Summary,
+    out: &Path,
+    stats_path: Option<&Path>,
+    est: &estimate::Estimate,
+) -> Result<(), CliError> {
+    let mrays_per_second = run.stats.total() as f64 / run.seconds.max(1e-9) / 1e6;
+    if let Some(path) = stats_path {
         let json = serde_json::to_string_pretty(&serde_json::json!({
-            "seconds": progress.seconds,
+            "seconds": run.seconds,
             "threads": pool.current_num_threads(),
-            "spp": pass.samples(),
-            "rounds": progress.rounds,
-            "rays": progress.stats,
+            "spp": run.spp,
+            "rounds": run.rounds,
+            "rays": run.stats,
             "effects": prepared.effects,
-            "total_rays": progress.stats.total(),
+            "total_rays": run.stats.total(),
             "estimated_rays": est.rays(),
             "mrays_per_second": mrays_per_second,
         }))?;
         output::write_file(path, json.as_bytes())
             .map_err(|e| format!("cannot write stats: {e}"))?;
     }
-    let s = &progress.stats;
+    let s = &run.stats;
     if s.dropped > 0 {
         eprintln!(
             "warning: {} sample(s) came out NaN, infinite or negative and were dropped \
@@ -491,8 +608,8 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
          refraction {}, indirect {}), {} dropped samples, {:.1} Mrays/s -> {}",
         prepared.film.width,
         prepared.film.height,
-        pass.samples(),
-        progress.seconds,
+        run.spp,
+        run.seconds,
         pool.current_num_threads(),
         s.total(),
         s.camera,

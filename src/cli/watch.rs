@@ -18,7 +18,7 @@ use clap::Args;
 use notify::{EventKind, RecursiveMode, Watcher};
 use rtis::render::estimate::{self, human_seconds};
 use rtis::render::pass::Pass;
-use rtis::render::progressive::{self, Ending, Round};
+use rtis::render::progressive::{self, Round};
 use rtis::stats::RayStats;
 use std::collections::BTreeSet;
 use std::net::SocketAddr;
@@ -65,8 +65,8 @@ struct State {
     error: Option<String>,
     /// Warnings of the last good scene.
     warnings: Vec<String>,
-    /// `loading`, `rendering`, `done` or `error`.
-    status: &'static str,
+    /// What the renderer is doing.
+    status: Status,
     /// Samples per pixel the scene asks for.
     target_spp: u32,
     /// The cost estimate, as `render` prints it.
@@ -77,6 +77,21 @@ struct State {
     rays: RayStats,
     /// Seconds spent tracing the image shown.
     seconds: f64,
+}
+
+/// What the renderer is doing, as `/state` says it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+enum Status {
+    /// Reading the scene (and building its BVH).
+    #[default]
+    Loading,
+    /// Rendering rounds.
+    Rendering,
+    /// Every sample is in the image.
+    Done,
+    /// The scene has an error; the image is the last good one.
+    Error,
 }
 
 /// An image as the page receives it.
@@ -99,6 +114,9 @@ struct Follow {
     files: Mutex<BTreeSet<PathBuf>>,
     /// Set on a change: the renderer drops its round and loads the scene again.
     changed: AtomicBool,
+    /// Set while the scene has an error: then any change in the folders followed reloads
+    /// it, since the error may name a file not read yet (a missing base or mesh).
+    broken: AtomicBool,
 }
 
 /// The canonical form of `path` (its folder canonicalised, so a file being replaced still
@@ -126,13 +144,11 @@ pub fn run(a: WatchArgs) -> Result<(), CliError> {
         .server_addr()
         .to_ip()
         .ok_or("the server is not on an IP address")?;
-    let state = Arc::new(Mutex::new(State {
-        status: "loading",
-        ..State::default()
-    }));
+    let state = Arc::new(Mutex::new(State::default()));
     let follow = Arc::new(Follow {
         files: Mutex::new(BTreeSet::from([canonical(&a.scene)])),
         changed: AtomicBool::new(false),
+        broken: AtomicBool::new(false),
     });
     let (tx, rx) = mpsc::channel();
     let watcher = start_watcher(&follow, tx)?;
@@ -150,7 +166,7 @@ pub fn run(a: WatchArgs) -> Result<(), CliError> {
         a.scene.display()
     );
     for request in server.incoming_requests() {
-        let response = answer(&request, &state);
+        let response = answer(&request, &state, bound);
         // A page closed while its answer is sent is not an error of ours.
         let _ = request.respond(response);
     }
@@ -169,8 +185,11 @@ fn start_watcher(
         if matches!(event.kind, EventKind::Access(_)) {
             return;
         }
-        let files = follow.files.lock().unwrap_or_else(|e| e.into_inner());
-        if event.paths.iter().any(|p| files.contains(&canonical(p))) {
+        let relevant = follow.broken.load(Ordering::SeqCst) || {
+            let files = follow.files.lock().unwrap_or_else(|e| e.into_inner());
+            event.paths.iter().any(|p| files.contains(&canonical(p)))
+        };
+        if relevant {
             follow.changed.store(true, Ordering::SeqCst);
             let _ = tx.send(());
         }
@@ -185,11 +204,18 @@ fn watch_folders(
     watched: &mut BTreeSet<PathBuf>,
 ) {
     for f in files {
-        if let Some(dir) = f.parent()
-            && !watched.contains(dir)
-            && watcher.watch(dir, RecursiveMode::NonRecursive).is_ok()
-        {
-            watched.insert(dir.to_path_buf());
+        let Some(dir) = f.parent() else { continue };
+        if watched.contains(dir) {
+            continue;
+        }
+        match watcher.watch(dir, RecursiveMode::NonRecursive) {
+            Ok(()) => {
+                watched.insert(dir.to_path_buf());
+            }
+            Err(e) => eprintln!(
+                "warning: cannot follow {}: {e}; a change there will not restart the render",
+                dir.display()
+            ),
         }
     }
 }
@@ -210,26 +236,32 @@ fn renderer(
         {
             let mut s = lock(state);
             s.generation += 1;
-            s.status = "loading";
+            s.status = Status::Loading;
         }
         match rtis::scene::load_path(scene_path) {
             Err(e) => {
-                // Keep the last good image; follow the file the error is in as well.
-                let mut files = follow.files.lock().unwrap_or_else(|e| e.into_inner());
-                files.insert(canonical(Path::new(&e.file)));
+                // Keep the last good image; follow the file the error is in as well, and
+                // reload on any change in the folders followed.
+                follow.broken.store(true, Ordering::SeqCst);
+                let files = {
+                    let mut files = follow.files.lock().unwrap_or_else(|e| e.into_inner());
+                    files.insert(canonical(Path::new(&e.file)));
+                    files.clone()
+                };
                 watch_folders(&mut watcher, &files, &mut watched);
-                drop(files);
                 let mut s = lock(state);
                 s.error = Some(e.to_string());
-                s.status = "error";
+                s.status = Status::Error;
             }
             Ok(scene) => {
-                {
-                    let mut files = follow.files.lock().unwrap_or_else(|e| e.into_inner());
-                    *files = scene.files.iter().map(|f| canonical(f)).collect();
-                    files.insert(canonical(scene_path));
-                    watch_folders(&mut watcher, &files, &mut watched);
-                }
+                follow.broken.store(false, Ordering::SeqCst);
+                let mut files: BTreeSet<PathBuf> =
+                    scene.files.iter().map(|f| canonical(f)).collect();
+                files.insert(canonical(scene_path));
+                // The watcher's thread runs the event handler, which takes this lock: it is
+                // never held while the watcher is asked to follow a folder.
+                *follow.files.lock().unwrap_or_else(|e| e.into_inner()) = files.clone();
+                watch_folders(&mut watcher, &files, &mut watched);
                 pool.install(|| render(&scene, state, follow));
             }
         }
@@ -249,6 +281,20 @@ fn renderer(
 
 /// Render `scene` progressively into `state` until done or a change sets `follow.changed`.
 fn render(scene: &rtis::scene::Scene, state: &Mutex<State>, follow: &Follow) {
+    let film = scene.settings.film;
+    if film.width as u64 * film.height as u64 > progressive::MAX_PIXELS {
+        let mut s = lock(state);
+        s.error = Some(format!(
+            "{}: a film of {}x{} is too large to preview (watch renders progressively, at most \
+             {} pixels): lower its width and height while you edit",
+            scene.origin,
+            film.width,
+            film.height,
+            progressive::MAX_PIXELS
+        ));
+        s.status = Status::Error;
+        return;
+    }
     let prepared = rtis::extract(scene);
     let est = estimate::estimate(&prepared);
     let threads = rayon::current_num_threads();
@@ -261,7 +307,7 @@ fn render(scene: &rtis::scene::Scene, state: &Mutex<State>, follow: &Follow) {
             .chain(&prepared.warnings)
             .cloned()
             .collect();
-        s.status = "rendering";
+        s.status = Status::Rendering;
         s.target_spp = prepared.film.spp;
         s.effects = prepared.effects.to_string();
         s.estimate = format!(
@@ -289,9 +335,15 @@ fn render(scene: &rtis::scene::Scene, state: &Mutex<State>, follow: &Follow) {
         }));
         s.rays = r.stats;
         s.seconds = r.seconds;
+        // Under the same lock as the image, so the page never sees the last image as
+        // "rendering".
+        if pass.is_complete() {
+            s.status = Status::Done;
+        }
         true
     };
-    let progress = progressive::refine(
+    // `on_round` marks the image done with its last round; a stop means a change.
+    progressive::refine(
         &prepared,
         Pass::empty(&prepared),
         None,
@@ -299,15 +351,20 @@ fn render(scene: &rtis::scene::Scene, state: &Mutex<State>, follow: &Follow) {
         &follow.changed,
         &mut on_round,
     );
-    if progress.ending == Ending::Complete {
-        lock(state).status = "done";
-    }
+}
+
+/// Whether a request's `Host` header names this server: its address and port, or
+/// `localhost` with its port.
+fn host_allowed(host: &str, bound: SocketAddr) -> bool {
+    let port = bound.port().to_string();
+    host == bound.to_string() || host.strip_prefix("localhost:").is_some_and(|p| p == port)
 }
 
 /// The response to one request.
 fn answer(
     request: &tiny_http::Request,
     state: &Mutex<State>,
+    bound: SocketAddr,
 ) -> tiny_http::Response<std::io::Cursor<Vec<u8>>> {
     let header = |k: &str, v: &str| {
         tiny_http::Header::from_bytes(k.as_bytes(), v.as_bytes()).expect("valid header")
@@ -320,6 +377,16 @@ fn answer(
     };
     if *request.method() != tiny_http::Method::Get {
         return respond(405, "text/plain", b"only GET\n".to_vec());
+    }
+    // A page on another site that a DNS trick points at this port names its own host: only
+    // the address served on, or localhost, is answered.
+    let host = request
+        .headers()
+        .iter()
+        .find(|h| h.field.equiv("Host"))
+        .map(|h| h.value.as_str().to_string());
+    if !host.as_deref().is_some_and(|h| host_allowed(h, bound)) {
+        return respond(403, "text/plain", b"unknown Host\n".to_vec());
     }
     let path = request.url().split('?').next().unwrap_or("");
     match path {

@@ -25,14 +25,34 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
-/// A hash of everything that decides a render's samples: camera, geometry, materials, lights,
-/// background, shader, model, effects and film size. Passes of one render share it.
+/// FNV-1a over text written into it: a hash of `Debug` output without building the string.
+struct Fnv(u64);
+
+impl std::fmt::Write for Fnv {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.0 = s.bytes().fold(self.0, |h, b| {
+            (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+        });
+        Ok(())
+    }
+}
+
+/// A hash of everything that decides a render's samples: camera, geometry (primitives and
+/// smooth normals), materials, lights, background, shader, model, effects and film size.
+/// Passes of one render share it. Streamed, so a mesh of a million triangles costs a pass over
+/// it, not a string of its size.
 pub fn fingerprint(scene: &RenderScene) -> u64 {
+    use std::fmt::Write;
     let f = &scene.film;
-    let text = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}",
-        scene.camera,
-        scene.geometry.prims().collect::<Vec<_>>(),
+    let mut h = Fnv(fnv1a(b""));
+    let _ = write!(h, "{:?}|", scene.camera);
+    for p in scene.geometry.prims() {
+        let _ = write!(h, "{p:?}");
+    }
+    let _ = write!(
+        h,
+        "|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}",
+        scene.geometry.normals,
         scene.materials,
         scene.lights,
         scene.background,
@@ -42,7 +62,7 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
         f.width,
         f.height,
     );
-    fnv1a(text.as_bytes())
+    h.0
 }
 
 /// Parse `I/N` (pass `I`, counting from 0, of `N`).
@@ -219,8 +239,15 @@ impl Pass {
             _ => Transfer::Srgb,
         };
         let ranges = parse_ranges(&attr("rtis.ranges")?)
-            .filter(|r| r.iter().all(|r| r.end <= spp))
-            .ok_or_else(|| at("`rtis.ranges` is not a list of sample ranges within spp".into()))?;
+            .filter(|r| {
+                r.iter().all(|r| r.end <= spp) && r.windows(2).all(|w| w[0].end <= w[1].start)
+            })
+            .ok_or_else(|| {
+                at(
+                    "`rtis.ranges` is not a sorted list of disjoint sample ranges within spp"
+                        .into(),
+                )
+            })?;
         let (w, h) = (layer.size.width(), layer.size.height());
         let mut sums = vec![RgbSum::default(); w * h];
         for (c, name) in CHANNELS.iter().enumerate() {

@@ -9,7 +9,12 @@
 //!
 //! A time budget shortens the schedule: before each round, its time is predicted from the
 //! seconds per sample measured so far, and the round is cut to the samples that fit (or not
-//! started when not one fits). The first round of a render always runs, so there is an image.
+//! started when not one fits). The budget counts the wall time of the rounds (from the start
+//! of [`refine`]). The first round of a run always runs, so there is an image; under a budget
+//! it is one sample, to measure the rate.
+//!
+//! The pass holds 120 bytes per pixel (exact sums) and a round as much again while it runs, so
+//! films above [`MAX_PIXELS`] are rendered in one go instead (`rtis render` says so).
 
 use super::exact::RgbSum;
 use super::pass::Pass;
@@ -18,6 +23,10 @@ use crate::stats::RayStats;
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
+
+/// Largest film rendered progressively (2^23 pixels, 4096 x 2048): at most about 360 bytes
+/// per pixel while a round is assembled, 3 GiB.
+pub const MAX_PIXELS: u64 = 1 << 23;
 
 /// What a progressive render has after a round.
 #[derive(Clone, Debug)]
@@ -33,16 +42,28 @@ pub struct Round {
 }
 
 /// How a progressive render ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug)]
 pub enum Ending {
     /// Every sample of the film is held.
     Complete,
     /// `stop` was set: the round in flight was dropped, the earlier rounds are held.
-    Stopped,
+    Stopped {
+        /// The round in flight, with the tiles it finished (the others hold no sample): not
+        /// part of [`Progress::pass`]; a caller whose pass holds nothing yet may show these
+        /// tiles rather than no image.
+        dropped: (Range<u32>, Tiled<RgbSum>),
+    },
     /// The next round did not fit the time budget.
     OutOfTime,
     /// The `on_round` callback asked to end.
     Declined,
+}
+
+impl Ending {
+    /// Whether every sample is held.
+    pub fn is_complete(&self) -> bool {
+        matches!(self, Ending::Complete)
+    }
 }
 
 /// The result of [`refine`].
@@ -58,10 +79,6 @@ pub struct Progress {
     pub rounds: u32,
     /// Why it ended.
     pub ending: Ending,
-    /// When stopped: the round in flight, with the tiles it finished (the others hold no
-    /// sample). Not part of [`Progress::pass`]; a caller whose pass holds nothing yet may show
-    /// these tiles rather than no image.
-    pub dropped: Option<(Range<u32>, Tiled<RgbSum>)>,
 }
 
 /// Samples of the next round: as many as are held already (so the total doubles), at least
@@ -90,15 +107,17 @@ pub fn refine(
     let start = Instant::now();
     let (mut stats, mut seconds, mut rounds) = (RayStats::default(), 0.0, 0);
     let mut traced: u64 = 0;
-    let mut dropped = None;
     let ending = loop {
         let Some(mut samples) = next_round(&pass) else {
             break Ending::Complete;
         };
-        // Fit the round to what is left of the budget, at the rate measured so far.
+        // Fit the round to what is left of the budget, at the rate measured so far; a resumed
+        // render's first round is one sample, to measure the rate.
         if let Some(budget) = budget {
             let left = budget.as_secs_f64() - start.elapsed().as_secs_f64();
-            if rounds > 0 {
+            if rounds == 0 {
+                samples.end = samples.start + 1;
+            } else {
                 let per_sample = seconds / traced as f64;
                 let fit = (left / per_sample).floor().min(samples.len() as f64);
                 if fit < 1.0 {
@@ -110,8 +129,9 @@ pub fn refine(
         let size = samples.len() as u32;
         let part = render_pass(scene, samples.clone(), &|| on_tile(size), stop);
         if part.tiles_done < part.tiles {
-            dropped = Some((samples, part));
-            break Ending::Stopped;
+            break Ending::Stopped {
+                dropped: (samples, part),
+            };
         }
         pass.add(samples.clone(), &part.pixels);
         stats += part.stats;
@@ -138,7 +158,6 @@ pub fn refine(
         seconds,
         rounds,
         ending,
-        dropped,
     }
 }
 

@@ -13,7 +13,8 @@ use glam::{DVec3, Vec3A};
 
 /// Largest image side in pixels.
 pub const MAX_SIDE: u32 = 1 << 15;
-/// Largest pixel count (8192 x 8192): the film holds 12 bytes per pixel.
+/// Largest pixel count (8192 x 8192). A render in one go holds 16 bytes per pixel; a
+/// progressive one, limited to [`super::progressive::MAX_PIXELS`], about 360 while a round ends.
 pub const MAX_PIXELS: u64 = 1 << 26;
 /// Largest samples per pixel.
 pub const MAX_SPP: u32 = 1 << 20;

@@ -19,6 +19,9 @@ use std::io::Write;
 use std::net::TcpStream;
 use std::time::Duration;
 
+/// How long a send may wait for the viewer to read before the viewer is given up.
+pub const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
+
 /// Side of the square regions an update is cut into.
 pub const REGION: u32 = 128;
 
@@ -121,13 +124,28 @@ impl Display {
         let fail = |e: &dyn std::fmt::Display| {
             format!("--display {address}: cannot reach a tev viewer there: {e}")
         };
-        let addr = address
-            .to_socket_addrs()
-            .map_err(|e| fail(&e))?
-            .next()
-            .ok_or_else(|| fail(&"the name resolves to no address"))?;
-        let stream =
-            TcpStream::connect_timeout(&addr, Duration::from_secs(5)).map_err(|e| fail(&e))?;
+        // Every address the name has, in turn (`localhost` may give ::1 first, where tev
+        // listens on 127.0.0.1).
+        let mut last: Option<std::io::Error> = None;
+        let mut stream = None;
+        for addr in address.to_socket_addrs().map_err(|e| fail(&e))? {
+            match TcpStream::connect_timeout(&addr, Duration::from_secs(5)) {
+                Ok(s) => {
+                    stream = Some(s);
+                    break;
+                }
+                Err(e) => last = Some(e),
+            }
+        }
+        let stream = stream.ok_or_else(|| match last {
+            Some(e) => fail(&e),
+            None => fail(&"the name resolves to no address"),
+        })?;
+        // A viewer that stops reading must not stall the render: a send that waits this long
+        // fails, and the render goes on without the viewer.
+        stream
+            .set_write_timeout(Some(WRITE_TIMEOUT))
+            .map_err(|e| fail(&e))?;
         let mut display = Display {
             stream,
             name: name.to_string(),

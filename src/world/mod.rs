@@ -51,7 +51,10 @@ impl Default for Settings {
         Settings {
             film: Film::default(),
             camera: WorldCamera {
-                projection: Projection::Perspective { fov: 60.0 },
+                projection: Projection::Perspective {
+                    fov: 60.0,
+                    lens: None,
+                },
                 position: DVec3::ZERO,
                 look_at: DVec3::Z,
                 up: DVec3::Y,
@@ -87,6 +90,7 @@ pub struct Scene {
     /// Things worth telling the user that do not stop the render.
     pub warnings: Vec<String>,
     /// The files it was read from: the scene file, the bases it extends and the meshes it
-    /// loads (what `rtis watch` follows). Empty for a scene given as text.
+    /// loads (what `rtis watch` follows). A scene given as text lists the bases and meshes
+    /// it reads, not itself.
     pub files: Vec<std::path::PathBuf>,
 }

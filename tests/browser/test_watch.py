@@ -85,8 +85,8 @@ def test_watch_page_follows_edits_and_errors(watch, browser):
     shown = lambda: browser.execute_script("return window.rtisShown.spp;")
     # The render refines to the scene's 32 spp; the side panel shows its figures.
     wait("the full render", lambda: shown() == 32)
-    status = browser.find_element(By.ID, "status").text
-    assert status.startswith("done: 32 of 32 spp"), status
+    status = browser.find_element(By.ID, "status")
+    wait("done", lambda: status.text.startswith("done: 32 of 32 spp"))
     assert "rays" in browser.find_element(By.ID, "estimate").text
     assert "shadows" in browser.find_element(By.ID, "effects").text
     assert len(browser.find_elements(By.CSS_SELECTOR, "#rays tr")) >= 5

@@ -360,11 +360,14 @@ fn progressive_render_stops_resumes_and_keeps_its_bits() {
         err.contains("time budget spent: the whole frame at 1 of 4096 spp"),
         "{err}"
     );
-    assert!(timed.exists() && d.join("timed.exr").exists(), "{err}");
+    assert!(
+        timed.exists() && d.join("timed.partial.exr").exists(),
+        "{err}"
+    );
     let finished = d.join("finished.exr");
     run(&[
         "--resume",
-        d.join("timed.exr").to_str().unwrap(),
+        d.join("timed.partial.exr").to_str().unwrap(),
         "-o",
         finished.to_str().unwrap(),
     ]);

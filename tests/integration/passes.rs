@@ -272,7 +272,8 @@ fn a_sample_index_past_the_end_is_refused() {
 }
 
 /// A pass file whose header names an empty sample range is refused on reading (a range holds
-/// at least one sample), as is one past the spp.
+/// at least one sample), as is one past the spp, and ranges out of order or overlapping (which
+/// would count samples twice).
 #[test]
 fn pass_files_with_empty_or_outlying_ranges_are_refused() {
     let _limit = common::deadline(60);
@@ -280,7 +281,12 @@ fn pass_files_with_empty_or_outlying_ranges_are_refused() {
     let d = std::env::temp_dir().join(format!("rtis-ranges-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     let (_, good) = passes(&s, 3).remove(0);
-    for (name, ranges) in [("empty", vec![0..2, 4..4]), ("outlying", vec![0..2, 5..7])] {
+    for (name, ranges) in [
+        ("empty", vec![0..2, 4..4]),
+        ("outlying", vec![0..2, 5..7]),
+        ("unsorted", vec![4..6, 0..2]),
+        ("overlapping", vec![0..4, 2..6]),
+    ] {
         let bad = Pass {
             ranges,
             ..good.clone()
@@ -289,7 +295,7 @@ fn pass_files_with_empty_or_outlying_ranges_are_refused() {
         bad.write(&file).unwrap();
         let e = Pass::read(&file).unwrap_err();
         assert!(
-            e.contains("not a list of sample ranges within spp"),
+            e.contains("not a sorted list of disjoint sample ranges within spp"),
             "{name}: {e}"
         );
     }

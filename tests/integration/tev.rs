@@ -87,7 +87,7 @@ fn read_packet(stream: &mut impl Read) -> Option<Packet> {
                 f.0.chunks_exact(4)
                     .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
                     .collect();
-            // Channel-major values of the region, read by the offsets and strides.
+            // The region's values, pixel by pixel, read by the offsets and strides.
             let pixels = (region[2] * region[3]) as usize;
             let mut values = Vec::new();
             for i in 0..pixels {
@@ -132,23 +132,24 @@ fn render_streams_each_round_to_a_tev_server() {
     });
     // 200 x 150: two regions across, two down (128 + 72, 128 + 22).
     let out = d.join("streamed.exr");
-    let run = Command::new(env!("CARGO_BIN_EXE_rtis"))
-        .arg("render")
-        .arg(&scene)
-        .args([
-            "--width",
-            "200",
-            "--height",
-            "150",
-            "--spp",
-            "4",
-            "--display",
-        ])
-        .arg(format!("127.0.0.1:{port}"))
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let run = crate::common::output_within(
+        Command::new(env!("CARGO_BIN_EXE_rtis"))
+            .arg("render")
+            .arg(&scene)
+            .args([
+                "--width",
+                "200",
+                "--height",
+                "150",
+                "--spp",
+                "4",
+                "--display",
+            ])
+            .arg(format!("127.0.0.1:{port}"))
+            .arg("-o")
+            .arg(&out),
+        300,
+    );
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{err}");
     assert!(err.contains("streaming each round to tev"), "{err}");
@@ -212,13 +213,14 @@ fn an_unreachable_display_is_refused_before_rendering() {
     let d = std::env::temp_dir().join(format!("rtis-tev-none-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     let out = d.join("x.png");
-    let run = Command::new(env!("CARGO_BIN_EXE_rtis"))
-        .args(["render", "--width", "8", "--display"])
-        .arg(format!("127.0.0.1:{port}"))
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let run = crate::common::output_within(
+        Command::new(env!("CARGO_BIN_EXE_rtis"))
+            .args(["render", "--width", "8", "--display"])
+            .arg(format!("127.0.0.1:{port}"))
+            .arg("-o")
+            .arg(&out),
+        300,
+    );
     let err = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(1), "{err}");
     assert!(err.contains("cannot reach a tev viewer"), "{err}");

@@ -21,10 +21,15 @@ impl Drop for Watch {
 
 /// GET `path` from `addr`: the status code, the headers and the body.
 fn get(addr: &str, path: &str) -> (u16, String, Vec<u8>) {
+    get_as(addr, path, addr)
+}
+
+/// GET `path` from `addr` with the `Host` header `host`.
+fn get_as(addr: &str, path: &str, host: &str) -> (u16, String, Vec<u8>) {
     let mut s = TcpStream::connect(addr).unwrap();
     write!(
         s,
-        "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"
+        "GET {path} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
     )
     .unwrap();
     let mut raw = Vec::new();
@@ -79,10 +84,11 @@ fn start(scene: &Path) -> (Watch, String) {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
     let mut line = String::new();
-    BufReader::new(child.stderr.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
+    err.read_line(&mut line).unwrap();
+    // Keep reading, so that a later message never meets a closed pipe.
+    std::thread::spawn(move || std::io::copy(&mut err, &mut std::io::sink()));
     let addr = line
         .split("http://")
         .nth(1)
@@ -168,6 +174,11 @@ fn watch_follows_the_scene_and_its_base() {
     });
     let (_, _, fourth) = get(&addr, "/image");
     assert_ne!(fourth, first, "another seed");
+
+    // Another host name (a DNS-rebinding page) is refused; localhost is answered.
+    let port = addr.split(':').nth(1).unwrap();
+    assert_eq!(get_as(&addr, "/state", "evil.example:80").0, 403);
+    assert_eq!(get_as(&addr, "/state", &format!("localhost:{port}")).0, 200);
 
     // Nothing but the page and its two requests is served.
     let (code, head, page) = get(&addr, "/");
