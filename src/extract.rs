@@ -7,7 +7,9 @@
 
 use crate::accel::{FLAT, Geometry, Prim};
 use crate::geometry::Placement;
-use crate::light::{AreaLight, Emitter, Emitters, Emitting, Light, NO_LIGHT, PointLight};
+use crate::light::{
+    AreaLight, Emitter, Emitters, Emitting, Light, NO_LIGHT, PointLight, SpotLight,
+};
 use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
 use crate::shader::Shader;
@@ -117,6 +119,10 @@ pub fn extract(scene: &Scene) -> RenderScene {
             Light::Point(p) => Light::Point(PointLight {
                 in_room: geometry.in_room(p.position),
                 ..p
+            }),
+            Light::Spot(s) => Light::Spot(SpotLight {
+                in_room: geometry.in_room(s.position),
+                ..s
             }),
         })
         .collect();

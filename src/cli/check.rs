@@ -298,16 +298,31 @@ pub fn to_ron(scene: &Scene) -> String {
                 v3(t.translate)
             ));
         }
-        if let Some(WorldLight::Point {
-            position,
-            intensity,
-        }) = light
-        {
-            fields.push(format!(
+        match light {
+            Some(WorldLight::Point {
+                position,
+                intensity,
+            }) => fields.push(format!(
                 "light: Point(position: {}, intensity: {})",
                 v3(*position),
                 rgb(*intensity)
-            ));
+            )),
+            Some(WorldLight::Spot {
+                position,
+                direction,
+                intensity,
+                cutoff_angle,
+                beam_width,
+            }) => fields.push(format!(
+                "light: Spot(position: {}, direction: {}, intensity: {}, cutoff_angle: {}, \
+                 beam_width: {})",
+                v3(*position),
+                v3(*direction),
+                rgb(*intensity),
+                num(*cutoff_angle),
+                num(*beam_width)
+            )),
+            None => {}
         }
         if let Some(e) = emitter {
             fields.push(format!(

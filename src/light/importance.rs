@@ -20,6 +20,12 @@ use glam::Vec3A;
 pub fn importance(light: &Light, p: Vec3A, n: Vec3A, transmits: bool) -> f64 {
     let ((wi, _, d2), i_max) = match light {
         Light::Point(l) => (l.toward(p), l.intensity.max_element()),
+        // The intensity towards `p`, with the falloff computed as `incident` computes it.
+        Light::Spot(l) => {
+            let toward = l.toward(p);
+            let falloff = l.falloff(-toward.0.dot(l.axis));
+            (toward, l.intensity.max_element() * falloff)
+        }
     };
     // The direction and cosine exactly as `Light::incident` and the light's term compute them,
     // so that a light with a term has a weight. Computed whatever the case and then selected:
@@ -30,7 +36,7 @@ pub fn importance(light: &Light, p: Vec3A, n: Vec3A, transmits: bool) -> f64 {
     } else {
         wi.dot(n)
     };
-    let lit = d2 != 0.0 && d2.is_finite() && cos > 0.0;
+    let lit = d2 != 0.0 && d2.is_finite() && cos > 0.0 && i_max > 0.0;
     let w = f64::from(i_max.max(0.0)) * f64::from(cos) / f64::from(d2);
     if lit { w } else { 0.0 }
 }

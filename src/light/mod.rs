@@ -1,8 +1,8 @@
 //! The closed set of lights. Each variant lives in its own file; [`Light`] dispatches by `match`.
 //!
 //! [`WorldLight`] is the ECS component (scene units, double precision); [`WorldLight::extract`]
-//! makes the camera-relative [`Light`] that shaders use. Point lights are summed at every
-//! shading point (the course's Eq. 3). Emitting shapes ([`Emitter`]) become [`AreaLight`]s, one
+//! makes the camera-relative [`Light`] that shaders use. Point and spot lights are summed at
+//! every shading point (the course's Eq. 3). Emitting shapes ([`Emitter`]) become [`AreaLight`]s, one
 //! per primitive, gathered in [`Emitters`], which picks one per light sample in proportion to
 //! its power. [`choose_by_importance`] picks one point light at a shading point in proportion
 //! to the light it could send there.
@@ -11,11 +11,13 @@ mod area;
 mod emitters;
 mod importance;
 mod point;
+mod spot;
 
 pub use area::{AreaLight, Emitter, Emitting, LightSample};
 pub use emitters::{Chosen, Emitters, NO_LIGHT};
 pub use importance::{choose_by_importance, importance};
 pub use point::PointLight;
+pub use spot::SpotLight;
 
 use glam::{DVec3, Vec3A};
 
@@ -41,6 +43,20 @@ pub enum WorldLight {
         /// Radiant intensity, W/sr per channel.
         intensity: Vec3A,
     },
+    /// A spot light (Mitsuba 3's `spot`): intensity within the beam, falling linearly in the
+    /// angle to zero at the cutoff.
+    Spot {
+        /// Position, scene units.
+        position: DVec3,
+        /// The direction it points along (not zero).
+        direction: DVec3,
+        /// Radiant intensity on the axis, W/sr per channel.
+        intensity: Vec3A,
+        /// Half-angle of the cone beyond which it is black, degrees, in (0, 90].
+        cutoff_angle: f64,
+        /// Half-angle of the full beam, degrees, in (0, cutoff_angle].
+        beam_width: f64,
+    },
 }
 
 impl WorldLight {
@@ -55,6 +71,20 @@ impl WorldLight {
                 intensity,
                 in_room: false,
             }),
+            WorldLight::Spot {
+                position,
+                direction,
+                intensity,
+                cutoff_angle,
+                beam_width,
+            } => Light::Spot(SpotLight {
+                position: (position - origin).as_vec3a(),
+                axis: direction.normalize().as_vec3a(),
+                intensity,
+                beam: beam_width.to_radians() as f32,
+                cutoff: cutoff_angle.to_radians() as f32,
+                in_room: false,
+            }),
         }
     }
 }
@@ -64,6 +94,8 @@ impl WorldLight {
 pub enum Light {
     /// An isotropic point light.
     Point(PointLight),
+    /// A spot light.
+    Spot(SpotLight),
 }
 
 impl Light {
@@ -71,6 +103,7 @@ impl Light {
     pub fn power(&self) -> f32 {
         match self {
             Light::Point(l) => l.power(),
+            Light::Spot(l) => l.power(),
         }
     }
 
@@ -79,6 +112,7 @@ impl Light {
     pub fn in_room(&self) -> bool {
         match self {
             Light::Point(l) => l.in_room,
+            Light::Spot(l) => l.in_room,
         }
     }
 
@@ -88,6 +122,7 @@ impl Light {
     pub fn incident(&self, p: Vec3A) -> Option<Incident> {
         match self {
             Light::Point(l) => l.incident(p),
+            Light::Spot(l) => l.incident(p),
         }
     }
 }

@@ -7,7 +7,7 @@
 
 use super::values::{
     Aperture, Count, Direction, Fov, Ior, IorPart, MetalName, NonNegative, Point, Positive,
-    Reflectance, Rgb, Roughness, Scale, UpTo,
+    Reflectance, Rgb, Roughness, Scale, SpotAngle, UpTo,
 };
 use crate::camera::{Projection, WorldCamera, WorldLens};
 use crate::effects::Switches;
@@ -935,9 +935,51 @@ pub enum LightDesc {
         /// Radiant intensity, W/sr per channel, >= 0.
         intensity: Rgb,
     },
+    /// A spot light (Mitsuba 3's `spot`): `intensity` within `beam_width` of `direction`,
+    /// falling linearly in the angle to zero at `cutoff_angle`.
+    Spot {
+        /// Position.
+        position: Point,
+        /// The direction it points along.
+        direction: Direction,
+        /// Radiant intensity on the axis, W/sr per channel, >= 0.
+        intensity: Rgb,
+        /// Half-angle in degrees beyond which it is black, in (0, 90] (default 20, as
+        /// Mitsuba's).
+        #[serde(default = "spot_cutoff")]
+        cutoff_angle: SpotAngle,
+        /// Half-angle in degrees of the full beam, in (0, cutoff_angle] (default three
+        /// quarters of `cutoff_angle`, as Mitsuba's).
+        #[serde(default)]
+        beam_width: Option<SpotAngle>,
+    },
+}
+
+fn spot_cutoff() -> SpotAngle {
+    SpotAngle(20.0)
 }
 
 impl LightDesc {
+    /// Why this light cannot be: the field to blame and the message; `None` when it is sound.
+    /// Checked after parsing, where the field's place in the file is known (`super::load`).
+    pub fn invalid(&self) -> Option<(&'static str, String)> {
+        match *self {
+            LightDesc::Spot {
+                cutoff_angle,
+                beam_width: Some(beam),
+                ..
+            } if beam.0 > cutoff_angle.0 => Some((
+                "beam_width",
+                format!(
+                    "a spot's beam_width ({}) is wider than its cutoff_angle ({}): the beam is \
+                     the part inside the cutoff; make beam_width at most cutoff_angle",
+                    beam.0, cutoff_angle.0
+                ),
+            )),
+            _ => None,
+        }
+    }
+
     /// The world's light.
     pub fn to_world(&self) -> WorldLight {
         match *self {
@@ -947,6 +989,19 @@ impl LightDesc {
             } => WorldLight::Point {
                 position: position.0,
                 intensity: intensity.0.as_vec3a(),
+            },
+            LightDesc::Spot {
+                position,
+                direction,
+                intensity,
+                cutoff_angle,
+                beam_width,
+            } => WorldLight::Spot {
+                position: position.0,
+                direction: direction.0,
+                intensity: intensity.0.as_vec3a(),
+                cutoff_angle: cutoff_angle.0,
+                beam_width: beam_width.map_or(cutoff_angle.0 * 0.75, |b| b.0),
             },
         }
     }

@@ -150,6 +150,14 @@ fn check(src: &Source, file: &SceneFile) -> Result<(), SceneError> {
             }
             seen.insert(name, at);
         }
+        if let Some((field, why)) = e.light.as_ref().and_then(|l| l.invalid()) {
+            let light = node.and_then(|n| n.get("light", text));
+            let at = light
+                .and_then(|l| l.get(field, text))
+                .or(light)
+                .map_or_else(|| src.top_field("entities"), |n| n.start);
+            return Err(src.error(at, why));
+        }
         if e.shape.is_none() && e.light.is_some() && e.transform.is_some() {
             let at = node
                 .and_then(|n| n.field("transform"))

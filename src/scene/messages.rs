@@ -87,7 +87,13 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
     (
         "LightDesc",
         "light",
-        &[("Point", "Point(position: (0, 2, 0), intensity: (7, 7, 7))")],
+        &[
+            ("Point", "Point(position: (0, 2, 0), intensity: (7, 7, 7))"),
+            (
+                "Spot",
+                "Spot(position: (0, 2, 0), direction: (0, -1, 0), intensity: (7, 7, 7))",
+            ),
+        ],
     ),
     (
         "Model",
@@ -163,7 +169,10 @@ fn field_form(name: &str) -> Option<&'static str> {
             "one of `Sphere(...)`, `InfinitePlane(...)`, `Triangle(...)`, \
              `TriangleMesh(...)` and `Mesh(path: \"file.obj\")`"
         }
-        "light" => "`Point(position: (0, 2, 0), intensity: (7, 7, 7))`",
+        "light" => {
+            "`Point(position: (0, 2, 0), intensity: (7, 7, 7))` or `Spot(position: (0, 2, 0), \
+             direction: (0, -1, 0), intensity: (7, 7, 7))`"
+        }
         "transform" => "a transform `(scale: (1, 1, 1), rotate: (0, 0, 0), translate: (0, 0, 0))`",
         "effects" => "the effect switches `(shadows: false, ...)`",
         "materials" => "a map of named materials `{ \"red\": Phong(kd: (0.7, 0.2, 0.2)), ... }`",

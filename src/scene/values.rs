@@ -316,6 +316,31 @@ impl From<Aperture> for f64 {
     }
 }
 
+/// A spot light's half-angle in degrees, in (0, 90].
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct SpotAngle(pub f64);
+
+impl TryFrom<f64> for SpotAngle {
+    type Error = String;
+    fn try_from(v: f64) -> Result<Self, String> {
+        if v > 0.0 && v <= 90.0 {
+            Ok(SpotAngle(v))
+        } else {
+            Err(format!(
+                "must be a half-angle from the spot's axis in degrees, above 0 and at most 90, \
+                 got {}",
+                show(v)
+            ))
+        }
+    }
+}
+impl From<SpotAngle> for f64 {
+    fn from(a: SpotAngle) -> Self {
+        a.0
+    }
+}
+
 /// A Phong exponent, from 0 to [`MAX_SHININESS`].
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(try_from = "f64", into = "f64")]

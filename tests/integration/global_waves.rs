@@ -184,6 +184,15 @@ fn waves_give_the_depth_first_bits_in_the_course_box() {
          (light: Point(position: (-1.5, 1, 1), intensity: (0, 2, 6)))])"
     );
     agree("coloured lights", &rtis::extract(&scene(&text)));
+    // Spot lights, grey and coloured, whose cones end on the walls: their falloff lane by
+    // lane gives the walk's bits.
+    let text = format!(
+        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)), \
+         entities: [(light: Spot(position: (0, 2.5, 3), direction: (0.3, -1, 0.4), intensity: (6, 6, 6), \
+         cutoff_angle: 50, beam_width: 20)), \
+         (light: Spot(position: (-1, 1, 1), direction: (1, 0, 1), intensity: (1, 4, 2), cutoff_angle: 70))])"
+    );
+    agree("spot lights", &rtis::extract(&scene(&text)));
     // Ceiling panels with emission off: no hit samples them, and their rectangles are
     // geometry like any other.
     let area = scenes_dir().join("cornell-area.ron");

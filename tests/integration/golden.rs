@@ -197,6 +197,7 @@ golden_tests! {
     cornell_ambient => "cornell-ambient.ron",
     cornell_area => "cornell-area.ron",
     cornell_direct => "cornell-direct.ron",
+    cornell_lens => "cornell-lens.ron",
     cornell_n_bounce => "cornell-n-bounce.ron",
     cornell_physical => "cornell-physical.ron",
     cornell_two_bounce => "cornell-two-bounce.ron",

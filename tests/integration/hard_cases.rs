@@ -46,10 +46,15 @@ fn transform(scene: &mut Scene, s: f64, t: DVec3) {
         shape.points_mut().into_iter().for_each(f);
     }
     for light in scene.world.query_mut::<&mut WorldLight>() {
-        let WorldLight::Point {
+        let (WorldLight::Point {
             position,
             intensity,
-        } = light;
+        }
+        | WorldLight::Spot {
+            position,
+            intensity,
+            ..
+        }) = light;
         f(position);
         // Keep the irradiance I / d^2 the same at the scaled distances.
         *intensity *= (s * s) as f32;
@@ -363,7 +368,9 @@ fn non_finite_and_negative_samples_are_dropped_and_counted() {
     let clean = rtis::render(&p, &|| {});
     assert_eq!(clean.stats.dropped, 0);
     for bad in [f32::INFINITY, -1.0] {
-        let rtis::light::Light::Point(l) = &mut p.lights[0];
+        let rtis::light::Light::Point(l) = &mut p.lights[0] else {
+            panic!("the box's lights are point lights");
+        };
         l.intensity = Vec3A::splat(bad);
         let r = rtis::render(&p, &|| {});
         assert!(r.stats.dropped > 10, "{bad}: {} dropped", r.stats.dropped);

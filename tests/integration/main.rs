@@ -22,6 +22,7 @@ mod global_waves;
 mod global_weights;
 mod golden;
 mod hard_cases;
+mod lights;
 mod materials;
 mod meshes;
 mod origins;

@@ -345,6 +345,22 @@ const CASES: &[(&str, &str)] = &[
         "Scene(entities: [(name: \"lamp\", light: Point(position: (0, 2, 0), intensity: (7, 7, 7)), transform: (translate: (1, 0, 0)))])",
     ),
     (
+        "aperture negative",
+        "Scene(camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), aperture_radius: -0.1))",
+    ),
+    (
+        "spot beam wider than cutoff",
+        "Scene(entities: [(light: Spot(position: (0, 2, 0), direction: (0, -1, 0), intensity: (1, 1, 1),\n  cutoff_angle: 20, beam_width: 30))])",
+    ),
+    (
+        "spot cutoff beyond 90",
+        "Scene(entities: [(light: Spot(position: (0, 2, 0), direction: (0, -1, 0), intensity: (1, 1, 1), cutoff_angle: 120))])",
+    ),
+    (
+        "spot zero direction",
+        "Scene(entities: [(light: Spot(position: (0, 2, 0), direction: (0, 0, 0), intensity: (1, 1, 1)))])",
+    ),
+    (
         "empty triangle mesh",
         "Scene(entities: [(shape: TriangleMesh(vertices: [], faces: []), material: Mirror())])",
     ),

@@ -218,7 +218,8 @@ fn sources(shader: &str, light: f32, ambient: f32, sky: f32) -> rtis::render::Re
           background: ({sky}, {sky}, {sky}))"
     ));
     for l in s.world.query_mut::<&mut rtis::world::WorldLight>() {
-        let rtis::world::WorldLight::Point { intensity, .. } = l;
+        let (rtis::world::WorldLight::Point { intensity, .. }
+        | rtis::world::WorldLight::Spot { intensity, .. }) = l;
         *intensity *= light;
     }
     common::render_scene(&s)

@@ -529,8 +529,11 @@ unsafe fn point_sums<L: Floats>(
     let (p, n, ng, front, back, kd, o_err) = (h.p, h.n, h.ng, h.front, h.back, h.kd, h.o_err);
     let mut sum = [zero; 3];
     for light in lights {
-        let Light::Point(pl) = light;
-        let (x, intensity) = (pl.position, pl.intensity);
+        // A spot light is a point light whose intensity falls off off its axis.
+        let (x, intensity, in_room, spot) = match light {
+            Light::Point(pl) => (pl.position, pl.intensity, pl.in_room, None),
+            Light::Spot(sl) => (sl.position, sl.intensity, sl.in_room, Some(sl)),
+        };
         let bits = intensity.to_array().map(f32::to_bits);
         let grey = bits[0] == bits[1] && bits[1] == bits[2];
         // `PointLight::toward` and `incident`.
@@ -546,12 +549,31 @@ unsafe fn point_sums<L: Floats>(
         let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
         // `I / d^2`: one division where the light is grey (the same operands give the same
         // quotient), three otherwise.
-        let li = unsafe {
-            let x = L::splat(intensity.x) / d2;
-            if grey {
-                [x, x, x]
-            } else {
-                [x, L::splat(intensity.y) / d2, L::splat(intensity.z) / d2]
+        let li = match spot {
+            None => unsafe {
+                let x = L::splat(intensity.x) / d2;
+                if grey {
+                    [x, x, x]
+                } else {
+                    [x, L::splat(intensity.y) / d2, L::splat(intensity.z) / d2]
+                }
+            },
+            // `SpotLight::incident`, `I (falloff / d^2)`, lane by lane with the same operands.
+            Some(sl) => {
+                let mut v = [[0.0f32; MAX_LANES]; 4];
+                for (c, x) in [wi[0], wi[1], wi[2], d2].into_iter().enumerate() {
+                    x.write_to(&mut v[c]);
+                }
+                let mut out = [[0.0f32; MAX_LANES]; 3];
+                for lane in 0..L::LANES {
+                    let w = Vec3A::new(v[0][lane], v[1][lane], v[2][lane]);
+                    let l = sl.intensity * (sl.falloff(-w.dot(sl.axis)) / v[3][lane]);
+                    for c in 0..3 {
+                        out[c][lane] = l[c];
+                    }
+                }
+                // SAFETY: the caller vouches for the instruction set.
+                unsafe { out.map(|c| L::from_slice(&c)) }
             }
         };
         // `point_light_ray`: a term unless `d^2` is 0 or not finite, or `wi.n <= 0`.
@@ -569,7 +591,7 @@ unsafe fn point_sums<L: Floats>(
             if let Some(audit) = tr.audit {
                 audit_lanes(audit, o, wi, o_err, dist * end, L::bitmask(valid));
             }
-            let planes = !pl.in_room;
+            let planes = !in_room;
             let blocked = tr
                 .geometry
                 .occluded_lanes(o, wi, o_err, dist * end, planes, valid);

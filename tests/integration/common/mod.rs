@@ -130,8 +130,10 @@ pub fn nearest(prims: &[rtis::accel::Prim], ray: &rtis::geometry::Ray) -> Option
 /// the planes too (the renderer skips them for lights in the room).
 pub fn lights_out_of_room(scene: &mut rtis::RenderScene) {
     for light in &mut scene.lights {
-        let rtis::light::Light::Point(p) = light;
-        p.in_room = false;
+        match light {
+            rtis::light::Light::Point(p) => p.in_room = false,
+            rtis::light::Light::Spot(s) => s.in_room = false,
+        }
     }
 }
 

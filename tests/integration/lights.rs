@@ -1,0 +1,136 @@
+//! Lights (src/light/): the spot light's falloff at known angles (Mitsuba 3's linear ramp),
+//! its power against a quadrature of the falloff, and a floor under a spot: radiance
+//! `(kd / pi) I falloff(theta) cos(theta) / d^2` inside the beam, nothing beyond the cutoff,
+//! under Direct and Path alike.
+
+use crate::common::render_str;
+use glam::Vec3A;
+use rtis::light::SpotLight;
+
+fn spot(beam: f32, cutoff: f32) -> SpotLight {
+    SpotLight {
+        position: Vec3A::ZERO,
+        axis: Vec3A::new(0.0, -1.0, 0.0),
+        intensity: Vec3A::new(2.0, 4.0, 8.0),
+        beam: beam.to_radians(),
+        cutoff: cutoff.to_radians(),
+        in_room: false,
+    }
+}
+
+/// Within the beam 1; halfway between beam and cutoff (in angle) 1/2; a quarter of the way
+/// from the cutoff 1/4; at and beyond the cutoff 0; and `incident` applies it over `d^2`.
+#[test]
+fn spot_falloff_is_linear_in_the_angle() {
+    let s = spot(15.0, 20.0);
+    let at = |deg: f32| s.falloff(deg.to_radians().cos());
+    assert_eq!(at(0.0), 1.0);
+    assert_eq!(at(14.9), 1.0);
+    assert!((at(17.5) - 0.5).abs() < 1e-4, "{}", at(17.5));
+    assert!((at(18.75) - 0.25).abs() < 1e-4, "{}", at(18.75));
+    assert_eq!(at(20.0001), 0.0);
+    assert_eq!(at(90.0), 0.0);
+    // A point 2 below and at 17.5 degrees from the axis.
+    let theta = 17.5f32.to_radians();
+    let p = Vec3A::new(2.0 * theta.tan(), -2.0, 0.0);
+    let inc = s.incident(p).unwrap();
+    let d2 = p.length_squared();
+    let want = s.intensity * 0.5 / d2;
+    assert!(
+        (inc.li - want).abs().max_element() < 1e-4 * want.max_element(),
+        "{:?}",
+        inc.li
+    );
+    assert!((inc.wi + p.normalize()).length() < 1e-6);
+}
+
+/// The power `2 pi I [1 - (sin c - sin b)/(c - b)]` is the falloff integrated over the sphere
+/// (midpoint rule in theta, 200,000 steps), for a few beams, and `2 pi I (1 - cos c)` when the
+/// beam fills the cone.
+#[test]
+fn spot_power_is_the_integral_of_its_falloff() {
+    for (b, c) in [(15.0, 20.0), (5.0, 60.0), (30.0, 30.0), (1.0, 90.0)] {
+        let s = spot(b, c);
+        let n = 200_000;
+        let dt = std::f64::consts::PI / n as f64;
+        let integral: f64 = (0..n)
+            .map(|i| {
+                let t = (i as f64 + 0.5) * dt;
+                s.falloff(t.cos() as f32) as f64 * t.sin() * dt
+            })
+            .sum::<f64>()
+            * 2.0
+            * std::f64::consts::PI;
+        let mean_i = s.intensity.element_sum() as f64 / 3.0;
+        let want = integral * mean_i;
+        assert!(
+            (s.power() as f64 - want).abs() < 1e-4 * want,
+            "beam {b}, cutoff {c}: {} against {want}",
+            s.power()
+        );
+    }
+}
+
+/// A grey floor (kd 0.5) under a spot 2 units up pointing down, seen by an orthographic camera
+/// from above: inside the beam each pixel is `(kd / pi) I cos(theta) / d^2` at its point
+/// (within the variation over the pixel), beyond the cutoff 0, and Path (next-event
+/// estimation; no other surface) gives Direct's value.
+#[test]
+fn a_floor_under_a_spot_has_the_exact_radiance() {
+    let (h, i, beam, cutoff) = (2.0f64, 10.0f64, 20.0f64, 30.0f64);
+    let side = 64u32;
+    let extent = 4.0 * h * cutoff.to_radians().tan();
+    let text = |shader: &str| {
+        format!(
+            "Scene(film: (width: {side}, height: {side}, spp: 4), shader: {shader}, model: Physical,
+                   camera: Orthographic(position: (0, 5, 0), look_at: (0, 0, 0), up: (0, 0, 1),
+                                        height: {extent}),
+                   entities: [(shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+                               material: Phong(kd: (0.5, 0.5, 0.5), ks: (0, 0, 0))),
+                              (light: Spot(position: (0, {h}, 0), direction: (0, -1, 0),
+                                           intensity: ({i}, {i}, {i}),
+                                           cutoff_angle: {cutoff}, beam_width: {beam}))])"
+        )
+    };
+    let direct = render_str(&text("Direct()"));
+    let path = render_str(&text("Path(max_depth: 1)"));
+    let px = extent / side as f64;
+    let (mut inside, mut outside) = (0, 0);
+    for row in 0..side {
+        for col in 0..side {
+            // The pixel's centre on the floor; its corners' angles bound the variation.
+            let x = (col as f64 + 0.5 - side as f64 / 2.0) * px;
+            let z = (side as f64 / 2.0 - row as f64 - 0.5) * px;
+            let r = (x * x + z * z).sqrt();
+            let theta = r.atan2(h).to_degrees();
+            let v = direct.image.get(col, row).x as f64;
+            let reach = (r + px).atan2(h).to_degrees();
+            let near = (r - px).max(0.0).atan2(h).to_degrees();
+            if reach < beam {
+                let d2 = h * h + r * r;
+                let cos = h / d2.sqrt();
+                let want = 0.5 / std::f64::consts::PI * i * cos / d2;
+                assert!(
+                    (v - want).abs() < 0.03 * want,
+                    "({col}, {row}) at {theta:.1} deg: {v} against {want}"
+                );
+                inside += 1;
+            } else if near > cutoff {
+                assert_eq!(
+                    v, 0.0,
+                    "({col}, {row}) at {theta:.1} deg, beyond the cutoff"
+                );
+                outside += 1;
+            }
+            let p = path.image.get(col, row).x as f64;
+            assert!(
+                (p - v).abs() <= 1e-5 * v.max(1e-3),
+                "({col}, {row}): Path {p}, Direct {v}"
+            );
+        }
+    }
+    assert!(
+        inside > 200 && outside > 200,
+        "{inside} inside, {outside} outside"
+    );
+}
