@@ -3,7 +3,7 @@
 
 Not run in CI. One description (below) is written both as a Mitsuba dict and as an rtis scene
 file (tests/data/lens_spot.ron), so the two cannot drift apart: three diffuse spheres at
-depths 3, 5 and 8 on a grey floor, seen through a thin lens (aperture radius 0.12) focused on
+depths 4.5, 7 and 10 on a grey floor, seen through a thin lens (aperture radius 0.12) focused on
 the middle one, lit by two spot lights (one white with a soft edge, one coloured with a hard
 one) and nothing else. Both renderers trace paths without a depth limit, Russian roulette from
 depth 5, a box pixel filter; Mitsuba's sensor is `thinlens` with `fov_axis: y`, its emitters
@@ -34,9 +34,9 @@ EYE, TARGET, UP, FOV = [0.0, 1.2, -2.0], [0.0, 0.6, 5.0], [0, 1, 0], 40
 APERTURE, FOCUS = 0.12, 7.0
 FLOOR = [0.6, 0.6, 0.6]
 # (centre, radius, reflectance)
-SPHERES = [([-1.0, 0.6, 1.0], 0.6, [0.8, 0.3, 0.2]),
+SPHERES = [([-0.9, 0.6, 2.5], 0.6, [0.8, 0.3, 0.2]),
            ([0.3, 0.6, 5.0], 0.6, [0.3, 0.7, 0.3]),
-           ([1.6, 0.6, 9.0], 0.6, [0.3, 0.4, 0.8])]
+           ([1.4, 0.6, 8.0], 0.6, [0.3, 0.4, 0.8])]
 # (position, direction, intensity, cutoff, beam)
 SPOTS = [([0.0, 4.0, 3.0], [0.1, -1.0, 0.35], [25.0, 25.0, 25.0], 40.0, 15.0),
          ([-2.5, 2.5, 6.0], [1.0, -0.6, 0.4], [12.0, 6.0, 2.0], 25.0, 25.0)]
