@@ -5,9 +5,9 @@ Not run in CI. One description (below) is written both as a Mitsuba dict and as 
 file (tests/data/lens_spot.ron), so the two cannot drift apart: three diffuse spheres at
 depths 4.5, 7 and 10 on a grey floor, seen through a thin lens (aperture radius 0.12) focused on
 the middle one, lit by two spot lights (one white with a soft edge, one coloured with a hard
-one) and nothing else. Both renderers trace paths without a depth limit, Russian roulette from
+one) and a faint sun (`directional`). Both renderers trace paths without a depth limit, Russian roulette from
 depth 5, a box pixel filter; Mitsuba's sensor is `thinlens` with `fov_axis: y`, its emitters
-`spot` oriented by `look_at`.
+`spot` oriented by `look_at` and `directional`.
 
 It writes tests/data/mitsuba_lens_spot_<W>x<H>_spp<N>.exr (linear float32 RGB, Mitsuba's
 orientation: flip left-right before comparing with rtis) and a .json beside it with the
@@ -38,8 +38,10 @@ SPHERES = [([-0.9, 0.6, 2.5], 0.6, [0.8, 0.3, 0.2]),
            ([0.3, 0.6, 5.0], 0.6, [0.3, 0.7, 0.3]),
            ([1.4, 0.6, 8.0], 0.6, [0.3, 0.4, 0.8])]
 # (position, direction, intensity, cutoff, beam)
-SPOTS = [([0.0, 4.0, 3.0], [0.1, -1.0, 0.35], [25.0, 25.0, 25.0], 40.0, 15.0),
-         ([-2.5, 2.5, 6.0], [1.0, -0.6, 0.4], [12.0, 6.0, 2.0], 25.0, 25.0)]
+SPOTS = [([0.0, 4.0, 3.0], [0.05, -1.0, 0.3], [40.0, 40.0, 40.0], 40.0, 15.0),
+         ([-2.5, 2.5, 6.0], [1.0, -0.6, 0.4], [40.0, 20.0, 6.0], 25.0, 25.0)]
+# A faint sun: (direction it travels in, irradiance)
+SUN = ([0.4, -1.0, 0.6], [0.25, 0.25, 0.3])
 
 
 def mitsuba_dict(mi, spp, seed=0):
@@ -71,6 +73,8 @@ def mitsuba_dict(mi, spp, seed=0):
         scene[f"spot{i}"] = {"type": "spot", "to_world": T().look_at(origin=p, target=target, up=up),
                              "intensity": {"type": "rgb", "value": e},
                              "cutoff_angle": cutoff, "beam_width": beam}
+    scene["sun"] = {"type": "directional", "direction": SUN[0],
+                    "irradiance": {"type": "rgb", "value": SUN[1]}}
     return scene
 
 
@@ -104,6 +108,7 @@ def rtis_scene(spp):
     for p, d, e, cutoff, beam in SPOTS:
         lines.append(f"        (light: Spot(position: {tup(p)}, direction: {tup(d)}, intensity: {tup(e)}, "
                      f"cutoff_angle: {num(cutoff)}, beam_width: {num(beam)})),")
+    lines.append(f"        (light: Directional(direction: {tup(SUN[0])}, irradiance: {tup(SUN[1])})),")
     lines += ["    ],", ")", ""]
     return "\n".join(lines)
 

@@ -6,7 +6,7 @@
 //! before rounding to `f32`, so a scene far from the origin renders as precisely as one at it.
 
 use crate::accel::{FLAT, Geometry, Prim};
-use crate::geometry::Placement;
+use crate::geometry::{Aabb, Placement};
 use crate::light::{
     AreaLight, Emitter, Emitters, Emitting, Light, NO_LIGHT, PointLight, SpotLight,
 };
@@ -15,6 +15,7 @@ use crate::render::{RenderScene, effects};
 use crate::shader::Shader;
 use crate::shape::Shape;
 use crate::world::{Name, Scene, Transform, WorldLight, WorldShape};
+use glam::Vec3A;
 
 /// Build the render data of a loaded scene.
 pub fn extract(scene: &Scene) -> RenderScene {
@@ -111,11 +112,25 @@ pub fn extract(scene: &Scene) -> RenderScene {
         }
     }
     let geometry = Geometry::build(prims, normals);
+    // A ball around the scene's finite parts (shapes but planes, lights, the camera), for a
+    // directional light's power.
+    let mut bounds = Aabb::EMPTY.grow(Vec3A::ZERO);
+    for p in geometry.prims() {
+        if let Some(b) = p.shape.bounds() {
+            bounds = bounds.union(b);
+        }
+    }
+    for l in scene.world.query::<&WorldLight>().iter() {
+        if let WorldLight::Point { position, .. } | WorldLight::Spot { position, .. } = l {
+            bounds = bounds.grow((*position - origin).as_vec3a());
+        }
+    }
+    let scene_radius = 0.5 * (bounds.max - bounds.min).length();
     let lights: Vec<_> = scene
         .world
         .query::<&WorldLight>()
         .iter()
-        .map(|l| match l.extract(origin) {
+        .map(|l| match l.extract(origin, scene_radius) {
             Light::Point(p) => Light::Point(PointLight {
                 in_room: geometry.in_room(p.position),
                 ..p
@@ -124,6 +139,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
                 in_room: geometry.in_room(s.position),
                 ..s
             }),
+            directional @ Light::Directional(_) => directional,
         })
         .collect();
     let emitters = Emitters::new(area_lights);

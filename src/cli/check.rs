@@ -322,6 +322,14 @@ pub fn to_ron(scene: &Scene) -> String {
                 num(*cutoff_angle),
                 num(*beam_width)
             )),
+            Some(WorldLight::Directional {
+                direction,
+                irradiance,
+            }) => fields.push(format!(
+                "light: Directional(direction: {}, irradiance: {})",
+                v3(*direction),
+                rgb(*irradiance)
+            )),
             None => {}
         }
         if let Some(e) = emitter {

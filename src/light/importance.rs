@@ -26,6 +26,11 @@ pub fn importance(light: &Light, p: Vec3A, n: Vec3A, transmits: bool) -> f64 {
             let falloff = l.falloff(-toward.0.dot(l.axis));
             (toward, l.intensity.max_element() * falloff)
         }
+        // A directional light's irradiance `E cos(theta)`: no distance (`d^2 = 1` stands in).
+        Light::Directional(l) => (
+            (l.incident().wi, f32::INFINITY, 1.0),
+            l.irradiance.max_element(),
+        ),
     };
     // The direction and cosine exactly as `Light::incident` and the light's term compute them,
     // so that a light with a term has a weight. Computed whatever the case and then selected:

@@ -1,19 +1,21 @@
 //! The closed set of lights. Each variant lives in its own file; [`Light`] dispatches by `match`.
 //!
 //! [`WorldLight`] is the ECS component (scene units, double precision); [`WorldLight::extract`]
-//! makes the camera-relative [`Light`] that shaders use. Point and spot lights are summed at
-//! every shading point (the course's Eq. 3). Emitting shapes ([`Emitter`]) become [`AreaLight`]s, one
+//! makes the camera-relative [`Light`] that shaders use. Point, spot and directional lights are
+//! summed at every shading point (the course's Eq. 3). Emitting shapes ([`Emitter`]) become [`AreaLight`]s, one
 //! per primitive, gathered in [`Emitters`], which picks one per light sample in proportion to
 //! its power. [`choose_by_importance`] picks one point light at a shading point in proportion
 //! to the light it could send there.
 
 mod area;
+mod directional;
 mod emitters;
 mod importance;
 mod point;
 mod spot;
 
 pub use area::{AreaLight, Emitter, Emitting, LightSample};
+pub use directional::DirectionalLight;
 pub use emitters::{Chosen, Emitters, NO_LIGHT};
 pub use importance::{choose_by_importance, importance};
 pub use point::PointLight;
@@ -57,11 +59,19 @@ pub enum WorldLight {
         /// Half-angle of the full beam, degrees, in (0, cutoff_angle].
         beam_width: f64,
     },
+    /// A directional light (a sun at infinity, Mitsuba 3's `directional`).
+    Directional {
+        /// The direction the light travels in (not zero).
+        direction: DVec3,
+        /// Irradiance on a surface facing it, W/m^2 per channel.
+        irradiance: Vec3A,
+    },
 }
 
 impl WorldLight {
-    /// The light in render coordinates, whose origin is the world point `origin`.
-    pub fn extract(&self, origin: DVec3) -> Light {
+    /// The light in render coordinates, whose origin is the world point `origin`, in a scene
+    /// whose finite parts fit in a ball of radius `scene_radius` (a directional light's power).
+    pub fn extract(&self, origin: DVec3, scene_radius: f32) -> Light {
         match *self {
             WorldLight::Point {
                 position,
@@ -85,6 +95,14 @@ impl WorldLight {
                 cutoff: cutoff_angle.to_radians() as f32,
                 in_room: false,
             }),
+            WorldLight::Directional {
+                direction,
+                irradiance,
+            } => Light::Directional(DirectionalLight {
+                direction: direction.normalize().as_vec3a(),
+                irradiance,
+                scene_radius,
+            }),
         }
     }
 }
@@ -96,6 +114,8 @@ pub enum Light {
     Point(PointLight),
     /// A spot light.
     Spot(SpotLight),
+    /// A directional light.
+    Directional(DirectionalLight),
 }
 
 impl Light {
@@ -104,6 +124,7 @@ impl Light {
         match self {
             Light::Point(l) => l.power(),
             Light::Spot(l) => l.power(),
+            Light::Directional(l) => l.power(),
         }
     }
 
@@ -113,6 +134,8 @@ impl Light {
         match self {
             Light::Point(l) => l.in_room,
             Light::Spot(l) => l.in_room,
+            // Planes can stand between any point and infinity.
+            Light::Directional(_) => false,
         }
     }
 
@@ -123,6 +146,7 @@ impl Light {
         match self {
             Light::Point(l) => l.incident(p),
             Light::Spot(l) => l.incident(p),
+            Light::Directional(l) => Some(l.incident()),
         }
     }
 }

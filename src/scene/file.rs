@@ -953,6 +953,14 @@ pub enum LightDesc {
         #[serde(default)]
         beam_width: Option<SpotAngle>,
     },
+    /// A directional light, a sun at infinity (Mitsuba 3's `directional`): light travelling
+    /// along `direction` with `irradiance` on a surface facing it.
+    Directional {
+        /// The direction the light travels in (from the sun towards the scene).
+        direction: Direction,
+        /// Irradiance on a surface facing the light, W/m^2 per channel, >= 0.
+        irradiance: Rgb,
+    },
 }
 
 fn spot_cutoff() -> SpotAngle {
@@ -1002,6 +1010,13 @@ impl LightDesc {
                 intensity: intensity.0.as_vec3a(),
                 cutoff_angle: cutoff_angle.0,
                 beam_width: beam_width.map_or(cutoff_angle.0 * 0.75, |b| b.0),
+            },
+            LightDesc::Directional {
+                direction,
+                irradiance,
+            } => WorldLight::Directional {
+                direction: direction.0,
+                irradiance: irradiance.0.as_vec3a(),
             },
         }
     }

@@ -93,6 +93,10 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
                 "Spot",
                 "Spot(position: (0, 2, 0), direction: (0, -1, 0), intensity: (7, 7, 7))",
             ),
+            (
+                "Directional",
+                "Directional(direction: (0, -1, 0), irradiance: (3, 3, 3))",
+            ),
         ],
     ),
     (
@@ -170,8 +174,9 @@ fn field_form(name: &str) -> Option<&'static str> {
              `TriangleMesh(...)` and `Mesh(path: \"file.obj\")`"
         }
         "light" => {
-            "`Point(position: (0, 2, 0), intensity: (7, 7, 7))` or `Spot(position: (0, 2, 0), \
-             direction: (0, -1, 0), intensity: (7, 7, 7))`"
+            "`Point(position: (0, 2, 0), intensity: (7, 7, 7))`, `Spot(position: (0, 2, 0), \
+             direction: (0, -1, 0), intensity: (7, 7, 7))` or `Directional(direction: (0, -1, \
+             0), irradiance: (3, 3, 3))`"
         }
         "transform" => "a transform `(scale: (1, 1, 1), rotate: (0, 0, 0), translate: (0, 0, 0))`",
         "effects" => "the effect switches `(shadows: false, ...)`",

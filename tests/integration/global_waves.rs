@@ -193,6 +193,12 @@ fn waves_give_the_depth_first_bits_in_the_course_box() {
          (light: Spot(position: (-1, 1, 1), direction: (1, 0, 1), intensity: (1, 4, 2), cutoff_angle: 70))])"
     );
     agree("spot lights", &rtis::extract(&scene(&text)));
+    // A sun beside the point lights: its shadow rays run to infinity through the planes.
+    let text = format!(
+        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)), \
+         entities: [(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))])"
+    );
+    agree("a sun", &rtis::extract(&scene(&text)));
     // Ceiling panels with emission off: no hit samples them, and their rectangles are
     // geometry like any other.
     let area = scenes_dir().join("cornell-area.ron");

@@ -46,18 +46,23 @@ fn transform(scene: &mut Scene, s: f64, t: DVec3) {
         shape.points_mut().into_iter().for_each(f);
     }
     for light in scene.world.query_mut::<&mut WorldLight>() {
-        let (WorldLight::Point {
-            position,
-            intensity,
+        match light {
+            WorldLight::Point {
+                position,
+                intensity,
+            }
+            | WorldLight::Spot {
+                position,
+                intensity,
+                ..
+            } => {
+                f(position);
+                // Keep the irradiance I / d^2 the same at the scaled distances.
+                *intensity *= (s * s) as f32;
+            }
+            // A direction and an irradiance do not change with the scene's scale and place.
+            WorldLight::Directional { .. } => {}
         }
-        | WorldLight::Spot {
-            position,
-            intensity,
-            ..
-        }) = light;
-        f(position);
-        // Keep the irradiance I / d^2 the same at the scaled distances.
-        *intensity *= (s * s) as f32;
     }
     let camera = &mut scene.settings.camera;
     f(&mut camera.position);

@@ -134,3 +134,57 @@ fn a_floor_under_a_spot_has_the_exact_radiance() {
         "{inside} inside, {outside} outside"
     );
 }
+
+/// A floor (kd 0.5) under a sun 35 degrees from the vertical with irradiance E = 3: every
+/// pixel is `(kd / pi) E cos(35 deg)` (no distance, no falloff), under Direct and Path alike,
+/// except under a black ball (seen from above) and in its shadow, whose centre is black.
+#[test]
+fn a_floor_under_a_sun_has_irradiance_e_cos_theta() {
+    let theta = 35f64.to_radians();
+    let (e, kd) = (3.0f64, 0.5f64);
+    let (dx, dy) = (theta.sin(), -theta.cos());
+    // The ball at height 1.5 casts its shadow's centre at x = 1.5 tan(theta).
+    let shadow_x = 1.5 * theta.tan();
+    let text = |shader: &str| {
+        format!(
+            "Scene(film: (width: 40, height: 40, spp: 4), shader: {shader}, model: Physical,
+                   camera: Orthographic(position: (0, 5, 0), look_at: (0, 0, 0), up: (0, 0, 1),
+                                        height: 8),
+                   entities: [(shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+                               material: Phong(kd: ({kd}, {kd}, {kd}), ks: (0, 0, 0))),
+                              (shape: Sphere(center: (0, 1.5, 0), radius: 0.5),
+                               material: Phong(kd: (0, 0, 0), ks: (0, 0, 0))),
+                              (light: Directional(direction: ({dx}, {dy}, 0),
+                                                  irradiance: ({e}, {e}, {e})))])"
+        )
+    };
+    let want = kd / std::f64::consts::PI * e * theta.cos();
+    for shader in ["Direct()", "Path(max_depth: 1)"] {
+        let r = render_str(&text(shader));
+        let px = 8.0 / 40.0;
+        let (mut lit, mut dark) = (0, 0);
+        for row in 0..40u32 {
+            for col in 0..40u32 {
+                // The pixel's centre on the floor (the image's right is up x forward = +x).
+                let x = (col as f64 + 0.5) * px - 4.0;
+                let z = 4.0 - (row as f64 + 0.5) * px;
+                // Whether any of the pixel's floor can see the ball above it towards the sun.
+                let d = ((x - shadow_x).powi(2) + z * z).sqrt();
+                let v = r.image.get(col, row).x as f64;
+                // The black ball itself, seen from above, hides the floor within 0.5 of the axis.
+                let under_ball = (x * x + z * z).sqrt() < 0.5 + px;
+                if d > 1.2 && !under_ball {
+                    assert!(
+                        (v - want).abs() < 1e-5 * want,
+                        "{shader} ({col}, {row}): {v} vs {want}"
+                    );
+                    lit += 1;
+                } else if d < 0.25 {
+                    assert_eq!(v, 0.0, "{shader} ({col}, {row}) in the shadow");
+                    dark += 1;
+                }
+            }
+        }
+        assert!(lit > 1000 && dark >= 4, "{shader}: {lit} lit, {dark} dark");
+    }
+}

@@ -361,6 +361,10 @@ const CASES: &[(&str, &str)] = &[
         "Scene(entities: [(light: Spot(position: (0, 2, 0), direction: (0, 0, 0), intensity: (1, 1, 1)))])",
     ),
     (
+        "sun without a direction",
+        "Scene(entities: [(light: Directional(direction: (0, 0, 0), irradiance: (1, 1, 1)))])",
+    ),
+    (
         "empty triangle mesh",
         "Scene(entities: [(shape: TriangleMesh(vertices: [], faces: []), material: Mirror())])",
     ),

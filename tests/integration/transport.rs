@@ -219,7 +219,11 @@ fn sources(shader: &str, light: f32, ambient: f32, sky: f32) -> rtis::render::Re
     ));
     for l in s.world.query_mut::<&mut rtis::world::WorldLight>() {
         let (rtis::world::WorldLight::Point { intensity, .. }
-        | rtis::world::WorldLight::Spot { intensity, .. }) = l;
+        | rtis::world::WorldLight::Spot { intensity, .. }
+        | rtis::world::WorldLight::Directional {
+            irradiance: intensity,
+            ..
+        }) = l;
         *intensity *= light;
     }
     common::render_scene(&s)

@@ -502,6 +502,45 @@ struct LightLanes<L: Floats> {
     scalar: u32,
 }
 
+/// `PointLight::toward` in lanes: the unit direction from the points `p` to `x`, `d^2` and
+/// the distance.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn toward<L: Floats>(x: Vec3A, p: [L; 3]) -> ([L; 3], L, L) {
+    // SAFETY: the caller vouches for the instruction set.
+    let to = unsafe {
+        [
+            L::splat(x.x) - p[0],
+            L::splat(x.y) - p[1],
+            L::splat(x.z) - p[2],
+        ]
+    };
+    let d2 = dot(to, to);
+    let dist = d2.sqrt();
+    ([to[0] / dist, to[1] / dist, to[2] / dist], d2, dist)
+}
+
+/// `I / d^2` in lanes: one division where the light is grey (the same operands give the same
+/// quotient), three otherwise.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn over_d2<L: Floats>(intensity: Vec3A, d2: L) -> [L; 3] {
+    let bits = intensity.to_array().map(f32::to_bits);
+    // SAFETY: the caller vouches for the instruction set.
+    unsafe {
+        let x = L::splat(intensity.x) / d2;
+        if bits[0] == bits[1] && bits[1] == bits[2] {
+            [x, x, x]
+        } else {
+            [x, L::splat(intensity.y) / d2, L::splat(intensity.z) / d2]
+        }
+    }
+}
+
 /// Eq. 3's point-light sums of the hits of `h`, lane by lane, each light's terms and shadow
 /// rays in lanes, added in the lights' order as `point_lights` adds them. Returns the sums, a
 /// row per channel (zero in lanes not filled).
@@ -529,37 +568,22 @@ unsafe fn point_sums<L: Floats>(
     let (p, n, ng, front, back, kd, o_err) = (h.p, h.n, h.ng, h.front, h.back, h.kd, h.o_err);
     let mut sum = [zero; 3];
     for light in lights {
-        // A spot light is a point light whose intensity falls off off its axis.
-        let (x, intensity, in_room, spot) = match light {
-            Light::Point(pl) => (pl.position, pl.intensity, pl.in_room, None),
-            Light::Spot(sl) => (sl.position, sl.intensity, sl.in_room, Some(sl)),
-        };
-        let bits = intensity.to_array().map(f32::to_bits);
-        let grey = bits[0] == bits[1] && bits[1] == bits[2];
-        // `PointLight::toward` and `incident`.
-        let to = unsafe {
-            [
-                L::splat(x.x) - p[0],
-                L::splat(x.y) - p[1],
-                L::splat(x.z) - p[2],
-            ]
-        };
-        let d2 = dot(to, to);
-        let dist = d2.sqrt();
-        let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
-        // `I / d^2`: one division where the light is grey (the same operands give the same
-        // quotient), three otherwise.
-        let li = match spot {
-            None => unsafe {
-                let x = L::splat(intensity.x) / d2;
-                if grey {
-                    [x, x, x]
-                } else {
-                    [x, L::splat(intensity.y) / d2, L::splat(intensity.z) / d2]
-                }
-            },
+        // The direction to the light, `d^2`, the distance and `L_i`, lane by lane, as each
+        // light's `incident` computes them.
+        let (wi, d2, dist, li, in_room) = match light {
+            Light::Point(pl) => {
+                let (wi, d2, dist) = unsafe { toward::<L>(pl.position, p) };
+                (
+                    wi,
+                    d2,
+                    dist,
+                    unsafe { over_d2::<L>(pl.intensity, d2) },
+                    pl.in_room,
+                )
+            }
             // `SpotLight::incident`, `I (falloff / d^2)`, lane by lane with the same operands.
-            Some(sl) => {
+            Light::Spot(sl) => {
+                let (wi, d2, dist) = unsafe { toward::<L>(sl.position, p) };
                 let mut v = [[0.0f32; MAX_LANES]; 4];
                 for (c, x) in [wi[0], wi[1], wi[2], d2].into_iter().enumerate() {
                     x.write_to(&mut v[c]);
@@ -573,8 +597,21 @@ unsafe fn point_sums<L: Floats>(
                     }
                 }
                 // SAFETY: the caller vouches for the instruction set.
-                unsafe { out.map(|c| L::from_slice(&c)) }
+                let li = unsafe { out.map(|c| L::from_slice(&c)) };
+                (wi, d2, dist, li, sl.in_room)
             }
+            // `DirectionalLight::incident`: the same direction everywhere, at infinity, `L_i =
+            // E`; `d^2 = 1` keeps the lanes valid.
+            Light::Directional(dl) => unsafe {
+                let w = dl.incident();
+                (
+                    [L::splat(w.wi.x), L::splat(w.wi.y), L::splat(w.wi.z)],
+                    L::splat(1.0),
+                    inf,
+                    [L::splat(w.li.x), L::splat(w.li.y), L::splat(w.li.z)],
+                    false,
+                )
+            },
         };
         // `point_light_ray`: a term unless `d^2` is 0 or not finite, or `wi.n <= 0`.
         let cos = dot(wi, n);

@@ -133,6 +133,8 @@ pub fn lights_out_of_room(scene: &mut rtis::RenderScene) {
         match light {
             rtis::light::Light::Point(p) => p.in_room = false,
             rtis::light::Light::Spot(s) => s.in_room = false,
+            // Never in a room: its shadow rays test the planes already.
+            rtis::light::Light::Directional(_) => {}
         }
     }
 }
