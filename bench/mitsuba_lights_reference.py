@@ -23,9 +23,10 @@ Usage:
 import argparse
 import json
 import os
-import time
 
 import numpy as np
+
+from mitsuba_halves import render_halves, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
@@ -125,28 +126,10 @@ def main():
     import mitsuba as mi
 
     mi.set_variant(args.variant)
-    halves, t = [], time.perf_counter()
-    for seed in (0, 1):
-        scene = mi.load_dict(mitsuba_dict(mi, args.spp // 2, seed))
-        acc = np.zeros((HEIGHT, WIDTH, 3))
-        chunk = min(256, args.spp // 2)
-        for k in range(args.spp // 2 // chunk):
-            acc += np.array(mi.render(scene, spp=chunk, seed=seed * 100003 + k)) * chunk
-        halves.append(acc / (args.spp // 2))
-    seconds = time.perf_counter() - t
-    img = 0.5 * (halves[0] + halves[1])
-    half_rmse = float(np.sqrt(np.mean((halves[0] - halves[1]) ** 2)))
+    img, half_rmse, seconds = render_halves(mi, lambda n, seed: mitsuba_dict(mi, n, seed), args.spp,
+                                            WIDTH, HEIGHT)
     stem = os.path.join(ROOT, "tests/data", f"mitsuba_lens_spot_{WIDTH}x{HEIGHT}_spp{args.spp}")
-    mi.Bitmap(img.astype(np.float32)).write(stem + ".exr")
-    meta = {
-        "mitsuba": mi.__version__, "variant": args.variant, "spp": args.spp,
-        "width": WIDTH, "height": HEIGHT, "seconds": round(seconds, 1),
-        "mean": [round(float(c), 6) for c in img.reshape(-1, 3).mean(axis=0)],
-        "half_rmse": half_rmse, "noise_rmse": half_rmse / 2,
-        "orientation": "Mitsuba's own: flip left-right (img[:, ::-1]) to compare with rtis",
-    }
-    with open(stem + ".json", "w") as f:
-        json.dump(meta, f, indent=2)
+    meta = write_reference(mi, stem, img, half_rmse, seconds, args.variant, args.spp)
     print(json.dumps(meta))
 
 

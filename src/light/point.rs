@@ -16,6 +16,17 @@ pub struct PointLight {
     pub in_room: bool,
 }
 
+/// The unit direction from `p` to a light at `x`, the distance and its square (NaN directions
+/// when `p` is `x`, or when the distance overflows): what a point or spot light's `incident`
+/// and the choice by importance read alike.
+#[inline]
+pub fn toward(x: Vec3A, p: Vec3A) -> (Vec3A, f32, f32) {
+    let to = x - p;
+    let d2 = to.length_squared();
+    let dist = d2.sqrt();
+    (to / dist, dist, d2)
+}
+
 impl PointLight {
     /// Emitted power `4 pi I`, averaged over the channels: its weight when one light is chosen
     /// per vertex.
@@ -44,9 +55,6 @@ impl PointLight {
     /// zero always has a weight.
     #[inline]
     pub fn toward(&self, p: Vec3A) -> (Vec3A, f32, f32) {
-        let to = self.position - p;
-        let d2 = to.length_squared();
-        let dist = d2.sqrt();
-        (to / dist, dist, d2)
+        toward(self.position, p)
     }
 }

@@ -70,9 +70,6 @@ impl SpotLight {
     /// [`super::PointLight::toward`]).
     #[inline]
     pub fn toward(&self, p: Vec3A) -> (Vec3A, f32, f32) {
-        let to = self.position - p;
-        let d2 = to.length_squared();
-        let dist = d2.sqrt();
-        (to / dist, dist, d2)
+        super::point::toward(self.position, p)
     }
 }

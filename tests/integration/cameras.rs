@@ -3,7 +3,7 @@
 //! there; the blur of a point off that plane is the thin-lens circle of confusion, measured in
 //! a render.
 
-use crate::common::{render_str, scene};
+use crate::common::{bits, render_str, scene};
 use glam::{DVec3, Vec3A};
 use rtis::camera::{Camera, Projection, WorldCamera, WorldLens};
 use rtis::sampling::Sampler;
@@ -16,13 +16,6 @@ fn camera(lens: Option<WorldLens>) -> Camera {
         up: DVec3::Y,
     }
     .extract(1.5)
-}
-
-fn bits(img: &rtis::render::film::Image) -> Vec<[u32; 3]> {
-    img.pixels
-        .iter()
-        .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
-        .collect()
 }
 
 /// `aperture_radius: 0` (and any focus distance) is no lens: the image has the bits of the
@@ -199,7 +192,9 @@ fn lens_spots_and_sun_match_mitsuba() {
     let b = crate::common::render_scene(&s);
     let r = crate::common::mitsuba_reference("mitsuba_lens_spot_160x120_spp4096.exr");
     let (mse, explained) = crate::common::block_mse(&a.image, &b.image, &r, 0.00243, &|_, _| false);
-    eprintln!("lens, spots and sun: block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}");
+    eprintln!(
+        "lens, spots and sun: block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}"
+    );
     assert!(
         mse < 1.5 * explained,
         "block MSE {mse:.3e} vs {explained:.3e}"

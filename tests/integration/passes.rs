@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use crate::common::scene;
+use crate::common::{bits, scene};
 use rtis::render::pass::{Pass, pass_range};
 use rtis::render::{render, render_pass};
 use std::process::Command;
@@ -27,13 +27,6 @@ fn passes(s: &rtis::RenderScene, n: u32) -> Vec<(String, Pass)> {
             let sums = render_pass(s, r.clone(), &|| {}, &AtomicBool::new(false));
             (format!("pass{i}"), Pass::from_render(s, r, sums.pixels))
         })
-        .collect()
-}
-
-fn bits(img: &rtis::render::film::Image) -> Vec<[u32; 3]> {
-    img.pixels
-        .iter()
-        .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
         .collect()
 }
 

@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use crate::common::scene;
+use crate::common::{bits, scene};
 use rtis::render::pass::Pass;
 use rtis::render::progressive::{Ending, check_resumable, next_round, refine};
 use rtis::render::render;
@@ -16,13 +16,6 @@ fn small_box(spp: u32, seed: u64) -> rtis::RenderScene {
         "Scene(extends: \"cornell.ron\", film: (width: 24, height: 20, spp: {spp}), seed: {seed},
                shader: Path(max_depth: 3))"
     )))
-}
-
-fn bits(img: &rtis::render::film::Image) -> Vec<[u32; 3]> {
-    img.pixels
-        .iter()
-        .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
-        .collect()
 }
 
 /// The rounds of 14 spp hold 1, 2, 4, 8 and 14 samples, each a prefix of the sample indices;

@@ -42,6 +42,14 @@ pub fn render_str(text: &str) -> Rendered {
     render_scene(&scene(text))
 }
 
+/// An image's pixels as bits, to compare renders bit for bit.
+pub fn bits(img: &rtis::render::film::Image) -> Vec<[u32; 3]> {
+    img.pixels
+        .iter()
+        .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+        .collect()
+}
+
 /// Relative closeness of two colours.
 pub fn close(a: Vec3A, b: Vec3A, rel: f32) -> bool {
     (a - b).abs().max_element() <= rel * b.abs().max_element().max(1e-6)

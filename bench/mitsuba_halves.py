@@ -1,0 +1,44 @@
+"""Shared by the bench/mitsuba_*_reference.py scripts: render a Mitsuba 3 scene in two
+independent halves of the samples and write the image with its noise figures.
+
+The noise RMSE is half the RMSE between the halves: the RMSE of their mean against its
+expectation, which the tests compare rtis's distance from the reference with.
+"""
+
+import json
+import time
+
+import numpy as np
+
+
+def render_halves(mi, make_dict, spp, width, height):
+    """Mitsuba's image of `make_dict(spp // 2, seed)` for seeds 0 and 1, averaged, rendered in
+    chunks of at most 256 spp: (image, RMSE between the halves, seconds)."""
+    halves, t = [], time.perf_counter()
+    for seed in (0, 1):
+        scene = mi.load_dict(make_dict(spp // 2, seed))
+        acc = np.zeros((height, width, 3))
+        chunk = min(256, spp // 2)
+        for k in range(spp // 2 // chunk):
+            acc += np.array(mi.render(scene, spp=chunk, seed=seed * 100003 + k)) * chunk
+        halves.append(acc / (spp // 2))
+    seconds = time.perf_counter() - t
+    img = 0.5 * (halves[0] + halves[1])
+    return img, float(np.sqrt(np.mean((halves[0] - halves[1]) ** 2))), seconds
+
+
+def write_reference(mi, stem, img, half_rmse, seconds, variant, spp):
+    """Write `stem`.exr (linear float32 RGB) and `stem`.json (version, variant, spp, seconds,
+    mean, noise) and return the metadata."""
+    height, width = img.shape[:2]
+    mi.Bitmap(img.astype(np.float32)).write(stem + ".exr")
+    meta = {
+        "mitsuba": mi.__version__, "variant": variant, "spp": spp,
+        "width": width, "height": height, "seconds": round(seconds, 1),
+        "mean": [round(float(c), 6) for c in img.reshape(-1, 3).mean(axis=0)],
+        "half_rmse": half_rmse, "noise_rmse": half_rmse / 2,
+        "orientation": "Mitsuba's own: flip left-right (img[:, ::-1]) to compare with rtis",
+    }
+    with open(stem + ".json", "w") as f:
+        json.dump(meta, f, indent=2)
+    return meta
