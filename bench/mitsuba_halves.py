@@ -1,5 +1,6 @@
 """Shared by the bench/mitsuba_*_reference.py scripts: render a Mitsuba 3 scene in two
-independent halves of the samples and write the image with its noise figures.
+independent halves of the samples and write the image with its noise figures; write numbers
+and triples as rtis scene files spell them.
 
 The noise RMSE is half the RMSE between the halves: the RMSE of their mean against its
 expectation, which the tests compare rtis's distance from the reference with.
@@ -42,3 +43,14 @@ def write_reference(mi, stem, img, half_rmse, seconds, variant, spp):
     with open(stem + ".json", "w") as f:
         json.dump(meta, f, indent=2)
     return meta
+
+
+def num(v):
+    """A number as an rtis scene file writes it: whole numbers without a point."""
+    v = float(v)
+    return str(int(v)) if v == int(v) else repr(v)
+
+
+def tup(v):
+    """A triple as an rtis scene file writes it: `(x, y, z)`."""
+    return "(" + ", ".join(num(x) for x in v) + ")"

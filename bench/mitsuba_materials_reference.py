@@ -34,7 +34,7 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import render_halves, write_reference
+from mitsuba_halves import num, render_halves, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
@@ -131,15 +131,6 @@ def mitsuba_dict(mi, variant, spp, seed=0):
 
 
 # ----------------------------------------------------------------------------- rtis
-
-
-def num(v):
-    v = float(v)
-    return str(int(v)) if v == int(v) else repr(v)
-
-
-def tup(v):
-    return "(" + ", ".join(num(x) for x in v) + ")"
 
 
 def rtis_material(m):
