@@ -121,8 +121,12 @@ pub fn extract(scene: &Scene) -> RenderScene {
         }
     }
     for l in scene.world.query::<&WorldLight>().iter() {
-        if let WorldLight::Point { position, .. } | WorldLight::Spot { position, .. } = l {
-            bounds = bounds.grow((*position - origin).as_vec3a());
+        match l {
+            WorldLight::Point { position, .. } | WorldLight::Spot { position, .. } => {
+                bounds = bounds.grow((*position - origin).as_vec3a());
+            }
+            // At infinity: not part of the ball.
+            WorldLight::Directional { .. } => {}
         }
     }
     let scene_radius = 0.5 * (bounds.max - bounds.min).length();

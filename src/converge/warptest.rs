@@ -497,7 +497,7 @@ fn light_cases() -> Vec<Case> {
     ]
 }
 
-/// Rings (of equal area) and sectors of the unit disk's bins.
+/// Rings (of equal area) of the unit disk's bins.
 const DISK_RINGS: usize = 8;
 /// Sectors of the unit disk's bins.
 const DISK_SECTORS: usize = 16;

@@ -18,10 +18,13 @@ pub struct DirectionalLight {
 }
 
 impl DirectionalLight {
-    /// Power averaged over the channels, `pi r^2 E` with `r` the scene's bounding radius.
+    /// Power averaged over the channels, `pi r^2 E` with `r` the scene's bounding radius, in
+    /// double precision and at most `f32::MAX` (a bright sun over a scene 1e9 wide would
+    /// overflow, and the choice by power divide infinities).
     pub fn power(&self) -> f32 {
-        std::f32::consts::PI * self.scene_radius * self.scene_radius * self.irradiance.element_sum()
-            / 3.0
+        let r = self.scene_radius as f64;
+        let p = std::f64::consts::PI * r * r * self.irradiance.element_sum() as f64 / 3.0;
+        p.min(f32::MAX as f64) as f32
     }
 
     /// The light at any point: towards `-direction`, at infinite distance (a shadow ray runs

@@ -12,7 +12,8 @@ use super::Light;
 use glam::Vec3A;
 
 /// The unshadowed irradiance `I cos(theta) / d^2` that `light` sends to `p` across the unit
-/// normal `n`, with `I` its largest channel, in double precision (finite for every finite
+/// normal `n`, with `I` its largest channel (a spot's times its falloff towards `p`; a sun's
+/// `E cos(theta)`, with no distance), in double precision (finite for every finite
 /// input: `I <= f32::MAX` and `d^2 >= 2^-149`). Zero when the light is below the surface or
 /// coincides with `p`, exactly when [`Light::incident`] gives no light facing `n`; with
 /// `transmits` (a surface that passes light, as rough glass), `|cos(theta)|` on either side.

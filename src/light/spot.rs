@@ -3,7 +3,6 @@
 
 use super::Incident;
 use glam::Vec3A;
-use std::f32::consts::TAU;
 
 /// A spot light at `position` pointing along `axis`, with radiant intensity `intensity` (W/sr
 /// per channel) within `beam` of the axis, falling linearly in the angle to zero at `cutoff`.
@@ -48,21 +47,23 @@ impl SpotLight {
         } else {
             1.0 - c.cos()
         };
-        (TAU as f64 * share * self.intensity.element_sum() as f64 / 3.0) as f32
+        (std::f64::consts::TAU * share * self.intensity.element_sum() as f64 / 3.0) as f32
     }
 
     /// `L_i = I falloff(theta) / d^2` along the unit direction to the light; `None` when `p` is
-    /// the light's position (or the distance overflows).
+    /// the light's position (or the distance overflows), or outside the cone (no light, so no
+    /// shadow ray).
     #[inline]
     pub fn incident(&self, p: Vec3A) -> Option<Incident> {
         let (wi, dist, d2) = self.toward(p);
-        if d2 == 0.0 || !d2.is_finite() {
+        let falloff = self.falloff(-wi.dot(self.axis));
+        if d2 == 0.0 || !d2.is_finite() || falloff == 0.0 {
             return None;
         }
         Some(Incident {
             wi,
             dist,
-            li: self.intensity * (self.falloff(-wi.dot(self.axis)) / d2),
+            li: self.intensity * (falloff / d2),
         })
     }
 

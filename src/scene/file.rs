@@ -147,7 +147,7 @@ pub struct CameraDesc(pub CameraFields);
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum CameraFields {
-    /// A pinhole camera.
+    /// A perspective camera: a pinhole, or a thin lens with `aperture_radius` above 0.
     Perspective {
         /// Centre of projection.
         position: Point,

@@ -396,15 +396,19 @@ impl Resolved {
         // Shadow rays exist only where the shader shades with shadows on.
         let shadows = shades && on(fx.shadows);
         for (EntityDesc(light), lidx, li) in self.entities.iter().filter(|_| shadows) {
-            let Some(LightDesc::Point { position, .. }) = &light.light else {
-                continue;
+            let position = match &light.light {
+                Some(LightDesc::Point { position, .. } | LightDesc::Spot { position, .. }) => {
+                    position
+                }
+                // A sun is outside everything; no light, nothing to warn of.
+                Some(LightDesc::Directional { .. }) | None => continue,
             };
             for (EntityDesc(e), sidx, si) in &self.entities {
                 if let (Some(ShapeDesc::Sphere { center, radius }), None) = (&e.shape, &e.transform)
                     && (position.0 - center.0).length() < radius.0
                 {
                     warnings.push(format!(
-                        "{}: this point light is inside the sphere at {}: only the sphere's \
+                        "{}: this light is inside the sphere at {}: only the sphere's \
                          inside sees it, and its shadow rays are wasted elsewhere",
                         at(*lidx, *li, "light"),
                         at(*sidx, *si, "shape")

@@ -18,48 +18,42 @@ fn camera(lens: Option<WorldLens>) -> Camera {
     .extract(1.5)
 }
 
-/// `aperture_radius: 0` (and any focus distance) is no lens: the image has the bits of the
-/// scene without the fields.
+/// `aperture_radius: 0` (with any focus distance) is no lens: the box's own camera written
+/// out with it renders the bits of the box as it is; an aperture above 0 does not.
 #[test]
 fn a_zero_aperture_is_the_pinhole_to_the_bit() {
     let base = "film: (width: 24, height: 18, spp: 4), shader: Path(max_depth: 3)";
     let pinhole = render_str(&format!("Scene(extends: \"cornell.ron\", {base})"));
-    let zero = render_str(&format!(
-        "Scene(extends: \"cornell.ron\", {base},
-               camera: Perspective(position: (0, 0, -3.3), look_at: (0, 0, 0), fov: 60,
-                                   aperture_radius: 0, focus_distance: 2))"
-    ));
     let s = scene(&format!("Scene(extends: \"cornell.ron\", {base})"));
-    let Projection::Perspective { lens, .. } = s.settings.camera.projection else {
+    let c = s.settings.camera;
+    let Projection::Perspective { fov, lens } = c.projection else {
         panic!("the box has a perspective camera");
     };
     assert_eq!(lens, None);
-    // The box's own camera, written out with a zero aperture, renders the same bits.
-    let c = s.settings.camera;
-    let Projection::Perspective { fov, .. } = c.projection else {
-        panic!("the box's camera is a perspective one");
+    let with = |lens: &str| {
+        render_str(&format!(
+            "Scene(extends: \"cornell.ron\", {base},
+                   camera: Perspective(position: ({}, {}, {}), look_at: ({}, {}, {}),
+                                       up: ({}, {}, {}), fov: {fov}{lens}))",
+            c.position.x,
+            c.position.y,
+            c.position.z,
+            c.look_at.x,
+            c.look_at.y,
+            c.look_at.z,
+            c.up.x,
+            c.up.y,
+            c.up.z,
+        ))
     };
-    let written = render_str(&format!(
-        "Scene(extends: \"cornell.ron\", {base},
-               camera: Perspective(position: ({}, {}, {}), look_at: ({}, {}, {}),
-                                   up: ({}, {}, {}), fov: {}, aperture_radius: 0))",
-        c.position.x,
-        c.position.y,
-        c.position.z,
-        c.look_at.x,
-        c.look_at.y,
-        c.look_at.z,
-        c.up.x,
-        c.up.y,
-        c.up.z,
-        fov
-    ));
-    assert_eq!(bits(&written.image), bits(&pinhole.image));
-    assert_ne!(
-        bits(&zero.image),
-        bits(&pinhole.image),
-        "another camera position"
-    );
+    for zero in [
+        ", aperture_radius: 0",
+        ", aperture_radius: 0, focus_distance: 2",
+    ] {
+        assert_eq!(bits(&with(zero).image), bits(&pinhole.image), "{zero}");
+    }
+    let open = with(", aperture_radius: 0.05, focus_distance: 2");
+    assert_ne!(bits(&open.image), bits(&pinhole.image), "a lens must blur");
 }
 
 /// Every ray through the lens for an image point meets the plane in focus where the pinhole
@@ -83,8 +77,10 @@ fn points_on_the_focus_plane_are_sharp() {
             let r = pinhole.ray(u, v, || panic!("a pinhole draws no lens sample"));
             on_plane(r.o, r.d)
         };
+        let mut widest = 0.0f32;
         for _ in 0..1000 {
             let r = lens.ray(u, v, || s.next_2d());
+            widest = widest.max(r.o.length());
             assert!(r.o.length() <= radius as f32 * (1.0 + 1e-6), "{:?}", r.o);
             assert!(
                 r.o.dot(forward).abs() < 1e-6,
@@ -96,6 +92,10 @@ fn points_on_the_focus_plane_are_sharp() {
                 "({u}, {v}): {got} against {want}"
             );
         }
+        assert!(
+            widest > 0.9 * radius as f32,
+            "the lens's edge is never used: {widest}"
+        );
     }
 }
 

@@ -193,12 +193,25 @@ fn waves_give_the_depth_first_bits_in_the_course_box() {
          (light: Spot(position: (-1, 1, 1), direction: (1, 0, 1), intensity: (1, 4, 2), cutoff_angle: 70))])"
     );
     agree("spot lights", &rtis::extract(&scene(&text)));
-    // A sun beside the point lights: its shadow rays run to infinity through the planes.
-    let text = format!(
-        "Scene(extends: {cornell:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.3, 0.3, 0.3)), \
+    // A sun over the course's spheres on their plane (no ceiling): its light reaches the
+    // floor and the spheres, its shadow rays run to infinity; without it the image differs.
+    let spheres = scenes_dir().join("spheres.ron");
+    let spheres = spheres.to_str().unwrap();
+    let sunny = rtis::extract(&scene(&format!(
+        "Scene(extends: {spheres:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.1, 0.1, 0.1)), \
          entities: [(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))])"
+    )));
+    agree("a sun", &sunny);
+    let shaded = rtis::extract(&scene(&format!(
+        "Scene(extends: {spheres:?}, shader: Global(samples: 4, max_depth: 3, ambient: (0.1, 0.1, 0.1)))"
+    )));
+    let g = global(&sunny);
+    let rays = rays(&sunny, 64, 5);
+    assert_ne!(
+        trace(&sunny, &g, &rays, Order::Waves).0,
+        trace(&shaded, &g, &rays, Order::Waves).0,
+        "the sun lights nothing"
     );
-    agree("a sun", &rtis::extract(&scene(&text)));
     // Ceiling panels with emission off: no hit samples them, and their rectangles are
     // geometry like any other.
     let area = scenes_dir().join("cornell-area.ron");

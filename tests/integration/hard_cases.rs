@@ -67,6 +67,11 @@ fn transform(scene: &mut Scene, s: f64, t: DVec3) {
     let camera = &mut scene.settings.camera;
     f(&mut camera.position);
     f(&mut camera.look_at);
+    // A lens's sizes scale with the scene.
+    if let rtis::camera::Projection::Perspective { lens: Some(l), .. } = &mut camera.projection {
+        l.radius *= s;
+        l.focus_distance *= s;
+    }
 }
 
 fn small_cornell(file: &str) -> Scene {

@@ -624,11 +624,17 @@ fn silent_mistakes_are_warned_at_their_place() {
     assert_eq!(
         w,
         [
-            "w.ron:3:11: this point light is inside the sphere at w.ron:2:11: only the sphere's inside \
+            "w.ron:3:11: this light is inside the sphere at w.ron:2:11: only the sphere's inside \
           sees it, and its shadow rays are wasted elsewhere"
         ],
     );
     assert!(warnings(&inside.replace("(0, 0.5, 5)", "(0, 1.5, 5)")).is_empty());
+    // A spot inside the sphere too.
+    let spot = inside.replace(
+        "Point(position: (0, 0.5, 5),",
+        "Spot(position: (0, 0.5, 5), direction: (0, 0, 1),",
+    );
+    assert_eq!(warnings(&spot).len(), 1, "{spot}");
 }
 
 /// The repository's scenes load without a warning.

@@ -545,10 +545,12 @@ unsafe fn over_d2<L: Floats>(intensity: Vec3A, d2: L) -> [L; 3] {
 /// rays in lanes, added in the lights' order as `point_lights` adds them. Returns the sums, a
 /// row per channel (zero in lanes not filled).
 ///
-/// Each lane computes what `point_light_ray` and `point_light_term` compute for its hit:
-/// `wi = (x - p) / |x - p|`, `L_i = I / d^2`, no term where `d^2` is 0 or not finite or
-/// `wi.n <= 0`, the shadow ray from the origin on `wi`'s side to `SHADOW_END` of the distance,
-/// and `L_i r(wi, wo)`, in lanes for the course's diffuse reflectance `kd (wi.n)` and by
+/// Each lane computes what `point_light_ray` and `point_light_term` compute for its hit, for
+/// each kind of light as its `incident` does: `wi = (x - p) / |x - p|` and `L_i = I / d^2` for
+/// a point light, `I falloff / d^2` for a spot (no term outside its cone), `wi = -direction`
+/// and `L_i = E` at infinity for a sun; no term where `d^2` is 0 or not finite or `wi.n <= 0`,
+/// the shadow ray from the origin on `wi`'s side to `SHADOW_END` of the distance, and
+/// `L_i r(wi, wo)`, in lanes for the course's diffuse reflectance `kd (wi.n)` and by
 /// `other(lane, wi, L_i)` for the lanes of `h.scalar` (a specular lobe, the Physical model).
 /// The lanes' sums add `+0` where the walk adds `ZERO` for a light that adds nothing, as it
 /// does.
@@ -570,38 +572,41 @@ unsafe fn point_sums<L: Floats>(
     for light in lights {
         // The direction to the light, `d^2`, the distance and `L_i`, lane by lane, as each
         // light's `incident` computes them.
-        let (wi, d2, dist, li, in_room) = match light {
+        // `in_cone` is 1 in the lanes the light reaches at all (a spot's cone), else 0.
+        // SAFETY: the caller vouches for the instruction set.
+        let one = unsafe { L::splat(1.0) };
+        let (wi, d2, dist, li, in_room, in_cone) = match light {
             Light::Point(pl) => {
+                // SAFETY: the caller vouches for the instruction set.
                 let (wi, d2, dist) = unsafe { toward::<L>(pl.position, p) };
-                (
-                    wi,
-                    d2,
-                    dist,
-                    unsafe { over_d2::<L>(pl.intensity, d2) },
-                    pl.in_room,
-                )
+                let li = unsafe { over_d2::<L>(pl.intensity, d2) };
+                (wi, d2, dist, li, pl.in_room, one)
             }
             // `SpotLight::incident`, `I (falloff / d^2)`, lane by lane with the same operands.
             Light::Spot(sl) => {
+                // SAFETY: the caller vouches for the instruction set.
                 let (wi, d2, dist) = unsafe { toward::<L>(sl.position, p) };
                 let mut v = [[0.0f32; MAX_LANES]; 4];
                 for (c, x) in [wi[0], wi[1], wi[2], d2].into_iter().enumerate() {
                     x.write_to(&mut v[c]);
                 }
-                let mut out = [[0.0f32; MAX_LANES]; 3];
+                let mut out = [[0.0f32; MAX_LANES]; 4];
                 for lane in 0..L::LANES {
                     let w = Vec3A::new(v[0][lane], v[1][lane], v[2][lane]);
-                    let l = sl.intensity * (sl.falloff(-w.dot(sl.axis)) / v[3][lane]);
+                    let falloff = sl.falloff(-w.dot(sl.axis));
+                    let l = sl.intensity * (falloff / v[3][lane]);
                     for c in 0..3 {
                         out[c][lane] = l[c];
                     }
+                    out[3][lane] = if falloff > 0.0 { 1.0 } else { 0.0 };
                 }
                 // SAFETY: the caller vouches for the instruction set.
-                let li = unsafe { out.map(|c| L::from_slice(&c)) };
-                (wi, d2, dist, li, sl.in_room)
+                let [r, g, b, cone] = unsafe { out.map(|c| L::from_slice(&c)) };
+                (wi, d2, dist, [r, g, b], sl.in_room, cone)
             }
             // `DirectionalLight::incident`: the same direction everywhere, at infinity, `L_i =
             // E`; `d^2 = 1` keeps the lanes valid.
+            // SAFETY: the caller vouches for the instruction set.
             Light::Directional(dl) => unsafe {
                 let w = dl.incident();
                 (
@@ -610,12 +615,14 @@ unsafe fn point_sums<L: Floats>(
                     inf,
                     [L::splat(w.li.x), L::splat(w.li.y), L::splat(w.li.z)],
                     false,
+                    one,
                 )
             },
         };
         // `point_light_ray`: a term unless `d^2` is 0 or not finite, or `wi.n <= 0`.
         let cos = dot(wi, n);
-        let valid = d2.cmpne(zero) & d2.cmplt(inf) & !cos.cmple(zero) & h.filled;
+        let valid =
+            d2.cmpne(zero) & d2.cmplt(inf) & !cos.cmple(zero) & in_cone.cmpgt(zero) & h.filled;
         // `Origins::ray`: the side `wi` leaves by.
         let on_front = dot(ng, wi).cmpge(zero);
         let o = [
