@@ -188,3 +188,55 @@ fn a_floor_under_a_sun_has_irradiance_e_cos_theta() {
         assert!(lit > 1000 && dark >= 4, "{shader}: {lit} lit, {dark} dark");
     }
 }
+
+/// The choice of one light per vertex covers every kind: a floor point lit by a point light
+/// (`I cos / d^2`), a spot aimed at it (in its beam: the same), and a sun (`E cos`), seen by a
+/// pinpoint camera, has `(kd / pi)` times their sum under every strategy (summing all, one by
+/// power, one by importance), within 5 standard errors; one light per vertex traces one shadow
+/// ray per camera ray, all lights three.
+#[test]
+fn one_light_per_vertex_covers_every_kind() {
+    let kd = 0.5f64;
+    let (p, i_p) = ([-0.5f64, 2.0, -0.5], 3.0f64);
+    let (s, i_s) = ([0.5f64, 2.5, 0.0], 4.0f64);
+    let (sun, e) = ([0.3f64, -1.0, 0.2], 1.5f64);
+    let at = |x: [f64; 3], i: f64| {
+        let d2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+        i * (x[1] / d2.sqrt()) / d2
+    };
+    let sun_cos = -sun[1] / (sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]).sqrt();
+    let want = kd / std::f64::consts::PI * (at(p, i_p) + at(s, i_s) + e * sun_cos);
+    for shader in [
+        "Path(max_depth: 1, lights_per_vertex: All)",
+        "Path(max_depth: 1, lights_per_vertex: One)",
+        "Path(max_depth: 1, lights_per_vertex: Importance)",
+    ] {
+        let text = format!(
+            "Scene(film: (width: 32, height: 32, spp: 16),
+               camera: Perspective(position: (3, 1, -0.5), look_at: (0, 0, 0), fov: 0.001),
+               model: Physical, shader: {shader},
+               entities: [
+                 (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+                  material: Phong(kd: ({kd}, {kd}, {kd}), ks: (0, 0, 0))),
+                 (light: Point(position: ({}, {}, {}), intensity: ({i_p}, {i_p}, {i_p}))),
+                 (light: Spot(position: ({}, {}, {}), direction: ({}, {}, {}),
+                              intensity: ({i_s}, {i_s}, {i_s}), cutoff_angle: 30, beam_width: 20)),
+                 (light: Directional(direction: ({}, {}, {}), irradiance: ({e}, {e}, {e}))),
+               ])",
+            p[0], p[1], p[2], s[0], s[1], s[2], -s[0], -s[1], -s[2], sun[0], sun[1], sun[2]
+        );
+        let r = render_str(&text);
+        let (mean, se) = crate::common::mean_and_se(&r);
+        let tol = 5.0 * se + 1e-5 * want;
+        assert!(
+            (mean - want).abs() <= tol,
+            "{shader}: {mean:.6} vs exact {want:.6} (tolerance {tol:.2e})"
+        );
+        let shadow = r.stats.shadow as f64 / r.stats.camera as f64;
+        let expect = if shader.contains("All") { 3.0 } else { 1.0 };
+        assert!(
+            shadow <= expect + 1e-9,
+            "{shader}: {shadow} shadow rays per camera ray"
+        );
+    }
+}
