@@ -26,6 +26,8 @@ that this script rewrites from a run of `rtis render --stats`, `rtis bench --jso
                in .venv and libLLVM; see that script)
     commits    bench/commit_compare.py: the Global shader's time against the commit before its
                waves (COMPARE_BASE), both binaries rendering side by side (builds that commit)
+    lens       docs/images/cornell-lens.png: scenes/cornell-lens.ron (thin lens, spot light) at
+               its 720 px and 64 spp, with the render's time
     build      bench/build_times.py: a newcomer's two first builds (render, then tests) of this
                commit against BUILD_BASE (one test binary per file), each from nothing (about
                12 minutes; run it with nothing else compiling)
@@ -52,7 +54,7 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 README = os.path.join(ROOT, "README.md")
 RTIS = os.path.join(ROOT, "target", "release", "rtis")
-BLOCKS = ["build", "hero", "cornell", "commits", "effects", "meshes", "converge", "area", "materials", "obvhs", "embree",
+BLOCKS = ["build", "hero", "cornell", "commits", "effects", "meshes", "converge", "area", "materials", "lens", "obvhs", "embree",
           "mitsuba"]
 # The commit the `commits` block compares with: the last before the Global shader's waves.
 COMPARE_BASE = "e3269bf"
@@ -181,6 +183,20 @@ def film(scene):
     """(width, height, spp) of a scene, as `rtis check` prints it."""
     m = re.search(r"film: \(width: (\d+), height: (\d+), spp: (\d+)", run(["check", scene]))
     return tuple(int(v) for v in m.groups())
+
+
+def lens(_runs):
+    s = render_stats("scenes/cornell-lens.ron", "docs/images/cornell-lens.png")
+    return "\n".join([
+        "![The course's box through a thin lens focused on the red ball, lit by a spot light in place "
+        "of the nearest point light](docs/images/cornell-lens.png)",
+        "",
+        f"*`scenes/cornell-lens.ron`: aperture radius 0.15, focus distance 8, a spot of cutoff 35 and "
+        f"beam 25 degrees; `Path`, 720x576 at {s['spp']} spp: {s['total_rays'] / 1e6:.0f} M rays in "
+        f"{s['seconds']:.1f} s on {s['threads']} threads.*",
+        "",
+        stamp("`rtis render --stats`"),
+    ])
 
 
 def area(_runs):
@@ -420,7 +436,7 @@ def main():
     makers = {"build": build, "hero": hero, "cornell": cornell, "commits": commits, "effects": effects, "meshes": meshes,
               "converge": converge,
               "obvhs": obvhs,
-              "area": area, "materials": materials, "embree": embree, "mitsuba": mitsuba}
+              "area": area, "materials": materials, "lens": lens, "embree": embree, "mitsuba": mitsuba}
     for name in a.only.split(","):
         if name not in makers:
             print(f"unknown block {name}: use {', '.join(BLOCKS)}", file=sys.stderr)
