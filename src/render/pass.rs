@@ -90,6 +90,68 @@ pub fn pass_range(i: u32, n: u32, spp: u32) -> std::result::Result<Range<u32>, S
     Ok(at(i)..at(i + 1))
 }
 
+/// What makes passes parts of one render: film size, scene fingerprint, seed and spp.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderId {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// The scene's [`fingerprint`].
+    pub fingerprint: u64,
+    /// The render's seed.
+    pub seed: u64,
+    /// Samples per pixel of the whole render.
+    pub spp: u32,
+}
+
+/// Which part of a [`RenderId`] differs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Differs {
+    /// The film size.
+    Size,
+    /// The scene's fingerprint.
+    Fingerprint,
+    /// The seed.
+    Seed,
+    /// The samples per pixel.
+    Spp,
+}
+
+impl RenderId {
+    /// The render `scene` makes.
+    pub fn of(scene: &RenderScene) -> RenderId {
+        RenderId {
+            width: scene.film.width,
+            height: scene.film.height,
+            fingerprint: fingerprint(scene),
+            seed: scene.seed,
+            spp: scene.film.spp,
+        }
+    }
+
+    /// The first part (size, fingerprint, seed, spp) in which `other` differs, with this one's
+    /// value and `other`'s as text; `None` when they are one render.
+    pub fn differs(&self, other: &RenderId) -> Option<(Differs, String, String)> {
+        let size = |r: &RenderId| format!("{}x{}", r.width, r.height);
+        if (self.width, self.height) != (other.width, other.height) {
+            Some((Differs::Size, size(self), size(other)))
+        } else if self.fingerprint != other.fingerprint {
+            Some((
+                Differs::Fingerprint,
+                format!("{:016x}", self.fingerprint),
+                format!("{:016x}", other.fingerprint),
+            ))
+        } else if self.seed != other.seed {
+            Some((Differs::Seed, self.seed.to_string(), other.seed.to_string()))
+        } else if self.spp != other.spp {
+            Some((Differs::Spp, self.spp.to_string(), other.spp.to_string()))
+        } else {
+            None
+        }
+    }
+}
+
 /// A pass, or several merged: exact per-pixel sums of some of a render's samples.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pass {
@@ -131,6 +193,17 @@ fn parse_ranges(s: &str) -> Option<Vec<Range<u32>>> {
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
 impl Pass {
+    /// The render this pass is part of.
+    pub fn render(&self) -> RenderId {
+        RenderId {
+            width: self.width,
+            height: self.height,
+            fingerprint: self.fingerprint,
+            seed: self.seed,
+            spp: self.spp,
+        }
+    }
+
     /// Samples each pixel holds.
     pub fn samples(&self) -> u64 {
         self.ranges.iter().map(|r| (r.end - r.start) as u64).sum()
@@ -290,30 +363,16 @@ impl Pass {
             .map(|r| (r.clone(), first_name.clone()))
             .collect();
         for (name, p) in it {
-            let differ = |what: &str, a: String, b: String| {
-                Err(format!(
+            if let Some((part, a, b)) = acc.render().differs(&p.render()) {
+                let what = match part {
+                    Differs::Size => "sizes",
+                    Differs::Fingerprint => "scene fingerprints",
+                    Differs::Seed => "seeds",
+                    Differs::Spp => "spp",
+                };
+                return Err(format!(
                     "{first_name} and {name} are passes of different renders: {what} {a} and {b}"
-                ))
-            };
-            if (p.width, p.height) != (acc.width, acc.height) {
-                return differ(
-                    "sizes",
-                    format!("{}x{}", acc.width, acc.height),
-                    format!("{}x{}", p.width, p.height),
-                );
-            }
-            if p.fingerprint != acc.fingerprint {
-                return differ(
-                    "scene fingerprints",
-                    format!("{:016x}", acc.fingerprint),
-                    format!("{:016x}", p.fingerprint),
-                );
-            }
-            if p.seed != acc.seed {
-                return differ("seeds", acc.seed.to_string(), p.seed.to_string());
-            }
-            if p.spp != acc.spp {
-                return differ("spp", acc.spp.to_string(), p.spp.to_string());
+                ));
             }
             for (a, b) in acc.sums.iter_mut().zip(&p.sums) {
                 *a += *b;

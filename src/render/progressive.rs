@@ -17,7 +17,7 @@
 //! films above [`MAX_PIXELS`] are rendered in one go instead (`rtis render` says so).
 
 use super::exact::RgbSum;
-use super::pass::Pass;
+use super::pass::{Differs, Pass, RenderId};
 use super::{RenderScene, Tiled, render_pass};
 use crate::stats::RayStats;
 use std::ops::Range;
@@ -164,32 +164,17 @@ pub fn refine(
 /// Check that `pass` (read from a file) belongs to `scene` and may be resumed by [`refine`]:
 /// the same size, fingerprint, seed and spp. The message names what differs.
 pub fn check_resumable(scene: &RenderScene, pass: &Pass) -> Result<(), String> {
-    let fresh = Pass::empty(scene);
-    let differ = |what: &str, file: String, now: String| {
-        Err(format!(
-            "it is a render of another {what} ({file}, the scene now gives {now}): resume only \
-             with the scene, film, seed and settings it was rendered with"
-        ))
+    let Some((part, file, now)) = pass.render().differs(&RenderId::of(scene)) else {
+        return Ok(());
     };
-    if (pass.width, pass.height) != (fresh.width, fresh.height) {
-        return differ(
-            "film size",
-            format!("{}x{}", pass.width, pass.height),
-            format!("{}x{}", fresh.width, fresh.height),
-        );
-    }
-    if pass.spp != fresh.spp {
-        return differ("spp", pass.spp.to_string(), fresh.spp.to_string());
-    }
-    if pass.seed != fresh.seed {
-        return differ("seed", pass.seed.to_string(), fresh.seed.to_string());
-    }
-    if pass.fingerprint != fresh.fingerprint {
-        return differ(
-            "scene",
-            format!("fingerprint {:016x}", pass.fingerprint),
-            format!("{:016x}", fresh.fingerprint),
-        );
-    }
-    Ok(())
+    let (what, file) = match part {
+        Differs::Size => ("film size", file),
+        Differs::Fingerprint => ("scene", format!("fingerprint {file}")),
+        Differs::Seed => ("seed", file),
+        Differs::Spp => ("spp", file),
+    };
+    Err(format!(
+        "it is a render of another {what} ({file}, the scene now gives {now}): resume only with \
+         the scene, film, seed and settings it was rendered with"
+    ))
 }
