@@ -14,7 +14,7 @@ use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
 use crate::shader::Shader;
 use crate::shape::Shape;
-use crate::world::{Name, Scene, Transform, WorldLight, WorldShape};
+use crate::world::{Name, Scene, Transform, WorldEnvironment, WorldLight, WorldShape};
 use glam::Vec3A;
 
 /// Build the render data of a loaded scene.
@@ -146,7 +146,13 @@ pub fn extract(scene: &Scene) -> RenderScene {
             directional @ Light::Directional(_) => directional,
         })
         .collect();
-    let emitters = Emitters::new(area_lights);
+    let environment = scene
+        .world
+        .query::<&WorldEnvironment>()
+        .iter()
+        .next()
+        .map(|env| env.extract(scene_radius));
+    let emitters = Emitters::with_points(area_lights, environment, &[]);
 
     // The effects, derived once from the parts, before the render scene is assembled.
     let derived = effects::derive(

@@ -8,7 +8,8 @@
 //! - [`shader`]: one file per shader, given the parts of the scene it reads;
 //! - [`accel`]: ray queries over the flat primitives (SIMD packets and a BVH);
 //! - [`shape`], [`material`], [`light`], [`camera`]: the closed sets, one file per variant;
-//! - [`geometry`], [`sampling`], [`mesh`], [`effects`], [`stats`]: leaf maths and data.
+//! - [`geometry`], [`sampling`], [`mesh`], [`raster`], [`effects`], [`stats`]: leaf maths and
+//!   data.
 //!
 //! [`converge`] (error against time) sits beside the command line on top.
 
@@ -23,6 +24,7 @@ pub mod geometry;
 pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod raster;
 pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -7,13 +7,15 @@
 
 use super::CliError;
 use glam::{DVec3, Vec3A};
+use rtis::light::Sky;
 use rtis::material::microfacet::Microfacet;
 use rtis::material::{Bsdf, Coating};
 use rtis::render::estimate::{self, human_seconds};
 use rtis::scene::{self, Scene};
 use rtis::shader::Shader;
 use rtis::world::{
-    Emitter, Material, MaterialName, Name, Projection, Transform, WorldLight, WorldShape,
+    Emitter, Material, MaterialName, Name, Projection, Transform, WorldEnvironment, WorldLight,
+    WorldShape,
 };
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -262,7 +264,7 @@ pub fn to_ron(scene: &Scene) -> String {
 
     // One line per entity, in the order of the file.
     let mut entities: Vec<(hecs::Entity, String)> = Vec::new();
-    for (id, name, sh, m, mname, t, light, emitter) in scene
+    for (id, name, sh, m, mname, t, light, env, emitter) in scene
         .world
         .query::<(
             hecs::Entity,
@@ -272,6 +274,7 @@ pub fn to_ron(scene: &Scene) -> String {
             Option<&MaterialName>,
             Option<&Transform>,
             Option<&WorldLight>,
+            Option<&WorldEnvironment>,
             Option<&Emitter>,
         )>()
         .iter()
@@ -331,6 +334,18 @@ pub fn to_ron(scene: &Scene) -> String {
                 rgb(*irradiance)
             )),
             None => {}
+        }
+        if let Some(env) = env {
+            let sky = match (&env.sky, &env.image) {
+                (Sky::Uniform(l), _) => format!("radiance: {}", rgb(*l)),
+                (Sky::Map(_), Some(path)) => format!("image: {path:?}"),
+                (Sky::Map(m), None) => format!("image: {m:?}"),
+            };
+            fields.push(format!(
+                "light: Environment({sky}, scale: {}, rotate: {})",
+                num(env.scale),
+                v3(env.rotate)
+            ));
         }
         if let Some(e) = emitter {
             fields.push(format!(

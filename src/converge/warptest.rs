@@ -8,13 +8,17 @@
 //! p-value is below the significance level (0.01, Sidak-corrected for the number of tests).
 //! The discrete Fresnel choice of Physical glass (reflect with probability `F`) is tested the
 //! same way over its two outcomes. Area-light sampling (choose a light by power, then a
-//! direction towards it) is tested against `Emitters::pdf_direction` from a point. The
+//! direction towards it) is tested against `Emitters::pdf_direction` from a point; the
+//! environment light's sampler (a constant sky; maps with a tiny bright sun, and of one texel)
+//! against `EnvironmentLight::pdf`, with the map's poles on the bins' axis. The
 //! microfacet samplers (GGX and Beckmann, visible and full) are tested through the directions
 //! they reflect, against `Microfacet::pdf_reflection`; every BSDF through `Bsdf::sample`
 //! against `Bsdf::pdf`, over the whole sphere.
 
 use crate::geometry::Frame;
-use crate::light::{AreaLight, Emitter, Emitters, Emitting};
+use crate::light::{
+    AreaLight, Emitter, Emitters, Emitting, EnvironmentLight, Sky, SkyMap, WorldEnvironment,
+};
 use crate::material::conductor::Conductor;
 use crate::material::microfacet::{Distribution, Microfacet, NormalSampling};
 use crate::material::plastic::Plastic;
@@ -22,12 +26,14 @@ use crate::material::rough_conductor::RoughConductor;
 use crate::material::rough_dielectric::RoughDielectric;
 use crate::material::rough_plastic::RoughPlastic;
 use crate::material::{Bsdf, Coating, Phong, fresnel_dielectric, reflect};
+use crate::raster::Raster;
 use crate::sampling::{Sampler, Sampling, hemisphere, warp};
 use crate::shader::path;
 use crate::shape::{Sphere, Triangle};
-use glam::Vec3A;
+use glam::{DVec3, Vec3A};
 use std::f64::consts::PI;
 use std::fmt::Write;
+use std::sync::Arc;
 
 /// Bins in `z` (cosine of the polar angle, from -1 to 1).
 pub const BINS_Z: usize = 20;
@@ -430,6 +436,65 @@ fn light_case(name: &str, lights: Vec<AreaLight>) -> Case {
     }
 }
 
+/// An environment light of `sky`, turned so that the map's zenith is the bins' `+z` (its poles,
+/// where the density per solid angle has its `1 / sin(theta)`, on the bins' axis).
+pub fn environment(sky: Sky) -> EnvironmentLight {
+    WorldEnvironment {
+        sky,
+        image: None,
+        scale: 1.0,
+        rotate: DVec3::new(90.0, 0.0, 0.0),
+    }
+    .extract(1.0)
+}
+
+/// A `w x h` map whose texel `(x, y)` is grey `f(x, y)`.
+pub fn grey_map(w: usize, h: usize, f: impl Fn(usize, usize) -> f32) -> Sky {
+    let texels = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| [f(x, y); 3])
+        .collect();
+    let raster = Raster::new(w, h, texels).expect("a map of w x h texels");
+    Sky::Map(Arc::new(SkyMap::new(raster)))
+}
+
+/// The environment light's sampler (two 53-bit numbers), against the density it claims.
+pub fn environment_case(name: &str, light: EnvironmentLight) -> Case {
+    let expected = integrate_pdf_peaked(|w| light.pdf(w) as f64);
+    Case {
+        name: name.into(),
+        draw: Box::new(move |s: &mut Sampler| {
+            let (u1, u2) = (s.next_f64(), s.next_f64());
+            Some(direction_bin(light.sample(u1, u2)?.wi))
+        }),
+        expected,
+        columns: BINS_PHI,
+    }
+}
+
+/// The environment samplers: a constant sky; a map of a dim sky with a sun of one texel 10^4
+/// times brighter (a peak a few degrees wide); and a map of one texel.
+fn environment_cases() -> Vec<Case> {
+    let sun = grey_map(64, 32, |x, y| {
+        if (x, y) == (20, 9) {
+            100.0
+        } else {
+            0.01 * (1.0 + x as f32 / 64.0)
+        }
+    });
+    vec![
+        environment_case(
+            "environment: constant sky",
+            environment(Sky::Uniform(Vec3A::ONE)),
+        ),
+        environment_case("environment: map with a tiny bright sun", environment(sun)),
+        environment_case(
+            "environment: map of 1x1",
+            environment(grey_map(1, 1, |_, _| 2.0)),
+        ),
+    ]
+}
+
 /// An emitting sphere, one-sided, of radiance `l`.
 fn sphere_light(c: Vec3A, r: f32, l: f32) -> AreaLight {
     AreaLight::new(
@@ -574,6 +639,7 @@ pub fn cases() -> Vec<Case> {
     ]
     .into_iter()
     .chain(light_cases())
+    .chain(environment_cases())
     .chain(microfacet_cases())
     .chain(bsdf_cases())
     .collect()

@@ -1,6 +1,7 @@
-//! The scene's area lights, chosen one per light sample in proportion to their power.
+//! The scene's area lights and its environment light, chosen one per light sample in
+//! proportion to their power.
 
-use super::AreaLight;
+use super::{AreaLight, EnvironmentLight};
 use crate::geometry::Ray;
 use glam::Vec3A;
 
@@ -12,22 +13,28 @@ pub const NO_LIGHT: u32 = u32::MAX;
 pub enum Chosen<'a> {
     /// An area light.
     Area(&'a AreaLight, f32),
+    /// The environment light.
+    Environment(&'a EnvironmentLight, f32),
     /// Point light number `index` of the render (only when the point lights take part).
     Point(usize, f32),
 }
 
-/// Every area light of a render, with the cumulative distribution of their powers; when one
-/// light is chosen per vertex (`Path(lights_per_vertex: One)` or `Importance`), the point
-/// lights' powers take part too, after the area lights.
+/// Every area light of a render and its environment light, with the cumulative distribution of
+/// their powers (area lights, then the environment); when one light is chosen per vertex
+/// (`Path(lights_per_vertex: One)` or `Importance`), the point lights' powers take part too,
+/// after them.
 #[derive(Clone, Debug, Default)]
 pub struct Emitters {
     /// The lights; a primitive refers to its light by index here.
     pub lights: Vec<AreaLight>,
+    /// The environment light, if the scene has one (at most one).
+    pub environment: Option<EnvironmentLight>,
     /// `cdf[i]`: the power of lights `0..=i` over the total; the last is 1. Double precision,
     /// and sampled with 53-bit numbers, so that a light whose share is below f32's 2^-24 grid
     /// (one small triangle of a million) is still chosen as often as [`Emitters::pmf`] says.
     cdf: Vec<f64>,
-    /// Each light's probability, `power / total` (area lights, then point lights).
+    /// Each light's probability, `power / total` (area lights, the environment, then point
+    /// lights).
     pmf: Vec<f32>,
 }
 
@@ -35,15 +42,20 @@ impl Emitters {
     /// The set of `lights`, each chosen with probability proportional to its power (uniformly
     /// if none has any).
     pub fn new(lights: Vec<AreaLight>) -> Self {
-        Self::with_points(lights, &[])
+        Self::with_points(lights, None, &[])
     }
 
-    /// The area `lights` and point lights of powers `points`, each chosen in proportion to its
-    /// power.
-    pub fn with_points(lights: Vec<AreaLight>, points: &[f32]) -> Self {
+    /// The area `lights`, the `environment` light and point lights of powers `points`, each
+    /// chosen in proportion to its power.
+    pub fn with_points(
+        lights: Vec<AreaLight>,
+        environment: Option<EnvironmentLight>,
+        points: &[f32],
+    ) -> Self {
         let mut powers: Vec<f64> = lights
             .iter()
             .map(|l| l.power())
+            .chain(environment.as_ref().map(EnvironmentLight::power))
             .chain(points.iter().copied())
             .map(f64::from)
             .collect();
@@ -63,25 +75,46 @@ impl Emitters {
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
-        Emitters { lights, cdf, pmf }
+        Emitters {
+            lights,
+            environment,
+            cdf,
+            pmf,
+        }
     }
 
-    /// True when the scene has no area light.
+    /// True when the scene has no area light and no environment light.
     #[inline]
     pub fn is_empty(&self) -> bool {
-        self.lights.is_empty()
+        self.lights.is_empty() && self.environment.is_none()
+    }
+
+    /// The number of area lights and environment lights, which come before the point lights in
+    /// the choice.
+    #[inline]
+    fn sampled(&self) -> usize {
+        self.lights.len() + usize::from(self.environment.is_some())
     }
 
     /// True when point lights take part in the choice.
     #[inline]
     pub fn with_point_lights(&self) -> bool {
-        self.pmf.len() > self.lights.len()
+        self.pmf.len() > self.sampled()
     }
 
-    /// The same area lights, chosen with the point lights of powers `points` (none: among
-    /// themselves).
+    /// The same area and environment lights, chosen with the point lights of powers `points`
+    /// (none: among themselves).
     pub fn rechosen(&self, points: &[f32]) -> Self {
-        Self::with_points(self.lights.clone(), points)
+        Self::with_points(self.lights.clone(), self.environment.clone(), points)
+    }
+
+    /// Probability that the environment light is chosen (0 without one).
+    #[inline]
+    pub fn pmf_environment(&self) -> f32 {
+        match self.environment {
+            Some(_) => self.pmf[self.lights.len()],
+            None => 0.0,
+        }
     }
 
     /// The point lights' part of the choice: `(start, share)`, where `u` in [0, 1) picks a
@@ -91,7 +124,7 @@ impl Emitters {
         if !self.with_point_lights() {
             return (1.0, 0.0);
         }
-        let start = match self.lights.len() {
+        let start = match self.sampled() {
             0 => 0.0,
             n => self.cdf[n - 1],
         };
@@ -106,16 +139,16 @@ impl Emitters {
 
     /// The area light that `u`, uniform in [0, 1), picks, with its probability: the first
     /// whose cumulative share exceeds `u` (a light of zero power is never picked); `None` if
-    /// `u` picks a point light, or there is no light.
+    /// `u` picks a point light or the environment, or there is no light.
     #[inline]
     pub fn choose(&self, u: f64) -> Option<(&AreaLight, f32)> {
         match self.choose_any(u)? {
             Chosen::Area(l, pmf) => Some((l, pmf)),
-            Chosen::Point(..) => None,
+            Chosen::Environment(..) | Chosen::Point(..) => None,
         }
     }
 
-    /// The light, area or point, that `u` picks, with its probability.
+    /// The light, area, environment or point, that `u` picks, with its probability.
     #[inline]
     pub fn choose_any(&self, u: f64) -> Option<Chosen<'_>> {
         if self.cdf.is_empty() {
@@ -126,19 +159,25 @@ impl Emitters {
             .partition_point(|&c| c <= u)
             .min(self.cdf.len() - 1);
         let pmf = self.pmf[i];
-        Some(match self.lights.get(i) {
-            Some(l) => Chosen::Area(l, pmf),
-            None => Chosen::Point(i - self.lights.len(), pmf),
+        let n = self.lights.len();
+        Some(match (self.lights.get(i), &self.environment) {
+            (Some(l), _) => Chosen::Area(l, pmf),
+            (None, Some(env)) if i == n => Chosen::Environment(env, pmf),
+            (None, _) => Chosen::Point(i - self.sampled(), pmf),
         })
     }
 
     /// Density per unit solid angle with which one light sample from `p` (choose a light, then
     /// sample it) picks direction `w`: the sum over the lights the ray from `p` meets of the
-    /// chance of choosing each times its density. For tests and `rtis warptest`; shaders ask
-    /// the one light a ray hit.
+    /// chance of choosing each times its density, and the environment's (which every ray
+    /// meets, ignoring occlusion). For tests and `rtis warptest`; shaders ask the one light a
+    /// ray hit.
     pub fn pdf_direction(&self, p: Vec3A, w: Vec3A) -> f32 {
         let ray = Ray::new(p, w);
-        let mut pdf = 0.0;
+        let mut pdf = match &self.environment {
+            Some(env) => self.pmf_environment() * env.pdf(w),
+            None => 0.0,
+        };
         for (i, light) in self.lights.iter().enumerate() {
             let shape = light.shape.shape();
             if let Some(t) = shape.intersect(&ray) {

@@ -3,22 +3,26 @@
 //! [`WorldLight`] is the ECS component (scene units, double precision); [`WorldLight::extract`]
 //! makes the camera-relative [`Light`] that shaders use. Point, spot and directional lights are
 //! summed at every shading point (the course's Eq. 3). Emitting shapes ([`Emitter`]) become [`AreaLight`]s, one
-//! per primitive, gathered in [`Emitters`], which picks one per light sample in proportion to
-//! its power. [`choose_by_importance`] picks one point light at a shading point in proportion
+//! per primitive, gathered in [`Emitters`] with the environment light ([`EnvironmentLight`], a
+//! constant sky or an image), which picks one per light sample in proportion to its power. [`choose_by_importance`] picks one point light at a shading point in proportion
 //! to the light it could send there.
 
 mod area;
 mod directional;
 mod emitters;
+mod environment;
 mod importance;
 mod point;
+mod sky_map;
 mod spot;
 
 pub use area::{AreaLight, Emitter, Emitting, LightSample};
 pub use directional::DirectionalLight;
 pub use emitters::{Chosen, Emitters, NO_LIGHT};
+pub use environment::{EnvironmentLight, Sky, WorldEnvironment};
 pub use importance::{choose_by_importance, importance};
 pub use point::PointLight;
+pub use sky_map::{SkyMap, luminance};
 pub use spot::SpotLight;
 
 use glam::{DVec3, Vec3A};

@@ -47,7 +47,13 @@ pub fn derive(
             Shader::Path(_) => true,
             _ => false,
         };
-    let emission = shading && emitters.lights.iter().any(|l| l.power() > 0.0);
+    // Light from emitting shapes and from the sky (whose power is 0 in a scene of no size).
+    let emission = shading
+        && (emitters.lights.iter().any(|l| l.power() > 0.0)
+            || emitters
+                .environment
+                .as_ref()
+                .is_some_and(|e| e.integral().max_element() > 0.0));
     let ambient = has_phong
         && matches!(shader, Shader::Global(g) if g.ambient != Vec3A::ZERO)
         && any_mat(|m| matches!(m, Material::Phong(p) if p.kd != Vec3A::ZERO));

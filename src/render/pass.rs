@@ -38,7 +38,7 @@ impl std::fmt::Write for Fnv {
 }
 
 /// A hash of everything that decides a render's samples: camera, geometry (primitives and
-/// smooth normals), materials, lights, background, shader, model, effects and film size.
+/// smooth normals), materials, lights, the environment light (its map by a hash), background, shader, model, effects and film size.
 /// Passes of one render share it. Streamed, so a mesh of a million triangles costs a pass over
 /// it, not a string of its size.
 pub fn fingerprint(scene: &RenderScene) -> u64 {
@@ -51,10 +51,11 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
     }
     let _ = write!(
         h,
-        "|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}",
+        "|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}",
         scene.geometry.normals,
         scene.materials,
         scene.lights,
+        scene.emitters.environment,
         scene.background,
         scene.shader,
         scene.model,

@@ -1,11 +1,13 @@
 //! Random numbers, sample warps and sampling strategies.
 
+pub mod distribution;
 pub mod hemisphere;
 mod pixel;
 mod rng;
 mod strategy;
 pub mod warp;
 
+pub use distribution::{Distribution1D, Distribution2D};
 pub use pixel::pixel_sample;
 pub use rng::{Sampler, mix};
 pub use strategy::{LightSampling, LightsPerVertex, Sampling, power_heuristic};

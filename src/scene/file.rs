@@ -12,7 +12,7 @@ use super::values::{
 use crate::camera::{Projection, WorldCamera, WorldLens};
 use crate::effects::Switches;
 use crate::geometry::Transform;
-use crate::light::{Emitter, WorldLight};
+use crate::light::{Emitter, Sky, SkyMap, WorldEnvironment, WorldLight};
 use crate::material::conductor::{Conductor, Metal};
 use crate::material::microfacet::Microfacet;
 use crate::material::plastic::Plastic;
@@ -925,7 +925,7 @@ impl TransformDesc {
 }
 
 /// A light as written.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum LightDesc {
     /// An isotropic point light: incident radiance `intensity / d^2`.
@@ -961,6 +961,40 @@ pub enum LightDesc {
         /// Irradiance on a surface facing the light, W/m^2 per channel, >= 0.
         irradiance: Rgb,
     },
+    /// An environment light (Mitsuba 3's `envmap` and `constant`): radiance arriving from
+    /// infinitely far away in every direction, from a latitude-longitude `image` or a constant
+    /// `radiance` (give one). Escaped rays see it; a scene has at most one, and no `background`
+    /// beside it.
+    Environment {
+        /// A latitude-longitude image of the radiance (OpenEXR, linear; or PNG, decoded from
+        /// sRGB), relative to this file's folder: its top row is the zenith (+y), its left
+        /// edge looks along -z and its centre along +z, as Mitsuba's `envmap`.
+        #[serde(default)]
+        image: Option<String>,
+        /// A constant sky's radiance, W/(m^2 sr) per channel, >= 0.
+        #[serde(default)]
+        radiance: Option<Rgb>,
+        /// A factor on the radiance, >= 0 (default 1).
+        #[serde(default = "unit_scale_factor")]
+        scale: NonNegative,
+        /// Rotation of the sky in degrees about x, then y, then z (default none), as a shape's
+        /// `Transform(rotate: ...)`.
+        #[serde(default = "origin")]
+        rotate: Point,
+    },
+}
+
+fn unit_scale_factor() -> NonNegative {
+    NonNegative(1.0)
+}
+
+/// A light as the world holds it: a light source placed in the world, or its sky.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightComponent {
+    /// A point, spot or directional light.
+    Light(WorldLight),
+    /// The environment light.
+    Environment(WorldEnvironment),
 }
 
 fn spot_cutoff() -> SpotAngle {
@@ -972,6 +1006,25 @@ impl LightDesc {
     /// Checked after parsing, where the field's place in the file is known (`super::load`).
     pub fn invalid(&self) -> Option<(&'static str, String)> {
         match *self {
+            LightDesc::Environment {
+                image: Some(_),
+                radiance: Some(_),
+                ..
+            } => Some((
+                "radiance",
+                "an Environment takes an `image` or a constant `radiance`, not both: remove one"
+                    .into(),
+            )),
+            LightDesc::Environment {
+                image: None,
+                radiance: None,
+                ..
+            } => Some((
+                "",
+                "an Environment needs an `image: \"sky.exr\"` (a latitude-longitude map) or a \
+                 constant `radiance: (r, g, b)`"
+                    .into(),
+            )),
             LightDesc::Spot {
                 cutoff_angle,
                 beam_width: Some(beam),
@@ -988,36 +1041,60 @@ impl LightDesc {
         }
     }
 
-    /// The world's light.
-    pub fn to_world(&self) -> WorldLight {
-        match *self {
-            LightDesc::Point {
+    /// The world's light; `load` reads an environment's image (its path as written), and its
+    /// message is the error's. An environment with neither an image nor a radiance (refused by
+    /// [`LightDesc::invalid`]) would be black.
+    pub fn to_world(
+        &self,
+        load: impl FnOnce(&str) -> Result<Arc<SkyMap>, String>,
+    ) -> Result<LightComponent, String> {
+        let light = |l| Ok(LightComponent::Light(l));
+        match self {
+            &LightDesc::Point {
                 position,
                 intensity,
-            } => WorldLight::Point {
+            } => light(WorldLight::Point {
                 position: position.0,
                 intensity: intensity.0.as_vec3a(),
-            },
-            LightDesc::Spot {
+            }),
+            &LightDesc::Spot {
                 position,
                 direction,
                 intensity,
                 cutoff_angle,
                 beam_width,
-            } => WorldLight::Spot {
+            } => light(WorldLight::Spot {
                 position: position.0,
                 direction: direction.0,
                 intensity: intensity.0.as_vec3a(),
                 cutoff_angle: cutoff_angle.0,
                 beam_width: beam_width.map_or(cutoff_angle.0 * 0.75, |b| b.0),
-            },
-            LightDesc::Directional {
+            }),
+            &LightDesc::Directional {
                 direction,
                 irradiance,
-            } => WorldLight::Directional {
+            } => light(WorldLight::Directional {
                 direction: direction.0,
                 irradiance: irradiance.0.as_vec3a(),
-            },
+            }),
+            LightDesc::Environment {
+                image,
+                radiance,
+                scale,
+                rotate,
+            } => {
+                let sky = match (image, radiance) {
+                    (Some(path), _) => Sky::Map(load(path)?),
+                    (None, Some(l)) => Sky::Uniform(l.0.as_vec3a()),
+                    (None, None) => Sky::Uniform(glam::Vec3A::ZERO),
+                };
+                Ok(LightComponent::Environment(WorldEnvironment {
+                    sky,
+                    image: image.clone(),
+                    scale: scale.0 as f32,
+                    rotate: rotate.0,
+                }))
+            }
         }
     }
 }

@@ -4,17 +4,19 @@
 use super::SceneError;
 use super::error::{clip, line_col};
 use super::file::{
-    CameraDesc, EffectsDesc, EntityDesc, FilmDesc, LightDesc, MaterialDesc, Model, SceneFile,
-    ShaderDesc, ShapeDesc, TableMaterial,
+    CameraDesc, EffectsDesc, EntityDesc, FilmDesc, LightComponent, LightDesc, MaterialDesc, Model,
+    SceneFile, ShaderDesc, ShapeDesc, TableMaterial,
 };
 use super::messages::{explain, offset_of};
 use super::spans::{self, Node};
 use super::values::Rgb;
+use crate::light::SkyMap;
 use crate::material::Material;
 use crate::world::{MaterialName, Name, Scene, Settings, Shader};
 use ron::extensions::Extensions;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The course's Cornell box, embedded: what `rtis render` draws when given no scene.
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/cornell.ron");
@@ -400,8 +402,10 @@ impl Resolved {
                 Some(LightDesc::Point { position, .. } | LightDesc::Spot { position, .. }) => {
                     position
                 }
-                // A sun is outside everything; no light, nothing to warn of.
-                Some(LightDesc::Directional { .. }) | None => continue,
+                // A sun or a sky is outside everything; no light, nothing to warn of.
+                Some(LightDesc::Directional { .. } | LightDesc::Environment { .. }) | None => {
+                    continue;
+                }
             };
             for (EntityDesc(e), sidx, si) in &self.entities {
                 if let (Some(ShapeDesc::Sphere { center, radius }), None) = (&e.shape, &e.transform)
@@ -433,6 +437,8 @@ impl Resolved {
             model: self.model.unwrap_or(d.model),
             effects: self.effects.map_or(d.effects, |e| e.to_world()),
         };
+        // Where the scene's environment light is written, once one is met.
+        let mut sky_at: Option<String> = None;
         for (EntityDesc(e), idx, i) in &self.entities {
             let src = &self.sources[*idx];
             // Where a component's value is written: the value of `field`, then `inner` inside
@@ -467,7 +473,43 @@ impl Resolved {
                 b.add(t.to_world());
             }
             if let Some(light) = &e.light {
-                b.add(light.to_world());
+                let light = light
+                    .to_world(|path| {
+                        let file = src.dir.clone().unwrap_or_default().join(path);
+                        files.push(file.clone());
+                        crate::raster::load(&file).map(|r| Arc::new(SkyMap::new(r)))
+                    })
+                    .map_err(|m| src.error(place("light", Some("image")), m))?;
+                match light {
+                    LightComponent::Light(l) => {
+                        b.add(l);
+                    }
+                    LightComponent::Environment(env) => {
+                        // One sky, and no background beside it: both say what escaped rays see.
+                        let at = place("light", None);
+                        if let Some(first) = &sky_at {
+                            return Err(src.error(
+                                at,
+                                format!(
+                                    "a second Environment light (the first at {first}): a scene \
+                                     has one sky; remove one"
+                                ),
+                            ));
+                        }
+                        if self.background.is_some() {
+                            return Err(src.error(
+                                at,
+                                "a scene with an Environment light has no `background`: the \
+                                 environment is what rays leaving the scene see; remove the \
+                                 `background` (or give the sky as `Environment(radiance: ...)`)"
+                                    .to_string(),
+                            ));
+                        }
+                        let (line, col) = line_col(&src.text, at);
+                        sky_at = Some(format!("{}:{line}:{col}", src.name));
+                        b.add(env);
+                    }
+                }
             }
             if let Some(emitter) = &e.emitter {
                 b.add(emitter.to_world());

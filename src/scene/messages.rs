@@ -97,6 +97,7 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
                 "Directional",
                 "Directional(direction: (0, -1, 0), irradiance: (3, 3, 3))",
             ),
+            ("Environment", "Environment(image: \"sky.exr\", scale: 1.0)"),
         ],
     ),
     (
@@ -175,8 +176,8 @@ fn field_form(name: &str) -> Option<&'static str> {
         }
         "light" => {
             "`Point(position: (0, 2, 0), intensity: (7, 7, 7))`, `Spot(position: (0, 2, 0), \
-             direction: (0, -1, 0), intensity: (7, 7, 7))` or `Directional(direction: (0, -1, \
-             0), irradiance: (3, 3, 3))`"
+             direction: (0, -1, 0), intensity: (7, 7, 7))`, `Directional(direction: (0, -1, \
+             0), irradiance: (3, 3, 3))` or `Environment(image: \"sky.exr\")`"
         }
         "transform" => "a transform `(scale: (1, 1, 1), rotate: (0, 0, 0), translate: (0, 0, 0))`",
         "effects" => "the effect switches `(shadows: false, ...)`",

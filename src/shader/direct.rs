@@ -21,8 +21,8 @@ pub fn radiance(tr: &mut Tracer, ray: &Ray, max_specular: u32, light_samples: u3
         ChainEnd::Bsdf { si, shading, beta } => {
             beta * direct_light(tr, &si, &shading, light_samples)
         }
-        // A ray that leaves the scene sees the background.
-        ChainEnd::Escaped { beta } => beta * tr.background,
+        // A ray that leaves the scene sees the background or the environment.
+        ChainEnd::Escaped { beta, sky } => beta * sky,
         ChainEnd::Absorbed => Vec3A::ZERO,
     }
 }

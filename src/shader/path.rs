@@ -3,9 +3,9 @@
 //! At each Phong vertex it adds the direct light of every point light (next-event estimation,
 //! Eq. 3 under the scene's model), then samples one direction and continues; mirrors and glass
 //! are followed exactly; Russian roulette ends paths after `rr_depth` bounces; escaped rays see
-//! the background.
+//! the background or the environment light.
 //!
-//! Area lights are gathered by the strategy `lights`: one light sample per Phong vertex
+//! Area lights and the environment light are gathered by the strategy `lights`: one light sample per Phong vertex
 //! (next-event estimation), the emitters that BRDF-sampled rays hit, or both weighted by the
 //! power heuristic (MIS). Under the Course model the indirect weights estimate a different
 //! integral from Eq. 3 (`r / (2 pi)^2`), so the two cannot be combined: area lights are then
@@ -97,9 +97,10 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     // after mirrors and glass).
     let mut scattered: Option<Scattered> = None;
     loop {
-        // Escaped rays see the background.
+        // Escaped rays see the background, or the environment light weighted against the
+        // light sample that could have found it.
         let Some(hit) = tr.trace(&ray, kind) else {
-            l += beta * tr.background;
+            l += beta * escaped(tr, &ray, scattered, lights);
             break;
         };
         let si = Interaction::new(tr, &ray, hit);
@@ -202,6 +203,30 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
         kind = next;
     }
     l
+}
+
+/// Radiance a ray that leaves the scene brings back: the background, or the environment's
+/// radiance `L_e` with the weight of the strategy that found it (as an emitter's): whole after
+/// the camera and mirrors and glass (no light sample finds those directions) and under `Brdf`;
+/// none under `Light`; the power heuristic under `Mis`, against the chance
+/// `P(env) pdf_env(wi)` that the light sample of the vertex it left picks its direction.
+fn escaped(tr: &Tracer, ray: &Ray, scattered: Option<Scattered>, lights: LightSampling) -> Vec3A {
+    let Some(env) = tr
+        .emitters
+        .environment
+        .as_ref()
+        .filter(|_| tr.effects.emission)
+    else {
+        return tr.background;
+    };
+    let w = match (scattered, lights) {
+        (None, _) | (Some(_), LightSampling::Brdf) => 1.0,
+        (Some(_), LightSampling::Light) => 0.0,
+        (Some(v), LightSampling::Mis) => {
+            power_heuristic(v.pdf, tr.emitters.pmf_environment() * env.pdf(ray.d))
+        }
+    };
+    env.radiance(ray.d) * w
 }
 
 /// Next-event estimation at a vertex whose surface reflects as `lobe`: Eq. 3 under the model

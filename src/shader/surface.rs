@@ -6,7 +6,10 @@
 use super::Tracer;
 use crate::effects::Effects;
 use crate::geometry::{Frame, Hit, Origins, Ray};
-use crate::light::{AreaLight, Chosen, Incident, Light, NO_LIGHT, choose_by_importance};
+use crate::light::{
+    AreaLight, Chosen, EnvironmentLight, Incident, Light, LightSample, NO_LIGHT,
+    choose_by_importance,
+};
 use crate::material::{Bsdf, Material, Model, Phong, reflect};
 use crate::sampling::{Sampling, hemisphere, power_heuristic};
 use crate::stats::RayKind;
@@ -171,6 +174,20 @@ pub fn emitted(tr: &Tracer, si: &Interaction) -> Vec3A {
     tr.emitters.lights[si.light as usize].emitted(si.hit.n, si.wo)
 }
 
+/// Radiance that a ray of unit direction `d` leaving the scene brings back: the background; or,
+/// in a scene with an environment light (whose background is black), the environment's
+/// radiance where `seen`. A ray that a light sample could have found instead (an indirect ray
+/// of the Direct and Global shaders, straight from the vertex whose light sample counted the
+/// environment) sees none of it, as it sees none of an emitter it hits.
+#[inline]
+pub fn sky(tr: &Tracer, d: Vec3A, seen: bool) -> Vec3A {
+    match &tr.emitters.environment {
+        Some(env) if tr.effects.emission && seen => env.radiance(d),
+        Some(_) if tr.effects.emission => Vec3A::ZERO,
+        _ => tr.background,
+    }
+}
+
 /// Eq. 3 with area lights: the point lights' sum ([`point_lights`]) plus the area lights'
 /// integral estimated with `light_samples` samples ([`area_lights`]).
 #[inline]
@@ -248,9 +265,9 @@ fn point_light_term<L: Lobe>(
 }
 
 /// The area lights' share of Eq. 3, `int L_e(wi) r(wi, wo) V(wi) dwi` over the directions that
-/// reach an emitter (`f cos` in place of `r` under the Physical model), estimated with `samples`
-/// light samples: each picks one light by power and a point on it, and weighs
-/// `L_e r V / (P(light) pdf(wi))`.
+/// reach an emitter or the environment (`f cos` in place of `r` under the Physical model),
+/// estimated with `samples` light samples: each picks one light by power and a point on it (a
+/// direction of the environment), and weighs `L_e r V / (P(light) pdf(wi))`.
 ///
 /// With `mis` (the BRDF sampling strategy of a path tracer), each sample is also weighted by the
 /// power heuristic against the density with which that strategy would pick `wi`; the path
@@ -271,16 +288,24 @@ pub fn area_lights<L: Lobe>(
         // Choose a light by power, then a point on it.
         let u = tr.sampler.next_f64();
         let (u1, u2) = tr.sampler.next_2d();
-        if let Some((light, pmf)) = tr.emitters.choose(u) {
-            sum += area_sample(tr, si, lobe, light, pmf, (u1, u2), mis);
+        match tr.emitters.choose_any(u) {
+            Some(Chosen::Area(light, pmf)) => {
+                sum += area_sample(tr, si, lobe, light, pmf, (u1, u2), mis);
+            }
+            Some(Chosen::Environment(env, pmf)) => {
+                sum += environment_sample(tr, si, lobe, env, pmf, mis);
+            }
+            // Point lights are summed apart when they take no part in the choice.
+            Some(Chosen::Point(..)) | None => {}
         }
     }
     sum / samples as f32
 }
 
-/// One light of all, point or area, chosen in proportion to its power and divided by the
-/// chance of choosing it (the path tracer's `lights_per_vertex: One`): one shadow ray. With
-/// `area` false a chosen area light adds nothing (BRDF-sampled rays gather area lights). With
+/// One light of all, point, area or environment, chosen in proportion to its power and divided
+/// by the chance of choosing it (the path tracer's `lights_per_vertex: One`): one shadow ray.
+/// With `area` false a chosen area or environment light adds nothing (BRDF-sampled rays gather
+/// them). With
 /// `by_importance` (`lights_per_vertex: Importance`) the point lights' share of the choice goes
 /// to each in proportion to its unshadowed contribution at the vertex instead.
 #[inline]
@@ -323,6 +348,9 @@ pub fn one_light<L: Lobe>(
         Some(Chosen::Area(light, pmf)) if area && tr.effects.emission => {
             area_sample(tr, si, lobe, light, pmf, (u1, u2), mis)
         }
+        Some(Chosen::Environment(env, pmf)) if area && tr.effects.emission => {
+            environment_sample(tr, si, lobe, env, pmf, mis)
+        }
         _ => Vec3A::ZERO,
     }
 }
@@ -343,6 +371,39 @@ fn area_sample<L: Lobe>(
     let Some(ls) = light.sample(si.hit.p, u1, u2) else {
         return Vec3A::ZERO;
     };
+    light_term(tr, si, lobe, &ls, pmf, mis)
+}
+
+/// One sample of the environment light `env`, chosen with probability `pmf`, from two more
+/// 53-bit random numbers (its map's cells can be finer than f32's grid), weighed as
+/// [`area_sample`]'s.
+#[inline]
+fn environment_sample<L: Lobe>(
+    tr: &mut Tracer,
+    si: &Interaction,
+    lobe: &L,
+    env: &EnvironmentLight,
+    pmf: f32,
+    mis: Option<Sampling>,
+) -> Vec3A {
+    let (v1, v2) = (tr.sampler.next_f64(), tr.sampler.next_f64());
+    let Some(ls) = env.sample(v1, v2) else {
+        return Vec3A::ZERO;
+    };
+    light_term(tr, si, lobe, &ls, pmf, mis)
+}
+
+/// A light sample's term, `L_e r V w / (pmf pdf)`: zero below a surface that does not transmit,
+/// without density, or shadowed.
+#[inline]
+fn light_term<L: Lobe>(
+    tr: &mut Tracer,
+    si: &Interaction,
+    lobe: &L,
+    ls: &LightSample,
+    pmf: f32,
+    mis: Option<Sampling>,
+) -> Vec3A {
     if ls.le == Vec3A::ZERO || (!lobe.transmits() && ls.wi.dot(si.n) <= 0.0) {
         return Vec3A::ZERO;
     }
@@ -460,10 +521,12 @@ pub enum ChainEnd<'a> {
         /// Throughput of the chain.
         beta: Vec3A,
     },
-    /// The chain left the scene with throughput `beta`: it sees the background.
+    /// The chain left the scene with throughput `beta`: it sees the sky ([`sky`]).
     Escaped {
         /// Throughput of the chain.
         beta: Vec3A,
+        /// The radiance it brings back from the sky.
+        sky: Vec3A,
     },
     /// The chain carries no light: an effect that is off, or longer than its cap.
     Absorbed,
@@ -476,7 +539,8 @@ pub enum ChainEnd<'a> {
 /// Also returns the light emitted towards the ray by the surfaces of the chain, weighted by the
 /// chain's throughput. The first surface's emission counts only when `see_first` (a camera ray;
 /// an indirect ray's emitter is the direct light of the vertex it left, already counted); after
-/// a mirror or glass every emitter counts, as no light sample reaches through them.
+/// a mirror or glass every emitter counts, as no light sample reaches through them. The
+/// environment light, where the chain escapes, counts by the same rule.
 #[inline]
 pub fn follow_specular<'a>(
     tr: &mut Tracer<'a>,
@@ -490,7 +554,9 @@ pub fn follow_specular<'a>(
     // `chain` counts the specular bounces that led to this ray.
     for chain in 0..=max_specular {
         let Some(hit) = tr.trace(&ray, kind) else {
-            return (ChainEnd::Escaped { beta }, le);
+            // The environment counts as an emitter does.
+            let sky = sky(tr, ray.d, see_first || chain > 0);
+            return (ChainEnd::Escaped { beta, sky }, le);
         };
         let si = Interaction::new(tr, &ray, hit);
         if see_first || chain > 0 {

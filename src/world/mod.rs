@@ -8,6 +8,7 @@
 //! - [`MaterialName`]: the `materials` table entry the material came from.
 //! - [`Transform`]: placement of the entity's shape.
 //! - [`WorldLight`]: a light source in scene units.
+//! - [`WorldEnvironment`]: the sky, an environment light (at most one in a world).
 //! - [`Emitter`]: makes the entity's shape an area light.
 //!
 //! Nothing here knows the file format or rays; the extraction step (`extract.rs`) turns a
@@ -16,7 +17,7 @@
 pub use crate::camera::{Projection, WorldCamera};
 pub use crate::effects::Switches;
 pub use crate::geometry::Transform;
-pub use crate::light::{Emitter, WorldLight};
+pub use crate::light::{Emitter, WorldEnvironment, WorldLight};
 pub use crate::material::{Material, Model};
 pub use crate::render::Film;
 pub use crate::shader::Shader;

@@ -9,6 +9,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("geometry", 0),
     ("sampling", 0),
     ("mesh", 0),
+    ("raster", 0),
     ("effects", 0),
     ("stats", 0),
     ("shape", 1),

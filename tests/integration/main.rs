@@ -17,6 +17,7 @@ mod cli_interrupt;
 mod converge;
 mod cpu_dispatch;
 mod effects;
+mod environment;
 mod estimate;
 mod global_waves;
 mod global_weights;

@@ -305,3 +305,32 @@ fn a_lens_sampler_crowding_the_centre_is_rejected() {
     );
     assert!(right.p_value > 1e-3, "p {}", right.p_value);
 }
+
+/// The environment sampler has power against a missing `sin(theta)`: on a constant map,
+/// drawing `(u, v)` uniformly (the cells' weights without their solid angle) crowds the poles
+/// and is rejected against the density the light claims; the light's own sampler passes.
+#[test]
+fn an_environment_sampler_missing_sin_theta_is_rejected() {
+    let light = warptest::environment(warptest::grey_map(16, 8, |_, _| 1.0));
+    let claimed = warptest::environment_case("claimed", light.clone()).expected;
+    // (u, v) uniform, mapped to directions as the light maps them (its zenith on +z).
+    let wrong = Case {
+        name: "uniform in (u, v)".into(),
+        draw: Box::new(|s: &mut rtis::sampling::Sampler| {
+            let (u, v) = s.next_2d();
+            let (theta, phi) = (v * std::f32::consts::PI, u * std::f32::consts::TAU);
+            let w = glam::Vec3A::new(
+                phi.sin() * theta.sin(),
+                phi.cos() * theta.sin(),
+                theta.cos(),
+            );
+            Some(direction_bin(w))
+        }),
+        expected: claimed,
+        columns: warptest::BINS_PHI,
+    };
+    let o = warptest::run(&wrong, 200_000, 5);
+    assert!(o.p_value < 1e-6, "p {}", o.p_value);
+    let right = warptest::run(&warptest::environment_case("map", light), 200_000, 5);
+    assert!(right.p_value > 1e-3, "p {}", right.p_value);
+}

@@ -62,7 +62,7 @@ pub fn radiance(tr: &mut Tracer, ray: &Ray, g: &Global) -> Vec3A {
     let (end, le) = follow_specular(tr, ray, RayKind::Camera, g.max_specular, true);
     le + match end {
         ChainEnd::Phong { si, phong, beta } => beta * first_hit(tr, g, &si, &phong),
-        ChainEnd::Escaped { beta } => beta * tr.background,
+        ChainEnd::Escaped { beta, sky } => beta * sky,
         // Eq. 1-4 are Phong's: a BSDF surface is black, as in the waves (scene files with
         // one are refused with Global; see `docs/transport.md`).
         ChainEnd::Bsdf { .. } | ChainEnd::Absorbed => Vec3A::ZERO,
@@ -193,8 +193,8 @@ fn incident(tr: &mut Tracer, g: &Global, ray: Ray, stack: &mut Vec<Pending>) -> 
         l += beta * le;
         let (si, phong, beta) = match end {
             ChainEnd::Phong { si, phong, beta: b } => (si, phong, beta * b),
-            ChainEnd::Escaped { beta: b } => {
-                l += beta * b * tr.background;
+            ChainEnd::Escaped { beta: b, sky } => {
+                l += beta * b * sky;
                 continue;
             }
             ChainEnd::Bsdf { .. } | ChainEnd::Absorbed => continue,
