@@ -28,6 +28,9 @@ that this script rewrites from a run of `rtis render --stats`, `rtis bench --jso
                waves (COMPARE_BASE), both binaries rendering side by side (builds that commit)
     lens       docs/images/cornell-lens.png: scenes/cornell-lens.ron (thin lens, spot light) at
                its 720 px and 64 spp, with the render's time
+    sky        docs/images/outdoor.png: scenes/outdoor.ron (an environment map with a sun) at its
+               640 px and 64 spp, and `rtis converge scenes/outdoor.ron`: the sky sampled by
+               importance, by the materials (cosine on the ground) and by both with MIS
     build      bench/build_times.py: a newcomer's two first builds (render, then tests) of this
                commit against BUILD_BASE (one test binary per file), each from nothing (about
                12 minutes; run it with nothing else compiling)
@@ -54,7 +57,7 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 README = os.path.join(ROOT, "README.md")
 RTIS = os.path.join(ROOT, "target", "release", "rtis")
-BLOCKS = ["build", "hero", "cornell", "commits", "effects", "meshes", "converge", "area", "materials", "lens", "obvhs", "embree",
+BLOCKS = ["build", "hero", "cornell", "commits", "effects", "meshes", "converge", "area", "materials", "lens", "sky", "obvhs", "embree",
           "mitsuba"]
 # The commit the `commits` block compares with: the last before the Global shader's waves.
 COMPARE_BASE = "e3269bf"
@@ -196,6 +199,35 @@ def lens(_runs):
         f"{s['seconds']:.1f} s on {s['threads']} threads.*",
         "",
         stamp("`rtis render --stats`"),
+    ])
+
+
+def sky(_runs):
+    s = render_stats("scenes/outdoor.ron", "docs/images/outdoor.png")
+    w, h, _ = film("scenes/outdoor.ron")
+    with tempfile.TemporaryDirectory() as d:
+        run(["converge", "scenes/outdoor.ron", "--out", d, "--runs", "1", "--seeds", "2"], stderr=subprocess.DEVNULL)
+        shutil.copyfile(os.path.join(d, "converge.png"), os.path.join(ROOT, "docs", "images", "converge-outdoor.png"))
+        with open(os.path.join(d, "converge.md")) as f:
+            table = [l for l in f.read().splitlines()
+                     if l.startswith("| family") or l.startswith("|---") or l.startswith("| Path MIS")
+                     or l.startswith("| Path light") or l.startswith("| Path BRDF")]
+    return "\n".join([
+        "![Five balls on a floor under a generated sky with a sun](docs/images/outdoor.png)",
+        "",
+        f"*`scenes/outdoor.ron`: `Environment(image: \"assets/sky.exr\")`, a 128x64 map whose sun is 2000 "
+        f"times its zenith; `Path`, {w}x{h} at {s['spp']} spp: {s['total_rays'] / 1e6:.0f} M rays in "
+        f"{s['seconds']:.1f} s on {s['threads']} threads.*",
+        "",
+        "![Error against time: the sky sampled by importance, by the materials, and both](docs/images/converge-outdoor.png)",
+        "",
+        "*`rtis converge scenes/outdoor.ron` (180 px, 2 seeds): the sky sampled by importance only "
+        "(`Path light`), by the materials only (`Path BRDF`: cosine on the diffuse ground), and both "
+        "weighted by MIS (`Path MIS`, the default).*",
+        "",
+        *table,
+        "",
+        stamp("`rtis render --stats` and `rtis converge scenes/outdoor.ron --runs 1 --seeds 2`"),
     ])
 
 
@@ -436,7 +468,7 @@ def main():
     makers = {"build": build, "hero": hero, "cornell": cornell, "commits": commits, "effects": effects, "meshes": meshes,
               "converge": converge,
               "obvhs": obvhs,
-              "area": area, "materials": materials, "lens": lens, "embree": embree, "mitsuba": mitsuba}
+              "area": area, "materials": materials, "lens": lens, "sky": sky, "embree": embree, "mitsuba": mitsuba}
     for name in a.only.split(","):
         if name not in makers:
             print(f"unknown block {name}: use {', '.join(BLOCKS)}", file=sys.stderr)

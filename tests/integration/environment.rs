@@ -302,7 +302,10 @@ fn a_sky_matches_mitsuba() {
     let (mse, explained) =
         crate::common::block_mse(&a.image, &b.image, &r, 0.005355, &|_, _| false);
     eprintln!("sky: block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}");
-    assert!(mse < 1.5 * explained, "block MSE {mse:.3e} vs {explained:.3e}");
+    assert!(
+        mse < 1.5 * explained,
+        "block MSE {mse:.3e} vs {explained:.3e}"
+    );
     let mean = Vec3A::new(0.334792, 0.374639, 0.493499);
     let m = (a.image.mean() + b.image.mean()) * 0.5;
     assert!(

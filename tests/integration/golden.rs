@@ -205,6 +205,7 @@ golden_tests! {
     materials_beckmann => "materials-beckmann.ron",
     mesh => "mesh.ron",
     mis => "mis.ron",
+    outdoor => "outdoor.ron",
     mitsuba_cornell => "mitsuba-cornell.ron",
     spheres => "spheres.ron",
     triangles => "triangles.ron",

@@ -240,3 +240,44 @@ fn one_light_per_vertex_covers_every_kind() {
         );
     }
 }
+
+/// A sun grazing a floor stays finite and exact: at `cos(theta)` of 1e-2, 1e-4 and 1e-7 (and
+/// exactly along the floor, 0) a Lambertian floor under Direct reflects `(kd / pi) E cos`, with
+/// no sample dropped; a rough plastic floor under Path stays finite and non-negative.
+#[test]
+fn a_sun_grazing_a_floor_is_finite() {
+    for cos in [1e-2f64, 1e-4, 1e-7, 0.0] {
+        let sin = (1.0 - cos * cos).sqrt();
+        let floor = |material: &str, shader: &str| {
+            format!(
+                "Scene(film: (width: 8, height: 8, spp: 4), shader: {shader}, model: Physical,
+                       camera: Orthographic(position: (0, 5, 0), look_at: (0, 0, 0),
+                                            up: (0, 0, 1), height: 2),
+                       entities: [(shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+                                   material: {material}),
+                                  (light: Directional(direction: ({sin}, {}, 0),
+                                                      irradiance: (3, 3, 3)))])",
+                -cos
+            )
+        };
+        let r = render_str(&floor(
+            "Phong(kd: (0.5, 0.5, 0.5), ks: (0, 0, 0))",
+            "Direct()",
+        ));
+        let want = 0.5 / std::f64::consts::PI * 3.0 * cos;
+        for p in &r.image.pixels {
+            assert!(
+                (p.x as f64 - want).abs() <= 1e-3 * want + 1e-12,
+                "cos {cos}: {} against {want}",
+                p.x
+            );
+        }
+        let r = render_str(&floor(
+            "RoughPlastic(alpha: 0.05, diffuse_reflectance: (0.5, 0.5, 0.5))",
+            "Path(max_depth: 3)",
+        ));
+        for p in &r.image.pixels {
+            assert!(p.x.is_finite() && p.x >= 0.0, "cos {cos}: {}", p.x);
+        }
+    }
+}
