@@ -328,7 +328,7 @@ mod random_scenes {
 
     prop_compose! {
         /// A random scene: a room of five planes (or none), shapes inside (some emitting), point
-        /// lights,
+        /// lights, a background or an environment light (constant, or a map up to 1e6 bright),
         /// a perspective or orthographic camera, any shader and model, at scale `s` from 1e-4
         /// to 1e4 and offset up to 1e6.
         fn random_scene()(
@@ -354,6 +354,7 @@ mod random_scenes {
             shader in shader(s),
             physical in any::<bool>(),
             background in prop_oneof![Just(0.0), Just(1.0), Just(1e6)],
+            sky in 0u8..4,
             spp in 1u32..3,
             seed in any::<u64>(),
         ) -> String {
@@ -407,7 +408,18 @@ mod random_scenes {
                     at(s, t, DVec3::new(0.1, 0.2, 1.0))
                 )
             };
-            let b = num(background);
+            // A sky in place of the background: none, a constant one, or the generated map at
+            // its own scale or 1e6 times it.
+            let map = crate::common::scenes_dir().join("assets/sky.exr");
+            let (sky, background) = match sky {
+                0 => (String::new(), format!("background: ({b}, {b}, {b}), ", b = num(background))),
+                1 => (format!("(light: Environment(radiance: ({b}, {b}, {b}))),", b = num(background)), String::new()),
+                k => (
+                    format!("(light: Environment(image: {map:?}, scale: {}, rotate: (10, 70, 0))),",
+                            if k == 2 { "1" } else { "1e6" }),
+                    String::new(),
+                ),
+            };
             // Rough materials and plastics render under the Physical model, in Direct and
             // Path: a scene with one gets those.
             let bsdf = things.contains("Rough") || things.contains("Plastic(");
@@ -415,8 +427,8 @@ mod random_scenes {
             let shader = if bsdf && shader.starts_with("Global") { "Path()".to_string() } else { shader };
             format!(
                 "Scene(film: (width: 9, height: 7, spp: {spp}), seed: {seed}, camera: {camera}, \
-                 shader: {shader}, model: {}, background: ({b}, {b}, {b}), \
-                 entities: [{walls} {things} {lamps}])",
+                 shader: {shader}, model: {}, {background}\
+                 entities: [{walls} {things} {lamps} {sky}])",
                 if physical { "Physical" } else { "Course" }
             )
         }
