@@ -3,13 +3,18 @@
 //! OpenEXR files hold linear values and are read as they are. PNG files (8 or 16 bits, grey or
 //! colour, with or without alpha) hold sRGB-encoded values and are decoded with the sRGB
 //! transfer function (IEC 61966-2-1), as Mitsuba 3 and pbrt-v4 decode them. Alpha is ignored.
-//! A raster holds 12 bytes per texel (three `f32`).
+//! A raster holds 12 bytes per texel (three `f32`); reading one needs about twice that at its
+//! peak, plus the file's own decoded form.
+//!
+//! A side may be at most [`MAX_SIDE`] texels and an image at most [`MAX_TEXELS`] texels; a larger
+//! one is refused before it is decoded, saying how much memory it would need.
 
 use std::path::Path;
 
-/// Largest number of texels a raster may have (2^28, 3 GiB as 12-byte texels): a larger image
-/// is refused before it is decoded.
+/// Largest number of texels a raster may have (2^28, 3 GiB as 12-byte texels).
 pub const MAX_TEXELS: u64 = 1 << 28;
+/// Largest width or height (2^16: texel coordinates stay exact in `f32` arithmetic).
+pub const MAX_SIDE: u32 = 1 << 16;
 
 /// A rectangle of linear RGB texels, row by row from the top.
 #[derive(Clone, Debug, PartialEq)]
@@ -83,10 +88,10 @@ pub fn load(path: &Path) -> Result<Raster, String> {
         .into_dimensions()
         .map_err(|e| format!("cannot read image {}: {e}", path.display()))?;
     let texels = w as u64 * h as u64;
-    if texels > MAX_TEXELS {
+    if texels > MAX_TEXELS || w > MAX_SIDE || h > MAX_SIDE {
         return Err(format!(
-            "image {} is {w}x{h}: as linear RGB it needs {} MiB, more than the limit of {} MiB \
-             ({MAX_TEXELS} texels)",
+            "image {} is {w}x{h}: as linear RGB it needs {} MiB; the limit is {} MiB \
+             ({MAX_TEXELS} texels) and {MAX_SIDE} texels a side",
             path.display(),
             (texels * 12) >> 20,
             (MAX_TEXELS * 12) >> 20
@@ -105,10 +110,11 @@ pub fn load(path: &Path) -> Result<Raster, String> {
         image,
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
     );
-    let rgb = image.to_rgb32f();
+    // The decoded image is dropped once converted (unless it was already linear RGB).
+    let rgb = image.into_rgb32f().into_raw();
     let decode = |c: f32| if linear { c } else { srgb_to_linear(c) };
     let texels = rgb
-        .pixels()
+        .chunks_exact(3)
         .map(|p| [decode(p[0]), decode(p[1]), decode(p[2])])
         .collect();
     Raster::new(w as usize, h as usize, texels)

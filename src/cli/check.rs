@@ -336,10 +336,9 @@ pub fn to_ron(scene: &Scene) -> String {
             None => {}
         }
         if let Some(env) = env {
-            let sky = match (&env.sky, &env.image) {
-                (Sky::Uniform(l), _) => format!("radiance: {}", rgb(*l)),
-                (Sky::Map(_), Some(path)) => format!("image: {path:?}"),
-                (Sky::Map(m), None) => format!("image: {m:?}"),
+            let sky = match &env.sky {
+                Sky::Uniform(l) => format!("radiance: {}", rgb(*l)),
+                Sky::Map { source, .. } => format!("image: {:?}", source.display().to_string()),
             };
             fields.push(format!(
                 "light: Environment({sky}, scale: {}, rotate: {})",

@@ -441,7 +441,6 @@ fn light_case(name: &str, lights: Vec<AreaLight>) -> Case {
 pub fn environment(sky: Sky) -> EnvironmentLight {
     WorldEnvironment {
         sky,
-        image: None,
         scale: 1.0,
         rotate: DVec3::new(90.0, 0.0, 0.0),
     }
@@ -455,7 +454,10 @@ pub fn grey_map(w: usize, h: usize, f: impl Fn(usize, usize) -> f32) -> Sky {
         .map(|(x, y)| [f(x, y); 3])
         .collect();
     let raster = Raster::new(w, h, texels).expect("a map of w x h texels");
-    Sky::Map(Arc::new(SkyMap::new(raster)))
+    Sky::Map {
+        map: Arc::new(SkyMap::new(raster)),
+        source: "(made by rtis warptest)".into(),
+    }
 }
 
 /// The environment light's sampler (two 53-bit numbers), against the density it claims.

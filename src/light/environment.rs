@@ -12,6 +12,7 @@ use super::{LightSample, SkyMap};
 use crate::sampling::warp::uniform_sphere;
 use glam::{DMat3, DVec3, Mat3A, Vec3A};
 use std::f32::consts::{PI, TAU};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 /// What the sky looks like.
@@ -20,7 +21,13 @@ pub enum Sky {
     /// The same radiance from every direction, W/(m^2 sr) per channel.
     Uniform(Vec3A),
     /// A latitude-longitude image of radiance (shared by every render of the scene).
-    Map(Arc<SkyMap>),
+    Map {
+        /// The image and its sampling distribution.
+        map: Arc<SkyMap>,
+        /// The file it was read from (for messages and `rtis check`), or a label for a map
+        /// made in code.
+        source: PathBuf,
+    },
 }
 
 /// The environment light as the world holds it.
@@ -28,8 +35,6 @@ pub enum Sky {
 pub struct WorldEnvironment {
     /// Its radiance before `scale`.
     pub sky: Sky,
-    /// The image's path as the scene file gives it, for messages and `rtis check`.
-    pub image: Option<String>,
     /// A factor on the radiance, `>= 0`.
     pub scale: f32,
     /// Rotation of the map's frame in degrees about x, then y, then z (as a shape's
@@ -88,7 +93,7 @@ impl EnvironmentLight {
     pub fn radiance(&self, d: Vec3A) -> Vec3A {
         match &self.sky {
             Sky::Uniform(l) => *l * self.scale,
-            Sky::Map(m) => {
+            Sky::Map { map: m, .. } => {
                 let (u, v, _) = uv_of(self.to_local * d);
                 m.eval(u, v) * self.scale
             }
@@ -102,7 +107,7 @@ impl EnvironmentLight {
     pub fn sample(&self, u1: f64, u2: f64) -> Option<LightSample> {
         let (wi, le, pdf) = match &self.sky {
             Sky::Uniform(l) => (uniform_sphere(u1 as f32, u2 as f32), *l, 1.0 / (4.0 * PI)),
-            Sky::Map(m) => {
+            Sky::Map { map: m, .. } => {
                 let ((u, v), pdf_uv) = m.sample(u1, u2)?;
                 let (sin_t, cos_t) = (v * PI).sin_cos();
                 let (sin_p, cos_p) = (u * TAU).sin_cos();
@@ -129,7 +134,7 @@ impl EnvironmentLight {
     pub fn pdf(&self, w: Vec3A) -> f32 {
         match &self.sky {
             Sky::Uniform(_) => 1.0 / (4.0 * PI),
-            Sky::Map(m) => {
+            Sky::Map { map: m, .. } => {
                 let (u, v, sin_t) = uv_of(self.to_local * w);
                 if sin_t <= 0.0 {
                     return 0.0;
@@ -144,7 +149,7 @@ impl EnvironmentLight {
         self.scale
             * match &self.sky {
                 Sky::Uniform(l) => 4.0 * PI * *l,
-                Sky::Map(m) => m.integral(),
+                Sky::Map { map, .. } => map.integral(),
             }
     }
 
@@ -182,8 +187,10 @@ mod tests {
         let texels = (0..32).map(|i| [i as f32, 1.0, (i % 5) as f32]).collect();
         let map = SkyMap::new(Raster::new(8, 4, texels).unwrap());
         let light = WorldEnvironment {
-            sky: Sky::Map(Arc::new(map)),
-            image: None,
+            sky: Sky::Map {
+                map: Arc::new(map),
+                source: "test".into(),
+            },
             scale: 2.0,
             rotate: DVec3::new(10.0, 70.0, -20.0),
         }

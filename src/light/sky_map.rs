@@ -37,7 +37,7 @@ pub struct SkyMap {
     cell_rows: usize,
     /// The cells' distribution (`width x cell_rows`).
     distribution: Distribution2D,
-    /// `int L dw` over the sphere, per channel, of the interpolated image.
+    /// `int L dw` over the sphere, per channel ([`SkyMap::integral`]).
     integral: Vec3A,
     /// A hash of the texels, for telling renders apart ([`std::fmt::Debug`]).
     hash: u64,
@@ -106,9 +106,19 @@ impl SkyMap {
         &self.raster
     }
 
-    /// `int L dw` over the sphere, per channel.
+    /// `int L dw` over the sphere, per channel (the cells' means over their solid angles: the
+    /// bilinear image's integral, within the variation of `sin(theta)` across a row).
     pub fn integral(&self) -> Vec3A {
         self.integral
+    }
+
+    /// The largest channel of any texel.
+    pub fn max_radiance(&self) -> f64 {
+        self.raster
+            .texels
+            .iter()
+            .flatten()
+            .fold(0.0f32, |m, &c| m.max(c)) as f64
     }
 
     /// The radiance at `(u, v)`, bilinear between texels, `u` wrapping and `v` clamped.

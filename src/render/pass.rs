@@ -51,11 +51,10 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
     }
     let _ = write!(
         h,
-        "|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}",
+        "|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}",
         scene.geometry.normals,
         scene.materials,
         scene.lights,
-        scene.emitters.environment,
         scene.background,
         scene.shader,
         scene.model,
@@ -63,6 +62,11 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
         f.width,
         f.height,
     );
+    // Only a scene with an environment hashes it, so that earlier passes of other scenes still
+    // merge.
+    if let Some(env) = &scene.emitters.environment {
+        let _ = write!(h, "|{env:?}");
+    }
     h.0
 }
 

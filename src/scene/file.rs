@@ -12,7 +12,7 @@ use super::values::{
 use crate::camera::{Projection, WorldCamera, WorldLens};
 use crate::effects::Switches;
 use crate::geometry::Transform;
-use crate::light::{Emitter, Sky, SkyMap, WorldEnvironment, WorldLight};
+use crate::light::{Emitter, Sky, WorldEnvironment, WorldLight};
 use crate::material::conductor::{Conductor, Metal};
 use crate::material::microfacet::Microfacet;
 use crate::material::plastic::Plastic;
@@ -984,6 +984,10 @@ pub enum LightDesc {
     },
 }
 
+/// Why an environment without an image or a radiance cannot be.
+const ENVIRONMENT_NEEDS: &str = "an Environment needs an `image: \"sky.exr\"` (a \
+                                 latitude-longitude map) or a constant `radiance: (r, g, b)`";
+
 fn unit_scale_factor() -> NonNegative {
     NonNegative(1.0)
 }
@@ -1019,12 +1023,7 @@ impl LightDesc {
                 image: None,
                 radiance: None,
                 ..
-            } => Some((
-                "",
-                "an Environment needs an `image: \"sky.exr\"` (a latitude-longitude map) or a \
-                 constant `radiance: (r, g, b)`"
-                    .into(),
-            )),
+            } => Some(("", ENVIRONMENT_NEEDS.into())),
             LightDesc::Spot {
                 cutoff_angle,
                 beam_width: Some(beam),
@@ -1041,12 +1040,12 @@ impl LightDesc {
         }
     }
 
-    /// The world's light; `load` reads an environment's image (its path as written), and its
-    /// message is the error's. An environment with neither an image nor a radiance (refused by
-    /// [`LightDesc::invalid`]) would be black.
+    /// The world's light; `load` reads an environment's image (its path as written) into its
+    /// sky, and its message is the error's, as is an environment with neither an image nor a
+    /// radiance ([`LightDesc::invalid`]).
     pub fn to_world(
         &self,
-        load: impl FnOnce(&str) -> Result<Arc<SkyMap>, String>,
+        load: impl FnOnce(&str) -> Result<Sky, String>,
     ) -> Result<LightComponent, String> {
         let light = |l| Ok(LightComponent::Light(l));
         match self {
@@ -1084,13 +1083,12 @@ impl LightDesc {
                 rotate,
             } => {
                 let sky = match (image, radiance) {
-                    (Some(path), _) => Sky::Map(load(path)?),
+                    (Some(path), _) => load(path)?,
                     (None, Some(l)) => Sky::Uniform(l.0.as_vec3a()),
-                    (None, None) => Sky::Uniform(glam::Vec3A::ZERO),
+                    (None, None) => return Err(ENVIRONMENT_NEEDS.into()),
                 };
                 Ok(LightComponent::Environment(WorldEnvironment {
                     sky,
-                    image: image.clone(),
                     scale: scale.0 as f32,
                     rotate: rotate.0,
                 }))

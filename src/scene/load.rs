@@ -9,8 +9,8 @@ use super::file::{
 };
 use super::messages::{explain, offset_of};
 use super::spans::{self, Node};
-use super::values::Rgb;
-use crate::light::SkyMap;
+use super::values::{MAX_RADIANCE, Rgb};
+use crate::light::{Sky, SkyMap};
 use crate::material::Material;
 use crate::world::{MaterialName, Name, Scene, Settings, Shader};
 use ron::extensions::Extensions;
@@ -377,9 +377,15 @@ impl Resolved {
         );
         let ambient = matches!(settings.shader, Shader::Global(g) if g.ambient != glam::Vec3A::ZERO)
             && on(fx.ambient);
-        let lit = self.entities.iter().any(|(EntityDesc(e), ..)| {
-            e.light.is_some() || (e.emitter.is_some() && on(fx.emission))
-        });
+        // An environment light is part of the `emission` effect.
+        let lit = self
+            .entities
+            .iter()
+            .any(|(EntityDesc(e), ..)| match &e.light {
+                Some(LightDesc::Environment { scale, .. }) => on(fx.emission) && scale.0 > 0.0,
+                Some(_) => true,
+                None => e.emitter.is_some() && on(fx.emission),
+            });
         if let Some((_, idx, i)) = self
             .entities
             .iter()
@@ -477,7 +483,11 @@ impl Resolved {
                     .to_world(|path| {
                         let file = src.dir.clone().unwrap_or_default().join(path);
                         files.push(file.clone());
-                        crate::raster::load(&file).map(|r| Arc::new(SkyMap::new(r)))
+                        // The absolute path, so that `rtis check` prints a scene that reads
+                        // back from anywhere.
+                        let source = std::path::absolute(&file).unwrap_or(file.clone());
+                        let map = Arc::new(SkyMap::new(crate::raster::load(&file)?));
+                        Ok(Sky::Map { map, source })
                     })
                     .map_err(|m| src.error(place("light", Some("image")), m))?;
                 match light {
@@ -496,13 +506,30 @@ impl Resolved {
                                 ),
                             ));
                         }
-                        if self.background.is_some() {
+                        if settings.background != glam::Vec3A::ZERO {
                             return Err(src.error(
                                 at,
-                                "a scene with an Environment light has no `background`: the \
-                                 environment is what rays leaving the scene see; remove the \
-                                 `background` (or give the sky as `Environment(radiance: ...)`)"
-                                    .to_string(),
+                                format!(
+                                    "a scene with an Environment light has a background of \
+                                     {:?} (here or in a base scene): the environment is what \
+                                     rays leaving the scene see; remove the `background` or make \
+                                     it black (a constant sky is `Environment(radiance: ...)`)",
+                                    settings.background.to_array()
+                                ),
+                            ));
+                        }
+                        // Radiance within the range of every other input.
+                        let peak = match &env.sky {
+                            Sky::Uniform(l) => l.max_element() as f64,
+                            Sky::Map { map, .. } => map.max_radiance(),
+                        } * env.scale as f64;
+                        if peak > MAX_RADIANCE {
+                            return Err(src.error(
+                                place("light", Some("scale")),
+                                format!(
+                                    "this sky's brightest radiance times its scale is {peak:e}, \
+                                     above the limit of 1e30: lower the scale"
+                                ),
                             ));
                         }
                         let (line, col) = line_col(&src.text, at);

@@ -5,8 +5,9 @@
 //! texel 10^6 times brighter than the rest, an all-black map and a 1x1 map; and located errors.
 
 use crate::common::{mean_and_se, render_scene, render_str, scene};
+use glam::DVec3;
 use glam::Vec3A;
-use rtis::light::SkyMap;
+use rtis::light::{Sky, SkyMap, WorldEnvironment};
 use rtis::raster::Raster;
 use rtis::render::film::Image;
 use rtis::render::output::{Transfer, save};
@@ -90,9 +91,8 @@ fn a_floor_under_a_constant_sky_reflects_kd_l() {
 }
 
 /// A white furnace: a Lambertian sphere of albedo 1 in a constant sky of radiance `L`
-/// reflects `L` everywhere, so the whole image is `L`, sphere and sky alike; a rough metal of
-/// reflectance 1 (energy lost only to its single-scattering microfacets) is darker, never
-/// brighter.
+/// reflects `L` everywhere, so the whole image is `L`, sphere and sky alike, under every
+/// strategy.
 #[test]
 fn a_white_furnace_disappears() {
     for lights in ["Mis", "Light", "Brdf"] {
@@ -131,6 +131,37 @@ fn irradiance_up(map: &SkyMap) -> f64 {
     e
 }
 
+/// [`irradiance_up`] for the map turned by `rotate` (degrees about x, then y, then z): the
+/// light's radiance over the world's upper hemisphere, on a fine midpoint grid in
+/// `(theta, phi)` about the world's `+y`.
+fn irradiance_up_rotated(map: &SkyMap, rotate: DVec3) -> f64 {
+    let light = WorldEnvironment {
+        sky: Sky::Map {
+            map: std::sync::Arc::new(map.clone()),
+            source: "test".into(),
+        },
+        scale: 1.0,
+        rotate,
+    }
+    .extract(1.0);
+    let (nt, np) = (768, 1536);
+    let (dt, dp) = (0.5 * PI / nt as f64, 2.0 * PI / np as f64);
+    let mut e = 0.0;
+    for j in 0..nt {
+        let theta = (j as f64 + 0.5) * dt;
+        for i in 0..np {
+            let phi = (i as f64 + 0.5) * dp;
+            let w = Vec3A::new(
+                (theta.sin() * phi.cos()) as f32,
+                theta.cos() as f32,
+                (theta.sin() * phi.sin()) as f32,
+            );
+            e += light.radiance(w).x as f64 * theta.cos() * theta.sin() * dt * dp;
+        }
+    }
+    e
+}
+
 /// A map with a small bright sun over a blue-ish gradient: a floor under it has radiance
 /// `(kd / pi) E`, `E` the map's irradiance, for every strategy (importance sampling, BSDF
 /// sampling and their MIS all estimate the same integral), whatever the sky's rotation about
@@ -143,10 +174,26 @@ fn a_floor_under_a_map_matches_its_irradiance() {
         let s = if sun(x, y) { 200.0 } else { 0.0 };
         Vec3A::new(0.2 + s, 0.4 + s, 0.6 + 0.01 * x as f32 + s) * (1.0 - y as f32 / h as f32)
     });
-    let want = 0.5 / PI * irradiance_up(&map);
-    for shader in STRATEGIES {
-        for rotate in ["(0, 0, 0)", "(0, 75, 0)"] {
-            let light = format!("Environment(image: {path:?}, rotate: {rotate})");
+    let unturned = 0.5 / PI * irradiance_up(&map);
+    for rotate in [DVec3::ZERO, DVec3::new(30.0, 75.0, -20.0)] {
+        let want = 0.5 / PI * irradiance_up_rotated(&map, rotate);
+        if rotate == DVec3::ZERO {
+            assert!(
+                (want / unturned - 1.0).abs() < 1e-3,
+                "{want} against {unturned}"
+            );
+        } else {
+            // Tilted, the sun and the sky's gradient light the floor differently.
+            assert!(
+                (want / unturned - 1.0).abs() > 0.05,
+                "{want} against {unturned}"
+            );
+        }
+        for shader in STRATEGIES {
+            let light = format!(
+                "Environment(image: {path:?}, rotate: ({}, {}, {}))",
+                rotate.x, rotate.y, rotate.z
+            );
             assert_mean(&floor_under(&light, shader, 64), want, shader);
         }
     }
@@ -172,6 +219,10 @@ fn camera_rays_see_the_map_in_mitsubas_orientation() {
     assert_eq!(look("(0, 0, 1)", "(0, 1, 0)"), Vec3A::new(3.5, 2.0, 1.0));
     // u = 1/4: between columns 1 and 2.
     assert_eq!(look("(1, 0, 0)", "(0, 1, 0)"), Vec3A::new(1.5, 2.0, 1.0));
+    // Off the axes, which tells the map from its mirror image: u = 3/8, column 2.5 (mirrored,
+    // 0.5).
+    let x = look("(1, 0, 1)", "(0, 1, 0)").x;
+    assert!((x - 2.5).abs() < 1e-4, "{x}");
     // u = 0: between the last column and the first.
     assert_eq!(look("(0, 0, -1)", "(0, 1, 0)"), Vec3A::new(3.5, 2.0, 1.0));
     assert_eq!(look("(0, 1, 0)", "(0, 0, 1)").y, 0.0);
@@ -266,7 +317,14 @@ fn environment_errors_are_located() {
         "Environment(radiance: (1, 1, 1))",
         "background: (0.1, 0.1, 0.1), ",
     );
-    assert!(e.contains("no `background`"), "{e}");
+    assert!(e.contains("has a background of"), "{e}");
+    // A black one (as cornell.ron writes) is the same as none.
+    let text =
+        "Scene(background: (0, 0, 0), entities: [(light: Environment(radiance: (1, 1, 1)))])";
+    assert!(rtis::scene::load_str(text, "t.ron", None).is_ok());
+    // Radiance times scale beyond 1e30.
+    let e = err("Environment(radiance: (1e25, 1, 1), scale: 1e6)", "");
+    assert!(e.contains("above the limit of 1e30"), "{e}");
     let text = "Scene(entities: [(light: Environment(radiance: (1, 1, 1))),
                                  (light: Environment(radiance: (2, 2, 2)))])";
     let e = rtis::scene::load_str(text, "t.ron", None)
@@ -312,4 +370,37 @@ fn a_sky_matches_mitsuba() {
         ((m - mean) / mean).abs().max_element() < 0.01,
         "mean {m} vs {mean}"
     );
+}
+
+/// The environment shares the choice of one light with the others: a floor point lit by a
+/// point light, a sun and a constant sky `L` (its whole upper hemisphere) has radiance
+/// `(kd / pi)(I cos / d^2 + E cos) + kd L`, under every light choice (all, one by power, one by
+/// importance) with MIS and with light sampling alone, within 5 standard errors.
+#[test]
+fn the_sky_shares_the_light_choice() {
+    let (kd, l) = (0.5f64, 0.3f64);
+    let (p, i_p) = ([-0.5f64, 2.0, -0.5], 3.0f64);
+    let (sun, e) = ([0.3f64, -1.0, 0.2], 1.5f64);
+    let d2 = p.iter().map(|c| c * c).sum::<f64>();
+    let sun_cos = -sun[1] / sun.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let want = kd / PI * (i_p * (p[1] / d2.sqrt()) / d2 + e * sun_cos) + kd * l;
+    for per_vertex in ["All", "One", "Importance"] {
+        for lights in ["Mis", "Light"] {
+            let text = format!(
+                "Scene(film: (width: 32, height: 32, spp: 16),
+                   camera: Perspective(position: (3, 1, -0.5), look_at: (0, 0, 0), fov: 0.001),
+                   model: Physical,
+                   shader: Path(max_depth: 1, lights: {lights}, lights_per_vertex: {per_vertex}),
+                   entities: [
+                     (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+                      material: Phong(kd: ({kd}, {kd}, {kd}), ks: (0, 0, 0))),
+                     (light: Point(position: ({}, {}, {}), intensity: ({i_p}, {i_p}, {i_p}))),
+                     (light: Directional(direction: ({}, {}, {}), irradiance: ({e}, {e}, {e}))),
+                     (light: Environment(radiance: ({l}, {l}, {l}))),
+                   ])",
+                p[0], p[1], p[2], sun[0], sun[1], sun[2]
+            );
+            assert_mean(&text, want, &format!("{per_vertex}, {lights}"));
+        }
+    }
 }
