@@ -1,6 +1,6 @@
-"""Shared by the bench/mitsuba_*_reference.py scripts: render a Mitsuba 3 scene in two
-independent halves of the samples and write the image with its noise figures; write numbers
-and triples as rtis scene files spell them.
+"""Shared by the bench/mitsuba_*_reference.py scripts: the sensor they all use, render a
+Mitsuba 3 scene in two independent halves of the samples and write the image with its noise
+figures; write numbers and triples as rtis scene files spell them.
 
 The noise RMSE is half the RMSE between the halves: the RMSE of their mean against its
 expectation, which the tests compare rtis's distance from the reference with.
@@ -10,6 +10,22 @@ import json
 import time
 
 import numpy as np
+
+
+def sensor(mi, kind, eye, target, up, fov, width, height, spp, seed, **extra):
+    """A Mitsuba sensor of `kind` (`perspective`, `thinlens` with its `extra` fields) at `eye`
+    looking at `target`, with a vertical `fov` as rtis's, an hdrfilm of `width x height` with
+    a box filter, and an independent sampler."""
+    return {
+        "type": kind,
+        "fov": fov,
+        "fov_axis": "y",
+        **extra,
+        "to_world": mi.ScalarTransform4f().look_at(origin=eye, target=target, up=up),
+        "film": {"type": "hdrfilm", "width": width, "height": height,
+                 "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+        "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
+    }
 
 
 def render_halves(mi, make_dict, spp, width, height):

@@ -26,7 +26,7 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import num, render_halves, tup, write_reference
+from mitsuba_halves import num, render_halves, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
@@ -51,17 +51,8 @@ def mitsuba_dict(mi, spp, seed=0):
     scene = {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
-        "sensor": {
-            "type": "thinlens",
-            "fov": FOV,
-            "fov_axis": "y",
-            "aperture_radius": APERTURE,
-            "focus_distance": FOCUS,
-            "to_world": T().look_at(origin=EYE, target=TARGET, up=UP),
-            "film": {"type": "hdrfilm", "width": WIDTH, "height": HEIGHT,
-                     "rfilter": {"type": "box"}, "pixel_format": "rgb"},
-            "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
-        },
+        "sensor": sensor(mi, "thinlens", EYE, TARGET, UP, FOV, WIDTH, HEIGHT, spp, seed,
+                         aperture_radius=APERTURE, focus_distance=FOCUS),
         # The floor: a rectangle of half size 1000 in y = 0 facing up.
         "floor": {"type": "rectangle", "to_world": T().rotate([1, 0, 0], -90).scale(1000),
                   "bsdf": diffuse(FLOOR)},

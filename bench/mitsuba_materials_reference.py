@@ -34,7 +34,7 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import num, render_halves, tup, write_reference
+from mitsuba_halves import num, render_halves, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
@@ -95,15 +95,7 @@ def mitsuba_dict(mi, variant, spp, seed=0):
     scene = {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5, "hide_emitters": False},
-        "sensor": {
-            "type": "perspective",
-            "fov": FOV,
-            "fov_axis": "y",
-            "to_world": T().look_at(origin=EYE, target=TARGET, up=UP),
-            "film": {"type": "hdrfilm", "width": WIDTH, "height": HEIGHT,
-                     "rfilter": {"type": "box"}, "pixel_format": "rgb"},
-            "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
-        },
+        "sensor": sensor(mi, "perspective", EYE, TARGET, UP, FOV, WIDTH, HEIGHT, spp, seed),
         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": SKY}},
         # The floor: a rectangle of half size 1000 in y = 0 facing up.
         "floor": {

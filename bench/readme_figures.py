@@ -202,16 +202,22 @@ def lens(_runs):
     ])
 
 
+def converge_rows(scene, plot, families):
+    """`rtis converge SCENE --runs 1 --seeds 2`: its plot copied to docs/images/PLOT, and its
+    table's header and the rows of the given families."""
+    with tempfile.TemporaryDirectory() as d:
+        run(["converge", scene, "--out", d, "--runs", "1", "--seeds", "2"], stderr=subprocess.DEVNULL)
+        shutil.copyfile(os.path.join(d, "converge.png"), os.path.join(ROOT, "docs", "images", plot))
+        with open(os.path.join(d, "converge.md")) as f:
+            return [l for l in f.read().splitlines()
+                    if l.startswith("| family") or l.startswith("|---")
+                    or any(l.startswith(f"| {family} |") for family in families)]
+
+
 def sky(_runs):
     s = render_stats("scenes/outdoor.ron", "docs/images/outdoor.png")
     w, h, _ = film("scenes/outdoor.ron")
-    with tempfile.TemporaryDirectory() as d:
-        run(["converge", "scenes/outdoor.ron", "--out", d, "--runs", "1", "--seeds", "2"], stderr=subprocess.DEVNULL)
-        shutil.copyfile(os.path.join(d, "converge.png"), os.path.join(ROOT, "docs", "images", "converge-outdoor.png"))
-        with open(os.path.join(d, "converge.md")) as f:
-            table = [l for l in f.read().splitlines()
-                     if l.startswith("| family") or l.startswith("|---") or l.startswith("| Path MIS")
-                     or l.startswith("| Path light") or l.startswith("| Path BRDF")]
+    table = converge_rows("scenes/outdoor.ron", "converge-outdoor.png", ["Path MIS", "Path light", "Path BRDF"])
     return "\n".join([
         "![Five balls on a floor under a generated sky with a sun](docs/images/outdoor.png)",
         "",
@@ -273,13 +279,7 @@ def area(_runs):
 
 def materials(_runs):
     s = render_stats("scenes/materials.ron", "docs/images/materials.png", ["--width", "576", "--spp", "256"])
-    with tempfile.TemporaryDirectory() as d:
-        run(["converge", "scenes/materials.ron", "--out", d, "--runs", "1", "--seeds", "2"], stderr=subprocess.DEVNULL)
-        shutil.copyfile(os.path.join(d, "converge.png"), os.path.join(ROOT, "docs", "images", "converge-materials.png"))
-        with open(os.path.join(d, "converge.md")) as f:
-            table = [l for l in f.read().splitlines()
-                     if l.startswith("| family") or l.startswith("|---") or l.startswith("| Path MIS")
-                     or l.startswith("| Path full normals")]
+    table = converge_rows("scenes/materials.ron", "converge-materials.png", ["Path MIS", "Path full normals"])
     return "\n".join([
         "![Rough gold, frosted glass and rough plastic at three roughnesses](docs/images/materials.png)",
         "",
