@@ -11,6 +11,7 @@ use rtis::light::Sky;
 use rtis::material::microfacet::Microfacet;
 use rtis::material::{Bsdf, Coating};
 use rtis::render::estimate::{self, human_seconds};
+use rtis::sampling::PixelFilter;
 use rtis::scene::{self, Scene};
 use rtis::shader::Shader;
 use rtis::world::{
@@ -200,9 +201,13 @@ pub fn to_ron(scene: &Scene) -> String {
     let s = &scene.settings;
     let mut out = String::from("Scene(\n");
     let f = &s.film;
+    let filter = match f.filter {
+        PixelFilter::Box => String::new(),
+        PixelFilter::Gaussian { stddev } => format!(", filter: Gaussian(stddev: {})", num(stddev)),
+    };
     let _ = writeln!(
         out,
-        "    film: (width: {}, height: {}, spp: {}, transfer: {:?}),",
+        "    film: (width: {}, height: {}, spp: {}, transfer: {:?}{filter}),",
         f.width, f.height, f.spp, f.transfer
     );
     let c = &s.camera;

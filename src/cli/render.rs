@@ -224,6 +224,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         height,
         spp: a.spp.unwrap_or(film.spp),
         transfer: a.transfer.unwrap_or(film.transfer),
+        filter: film.filter,
     };
     *film = overridden
         .checked()

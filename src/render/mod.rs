@@ -94,7 +94,9 @@ pub fn render_sample(
     let film = &scene.film;
     let pixel = row as u64 * film.width as u64 + col as u64;
     let mut sampler = Sampler::new(scene.seed, pixel, s as u64);
-    let (dx, dy) = pixel_sample(s, film.spp, scene.seed ^ pixel, &mut sampler);
+    let (dx, dy) = film
+        .filter
+        .place(pixel_sample(s, film.spp, scene.seed ^ pixel, &mut sampler));
     let u = (col as f32 + dx) / film.width as f32;
     let v = (row as f32 + dy) / film.height as f32;
     let ray = scene.camera.ray(u, v, || sampler.next_2d());

@@ -62,10 +62,13 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
         f.width,
         f.height,
     );
-    // Only a scene with an environment hashes it, so that earlier passes of other scenes still
-    // merge.
+    // Only a scene with an environment or a filter other than the box hashes them, so that
+    // earlier passes of other scenes still merge.
     if let Some(env) = &scene.emitters.environment {
         let _ = write!(h, "|{env:?}");
+    }
+    if f.filter != crate::sampling::PixelFilter::Box {
+        let _ = write!(h, "|{:?}", f.filter);
     }
     h.0
 }

@@ -6,7 +6,7 @@ use crate::camera::Camera;
 use crate::effects::Effects;
 use crate::light::{Emitters, Light};
 use crate::material::{Material, Model};
-use crate::sampling::Sampler;
+use crate::sampling::{PixelFilter, Sampler};
 use crate::shader::{RayAudit, Shader, Tracer};
 use crate::stats::RayStats;
 use glam::{DVec3, Vec3A};
@@ -30,16 +30,19 @@ pub struct Film {
     pub spp: u32,
     /// PNG transfer curve.
     pub transfer: Transfer,
+    /// Where in and around its pixel each sample goes ([`PixelFilter`]).
+    pub filter: PixelFilter,
 }
 
 impl Default for Film {
-    /// The course's 720 x 576, one sample per pixel, sRGB PNG.
+    /// The course's 720 x 576, one sample per pixel, sRGB PNG, the box filter.
     fn default() -> Self {
         Film {
             width: 720,
             height: 576,
             spp: 1,
             transfer: Transfer::Srgb,
+            filter: PixelFilter::Box,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! Random numbers, sample warps and sampling strategies.
 
 pub mod distribution;
+pub mod filter;
 pub mod hemisphere;
 mod pixel;
 mod rng;
@@ -8,6 +9,7 @@ mod strategy;
 pub mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
+pub use filter::PixelFilter;
 pub use pixel::pixel_sample;
 pub use rng::{Sampler, mix};
 pub use strategy::{LightSampling, LightsPerVertex, Sampling, power_heuristic};

@@ -31,7 +31,7 @@ use std::sync::Arc;
 pub use crate::material::Model;
 pub use crate::material::microfacet::{Distribution, NormalSampling};
 pub use crate::render::output::Transfer;
-pub use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
+pub use crate::sampling::{LightSampling, LightsPerVertex, PixelFilter, Sampling};
 
 /// Largest hemisphere sample count of the Global shader.
 pub const MAX_GLOBAL_SAMPLES: u32 = 1 << 16;
@@ -101,6 +101,27 @@ pub struct FilmFields {
     spp: Count<MAX_SPP>,
     #[serde(default)]
     transfer: Transfer,
+    #[serde(default)]
+    filter: FilterDesc,
+}
+
+/// A pixel filter as written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub enum FilterDesc {
+    /// Each sample inside its pixel (the default).
+    #[default]
+    Box,
+    /// A Gaussian truncated at 4 standard deviations, as Mitsuba 3's `gaussian`.
+    Gaussian {
+        /// Standard deviation in pixels, in (0, 8] (default 0.5, as Mitsuba's).
+        #[serde(default = "half_pixel")]
+        stddev: Positive,
+    },
+}
+
+fn half_pixel() -> Positive {
+    Positive(0.5)
 }
 
 fn default_width() -> Count<MAX_SIDE> {
@@ -121,6 +142,18 @@ impl TryFrom<FilmFields> for FilmDesc {
             height: f.height.0,
             spp: f.spp.0,
             transfer: f.transfer,
+            filter: match f.filter {
+                FilterDesc::Box => PixelFilter::Box,
+                FilterDesc::Gaussian { stddev } if stddev.0 <= 8.0 => PixelFilter::Gaussian {
+                    stddev: stddev.0 as f32,
+                },
+                FilterDesc::Gaussian { stddev } => {
+                    return Err(format!(
+                        "a Gaussian filter's stddev is at most 8 pixels, got {}",
+                        stddev.0
+                    ));
+                }
+            },
         }
         .checked()
         .map(FilmDesc)
@@ -134,6 +167,12 @@ impl From<FilmDesc> for FilmFields {
             height: Count(f.height),
             spp: Count(f.spp),
             transfer: f.transfer,
+            filter: match f.filter {
+                PixelFilter::Box => FilterDesc::Box,
+                PixelFilter::Gaussian { stddev } => FilterDesc::Gaussian {
+                    stddev: Positive(stddev as f64),
+                },
+            },
         }
     }
 }

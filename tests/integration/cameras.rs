@@ -206,3 +206,54 @@ fn lens_spots_and_sun_match_mitsuba() {
         "mean {m} vs {mean}"
     );
 }
+
+/// Pixel filters (src/sampling/filter.rs): a vertical edge between white (x >= 0) and black,
+/// on a pixel boundary, seen orthographically at one scene unit per pixel. With the box each
+/// pixel is all one side; with a Gaussian of standard deviation `s` (truncated at 4 s), pixel
+/// `c` is the share of the filter around its centre that lies past the edge,
+/// `(erf(4 / sqrt 2) - erf(d / (s sqrt 2))) / (2 erf(4 / sqrt 2))` with `d` its distance to the
+/// edge, within the stratification's noise at 4096 spp. A stddev above 8 is refused.
+#[test]
+fn a_gaussian_filter_blurs_an_edge_by_its_profile() {
+    let text = |filter: &str| {
+        format!(
+            "Scene(film: (width: 32, height: 4, spp: 4096{filter}),
+                   shader: Intersection(color: (1, 1, 1)),
+                   camera: Orthographic(position: (0, 0, -5), look_at: (0, 0, 0), up: (0, 1, 0),
+                                        height: 4),
+                   entities: [(shape: Rectangle(corner: (0, -50, 0), u: (100, 0, 0),
+                                                v: (0, 100, 0)),
+                               material: Phong(kd: (1, 1, 1)))])"
+        )
+    };
+    let boxed = crate::common::render_str(&text(""));
+    for c in 0..32 {
+        let want = if c >= 16 { 1.0 } else { 0.0 };
+        assert_eq!(boxed.image.get(c, 1).x, want, "box, column {c}");
+    }
+    for s in [0.5f64, 1.5] {
+        let r = crate::common::render_str(&text(&format!(", filter: Gaussian(stddev: {s})")));
+        let e = libm::erf(4.0 / std::f64::consts::SQRT_2);
+        for c in 0..32u32 {
+            // The edge's distance from the pixel's centre, along +x.
+            let d = 16.0 - (c as f64 + 0.5);
+            let want = if d >= 4.0 * s {
+                0.0
+            } else if d <= -4.0 * s {
+                1.0
+            } else {
+                (e - libm::erf(d / (s * std::f64::consts::SQRT_2))) / (2.0 * e)
+            };
+            let got = r.image.get(c, 1).x as f64;
+            assert!(
+                (got - want).abs() < 2e-3,
+                "stddev {s}, column {c}: {got} against {want}"
+            );
+        }
+    }
+    let e = rtis::scene::load_str(&text(", filter: Gaussian(stddev: 9)"), "t.ron", None)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("at most 8 pixels"), "{e}");
+}
