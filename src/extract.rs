@@ -13,7 +13,7 @@ use crate::light::{
 use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
 use crate::shader::Shader;
-use crate::shape::Shape;
+use crate::shape::{Corners, Shape};
 use crate::world::{Name, Scene, Transform, WorldEnvironment, WorldLight, WorldShape};
 use glam::Vec3A;
 
@@ -29,6 +29,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
     let mut materials: Vec<Material> = Vec::new();
     let mut prims = Vec::new();
     let mut normals = Vec::new();
+    let mut uvs: Vec<Option<[glam::Vec2; 3]>> = Vec::new();
     let mut area_lights = Vec::new();
     for (entity, shape, m, name, transform, emitter) in scene
         .world
@@ -50,13 +51,16 @@ pub fn extract(scene: &Scene) -> RenderScene {
             }
         };
         let place = Placement::new(transform, origin);
-        let dropped = shape.extract(&place, &mut |shape, vertex_normals| {
-            let smooth = match vertex_normals {
-                Some(n) => {
-                    normals.push(n);
+        let dropped = shape.extract(&place, &mut |shape, corners| {
+            let smooth = match corners {
+                Corners::NONE => FLAT,
+                Corners { normals: n, uvs: t } => {
+                    // A triangle with coordinates but no normals shades with its geometric
+                    // normal (zero normals interpolate to nothing).
+                    normals.push(n.unwrap_or([Vec3A::ZERO; 3]));
+                    uvs.push(t);
                     (normals.len() - 1) as u32
                 }
-                None => FLAT,
             };
             // Each primitive of an emitting shape is one area light.
             let emitting = match shape {
@@ -111,7 +115,14 @@ pub fn extract(scene: &Scene) -> RenderScene {
             p.shape = Shape::Plane(plane.oriented(plane.facing(&starts)));
         }
     }
-    let geometry = Geometry::build(prims, normals);
+    // Corners without coordinates take the barycentric defaults, when any has coordinates.
+    let uvs: Vec<[glam::Vec2; 3]> = if uvs.iter().any(Option::is_some) {
+        let bary = [glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y];
+        uvs.into_iter().map(|t| t.unwrap_or(bary)).collect()
+    } else {
+        Vec::new()
+    };
+    let geometry = Geometry::build_with_uvs(prims, normals, uvs);
     // A ball around the scene's finite parts (shapes but planes, lights, the camera), for a
     // directional light's power.
     let mut bounds = Aabb::EMPTY.grow(Vec3A::ZERO);

@@ -122,8 +122,14 @@ pub struct Geometry {
     pub sphere_each: Vec<(u32, SphereLanes<f32>)>,
     /// Each plane alone, with its prim index, in the order of `planes`.
     pub plane_each: Vec<(u32, PlaneLanes<f32>)>,
-    /// Vertex normals of smooth triangles, at their lane's index (empty if none is smooth).
+    /// Vertex normals of triangles with corner attributes (zero where a triangle has texture
+    /// coordinates but no normals: it shades with its geometric normal), at their lane's index
+    /// (empty if no triangle has any).
     pub normals: Vec<[glam::Vec3A; 3]>,
+    /// Texture coordinates of the same triangles' corners, at the same indices (the barycentric
+    /// defaults `(0, 0), (1, 0), (0, 1)` where a triangle has normals but no coordinates);
+    /// empty if no triangle has coordinates.
+    pub uvs: Vec<[glam::Vec2; 3]>,
     /// True if the BVH holds triangles: its rays then need the watertight test's shear
     /// constants.
     pub has_triangles: bool,
@@ -138,11 +144,25 @@ impl Geometry {
     /// sleeps until it is done, and the build has about ten such steps. Run whole on a worker,
     /// a build of 10k triangles took about 8% less time on two threads and 20% less on one.
     pub fn build(prims: Vec<Prim>, normals: Vec<[glam::Vec3A; 3]>) -> Self {
-        rayon::scope(|_| Self::build_on_worker(prims, normals))
+        Self::build_with_uvs(prims, normals, Vec::new())
     }
 
-    /// [`Geometry::build`], run where it is called.
-    fn build_on_worker(prims: Vec<Prim>, normals: Vec<[glam::Vec3A; 3]>) -> Self {
+    /// [`Geometry::build`] with the corners' texture coordinates: `uvs` (empty, or as long as
+    /// `normals`) at the same indices as `normals`.
+    pub fn build_with_uvs(
+        prims: Vec<Prim>,
+        normals: Vec<[glam::Vec3A; 3]>,
+        uvs: Vec<[glam::Vec2; 3]>,
+    ) -> Self {
+        rayon::scope(|_| Self::build_on_worker(prims, normals, uvs))
+    }
+
+    /// [`Geometry::build_with_uvs`], run where it is called.
+    fn build_on_worker(
+        prims: Vec<Prim>,
+        normals: Vec<[glam::Vec3A; 3]>,
+        uvs: Vec<[glam::Vec2; 3]>,
+    ) -> Self {
         // What goes to packets instead of the BVH, counted in parallel: planes, and spheres in
         // small scenes.
         let (n_spheres, n_planes) = prims
@@ -238,29 +258,44 @@ impl Geometry {
                 others.push(for_bvh[order[first + k] as usize]);
             }
         }
-        let normals = &normals;
-        // Vertex normals move to their lane's index; a smooth primitive kept whole (a
-        // triangle a lane cannot hold exactly) gets its normals appended after the lanes'.
-        let mut lane_normals: Vec<[glam::Vec3A; 3]> =
-            if attrs.iter().any(|a| a.material & SMOOTH != 0)
-                || others.iter().any(|p| p.smooth != FLAT)
-            {
-                ranges
-                    .par_iter()
-                    .zip(&blocks)
-                    .flat_map_iter(|(&range, block)| {
-                        let (leaf, _) = leaf(range);
-                        (0..4).map(move |k| match in_lane(block, k) {
-                            true if leaf[k].smooth != FLAT => normals[leaf[k].smooth as usize],
-                            _ => [glam::Vec3A::ZERO; 3],
-                        })
+        let (normals, uvs) = (&normals, &uvs);
+        // Corner attributes move to their lane's index; a primitive with them kept whole (a
+        // triangle a lane cannot hold exactly) gets them appended after the lanes'.
+        let any = attrs.iter().any(|a| a.material & SMOOTH != 0)
+            || others.iter().any(|p| p.smooth != FLAT);
+        // Each lane's index into the tables, or FLAT.
+        let sources: Vec<u32> = if any {
+            ranges
+                .par_iter()
+                .zip(&blocks)
+                .flat_map_iter(|(&range, block)| {
+                    let (leaf, _) = leaf(range);
+                    (0..4).map(move |k| match in_lane(block, k) {
+                        true => leaf[k].smooth,
+                        false => FLAT,
                     })
-                    .collect()
-            } else {
-                Vec::new()
-            };
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        fn to_lanes<T: Copy + Send + Sync>(sources: &[u32], table: &[T], none: T) -> Vec<T> {
+            if table.is_empty() {
+                return Vec::new();
+            }
+            sources
+                .par_iter()
+                .map(|&i| if i == FLAT { none } else { table[i as usize] })
+                .collect()
+        }
+        let mut lane_normals = to_lanes(&sources, normals, [glam::Vec3A::ZERO; 3]);
+        let mut lane_uvs = to_lanes(&sources, uvs, [glam::Vec2::ZERO; 3]);
+        drop(sources);
         for p in others.iter_mut().filter(|p| p.smooth != FLAT) {
             lane_normals.push(normals[p.smooth as usize]);
+            if !uvs.is_empty() {
+                lane_uvs.push(uvs[p.smooth as usize]);
+            }
             p.smooth = (lane_normals.len() - 1) as u32;
         }
         let in_bvh = for_bvh.len();
@@ -281,6 +316,7 @@ impl Geometry {
             spheres,
             planes,
             normals: lane_normals,
+            uvs: lane_uvs,
             has_triangles,
         }
     }
@@ -304,16 +340,57 @@ impl Geometry {
             (FLAT, _) => n,
             (i, Shape::Triangle(t)) => {
                 let [n0, n1, n2] = self.normals[i as usize];
-                let (e1, e2, ep) = (t.v[1] - t.v[0], t.v[2] - t.v[0], p - t.v[0]);
-                let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-                let (d20, d21) = (ep.dot(e1), ep.dot(e2));
-                let det = d00 * d11 - d01 * d01;
-                let b1 = (d11 * d20 - d01 * d21) / det;
-                let b2 = (d00 * d21 - d01 * d20) / det;
+                let (b1, b2) = barycentric(&t, p);
                 let ns = ((1.0 - b1 - b2) * n0 + b1 * n1 + b2 * n2).normalize_or_zero();
                 if ns == glam::Vec3A::ZERO { n } else { ns }
             }
             _ => n,
+        }
+    }
+
+    /// The texture coordinates `(u, v)` at point `p` of primitive `prim` (Mitsuba 3's
+    /// conventions; `docs/scene-format.md`, "Texture coordinates"):
+    ///
+    /// - a triangle: its corners' coordinates interpolated with `p`'s barycentric coordinates
+    ///   `(b1, b2)`, or `(b1, b2)` itself when it has none;
+    /// - a sphere: `u = phi / (2 pi)` with `phi = atan2(y, x)` in [0, 2 pi), `v = theta / pi`
+    ///   with `theta = acos(z)`, of the unit direction from its centre to `p`;
+    /// - a plane: `p` less the plane's point, along the two world axes other than the one its
+    ///   normal leans on most (`x, z` for a floor, `z, y` for a wall facing x, `x, y` for one
+    ///   facing z), one unit per scene unit.
+    #[inline]
+    pub fn uv(&self, prim: &Prim, p: glam::Vec3A) -> glam::Vec2 {
+        use glam::Vec2;
+        match prim.shape {
+            Shape::Triangle(t) => {
+                let (b1, b2) = barycentric(&t, p);
+                match self.uvs.get(prim.smooth as usize) {
+                    Some(&[t0, t1, t2]) if prim.smooth != FLAT => {
+                        (1.0 - b1 - b2) * t0 + b1 * t1 + b2 * t2
+                    }
+                    _ => Vec2::new(b1, b2),
+                }
+            }
+            Shape::Sphere(s) => {
+                let d = ((p - s.c) / s.r).clamp(glam::Vec3A::splat(-1.0), glam::Vec3A::ONE);
+                let phi = d.y.atan2(d.x).rem_euclid(std::f32::consts::TAU);
+                let u = phi / std::f32::consts::TAU;
+                Vec2::new(
+                    if u >= 1.0 { 0.0 } else { u },
+                    d.z.acos() / std::f32::consts::PI,
+                )
+            }
+            Shape::Plane(pl) => {
+                let d = p - pl.origin;
+                let a = pl.n.abs();
+                if a.y >= a.x && a.y >= a.z {
+                    Vec2::new(d.x, d.z)
+                } else if a.x >= a.z {
+                    Vec2::new(d.z, d.y)
+                } else {
+                    Vec2::new(d.x, d.y)
+                }
+            }
         }
     }
 
@@ -467,4 +544,17 @@ impl Geometry {
             })
         })
     }
+}
+
+/// The barycentric coordinates `(b1, b2)` of point `p` in triangle `t` (the weights of its
+/// second and third vertices), by the normal equations of `p - v0 = b1 e1 + b2 e2`.
+#[inline]
+fn barycentric(t: &crate::shape::Triangle, p: glam::Vec3A) -> (f32, f32) {
+    let (e1, e2, ep) = (t.v[1] - t.v[0], t.v[2] - t.v[0], p - t.v[0]);
+    let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d20, d21) = (ep.dot(e1), ep.dot(e2));
+    let det = d00 * d11 - d01 * d01;
+    let b1 = (d11 * d20 - d01 * d21) / det;
+    let b2 = (d00 * d21 - d01 * d20) / det;
+    (b1, b2)
 }

@@ -10,7 +10,8 @@ pub struct Prim {
     pub shape: Shape,
     /// Index into the prepared material array.
     pub material: u32,
-    /// A smooth triangle's vertex normals, or [`FLAT`]: an index into the normals passed to
+    /// A triangle's corner attributes (vertex normals, texture coordinates), or [`FLAT`] for
+    /// none: an index into the normals (and coordinates) passed to
     /// [`Geometry::build`](super::Geometry::build), and in the primitives [`Geometry::prim`](super::Geometry::prim) returns, into
     /// [`Geometry::normals`](super::Geometry::normals).
     pub smooth: u32,

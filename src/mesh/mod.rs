@@ -18,4 +18,8 @@ pub struct MeshData {
     pub normals: Vec<DVec3>,
     /// Triangles as indices into `positions`.
     pub faces: Vec<[u32; 3]>,
+    /// Per-vertex texture coordinates (same indexing as `positions`), empty when not given.
+    /// From OBJ's `vt`, with `v` flipped (`1 - v`), as Mitsuba 3 reads OBJ files: an image's top
+    /// row is at `v = 0`.
+    pub uvs: Vec<glam::Vec2>,
 }

@@ -30,6 +30,7 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
     })?;
     let mut mesh = MeshData::default();
     let mut all_normals = true;
+    let mut all_uvs = true;
     for m in &models {
         let base = mesh.positions.len() as u32;
         let p = &m.mesh.positions;
@@ -53,6 +54,14 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
         } else {
             all_normals = false;
         }
+        // Texture coordinates, `v` flipped as Mitsuba reads OBJ files.
+        let t = &m.mesh.texcoords;
+        if t.len() / 2 == p.len() / 3 && t.len() % 2 == 0 {
+            mesh.uvs
+                .extend(t.chunks_exact(2).map(|c| glam::Vec2::new(c[0], 1.0 - c[1])));
+        } else {
+            all_uvs = false;
+        }
         mesh.faces.extend(
             m.mesh
                 .indices
@@ -62,6 +71,9 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
     }
     if !all_normals || mesh.normals.contains(&DVec3::ZERO) {
         mesh.normals.clear();
+    }
+    if !all_uvs || mesh.uvs.iter().any(|t| !t.is_finite()) {
+        mesh.uvs.clear();
     }
     if let Some(bad) = mesh
         .positions

@@ -923,6 +923,7 @@ impl ShapeDesc {
                 positions: vertices.iter().map(|p| p.0).collect(),
                 normals: normals.iter().map(|n| n.0).collect(),
                 faces: faces.iter().map(|&(i, j, k)| [i, j, k]).collect(),
+                uvs: Vec::new(),
             })),
             ShapeDesc::Mesh { path } => WorldShape::Mesh(Arc::new(load_mesh(path)?)),
         })

@@ -70,56 +70,84 @@ impl WorldShape {
         }
     }
 
-    /// The render shapes of this shape placed by `at`, each with its vertex normals when
-    /// smooth, passed to `push`; returns how many zero-area triangles were dropped (they can
-    /// never be hit).
-    pub fn extract(
-        &self,
-        at: &Placement,
-        push: &mut dyn FnMut(Shape, Option<[Vec3A; 3]>),
-    ) -> usize {
+    /// The render shapes of this shape placed by `at`, each with its corners' attributes
+    /// (vertex normals when smooth, texture coordinates when given), passed to `push`; returns
+    /// how many zero-area triangles were dropped (they can never be hit).
+    pub fn extract(&self, at: &Placement, push: &mut dyn FnMut(Shape, Corners)) -> usize {
         let mut dropped = 0;
         // A mirroring transform reverses the winding: swap two vertices to keep the normal.
         let mirrors = at.mirrors();
-        let mut triangle = |v: [Vec3A; 3], n: Option<[Vec3A; 3]>| {
-            let (v, n) = if mirrors {
-                ([v[0], v[2], v[1]], n.map(|n| [n[0], n[2], n[1]]))
+        let mut triangle = |v: [Vec3A; 3], c: Corners| {
+            let (v, c) = if mirrors {
+                let c = Corners {
+                    normals: c.normals.map(|[a, b, c]| [a, c, b]),
+                    uvs: c.uvs.map(|[a, b, c]| [a, c, b]),
+                };
+                ([v[0], v[2], v[1]], c)
             } else {
-                (v, n)
+                (v, c)
             };
             match Triangle::new(v[0], v[1], v[2]) {
-                Some(t) => push(Shape::Triangle(t), n),
+                Some(t) => push(Shape::Triangle(t), c),
                 None => dropped += 1,
             }
         };
         match self {
-            WorldShape::Sphere { center, radius } => {
-                push(Shape::Sphere(Sphere::placed(*center, *radius, at)), None)
-            }
-            WorldShape::Plane { point, normal } => {
-                push(Shape::Plane(Plane::placed(*point, *normal, at)), None)
-            }
-            WorldShape::Triangle { v } => triangle(v.map(|p| at.point(p)), None),
+            WorldShape::Sphere { center, radius } => push(
+                Shape::Sphere(Sphere::placed(*center, *radius, at)),
+                Corners::NONE,
+            ),
+            WorldShape::Plane { point, normal } => push(
+                Shape::Plane(Plane::placed(*point, *normal, at)),
+                Corners::NONE,
+            ),
+            WorldShape::Triangle { v } => triangle(v.map(|p| at.point(p)), Corners::NONE),
             WorldShape::Rectangle { corner, u, v } => {
-                // Both triangles wind as u x v: (u, u + v) and (u + v, v).
+                // Both triangles wind as u x v: (u, u + v) and (u + v, v). Texture coordinates
+                // run from (0, 0) at the corner along u and v to (1, 1).
                 let [a, b, c, d] = [*corner, corner + u, corner + u + v, corner + v];
-                triangle([a, b, c].map(|p| at.point(p)), None);
-                triangle([a, c, d].map(|p| at.point(p)), None);
+                let uv = |s: f32, t: f32| glam::Vec2::new(s, t);
+                let [ta, tb, tc, td] = [uv(0.0, 0.0), uv(1.0, 0.0), uv(1.0, 1.0), uv(0.0, 1.0)];
+                let with = |uvs| Corners {
+                    normals: None,
+                    uvs: Some(uvs),
+                };
+                triangle([a, b, c].map(|p| at.point(p)), with([ta, tb, tc]));
+                triangle([a, c, d].map(|p| at.point(p)), with([ta, tc, td]));
             }
             WorldShape::Mesh(m) => {
                 let v: Vec<Vec3A> = m.positions.iter().map(|p| at.point(*p)).collect();
                 let n: Vec<Vec3A> = m.normals.iter().map(|d| at.normal(*d)).collect();
                 for f in &m.faces {
                     let idx = f.map(|i| i as usize);
-                    triangle(
-                        idx.map(|i| v[i]),
-                        (!n.is_empty()).then(|| idx.map(|i| n[i])),
-                    );
+                    let corners = Corners {
+                        normals: (!n.is_empty()).then(|| idx.map(|i| n[i])),
+                        uvs: (!m.uvs.is_empty()).then(|| idx.map(|i| m.uvs[i])),
+                    };
+                    triangle(idx.map(|i| v[i]), corners);
                 }
             }
         }
         dropped
     }
+}
+
+/// What a triangle's corners carry besides their positions: shading normals and texture
+/// coordinates, each optional.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Corners {
+    /// Unit vertex normals, interpolated for shading.
+    pub normals: Option<[Vec3A; 3]>,
+    /// Texture coordinates, interpolated at hits.
+    pub uvs: Option<[glam::Vec2; 3]>,
+}
+
+impl Corners {
+    /// Nothing beyond the positions: a flat triangle with barycentric coordinates.
+    pub const NONE: Corners = Corners {
+        normals: None,
+        uvs: None,
+    };
 }
 
 /// A prepared, camera-relative shape in single precision, ready for intersection.

@@ -18,6 +18,8 @@ pub struct Plane {
     /// The side rays are kept on: `1` where `n.p > dist`, `-1` where `n.p < dist`, `0` for
     /// none (the plane is not oriented: rays may be on either side).
     pub side: f32,
+    /// The point it was given with, where its texture coordinates start.
+    pub origin: Vec3A,
 }
 
 impl Plane {
@@ -30,6 +32,7 @@ impl Plane {
             n,
             dist: n.as_dvec3().dot(at.point_f64(point)) as f32,
             side: 0.0,
+            origin: at.point(point),
         }
     }
 
@@ -39,6 +42,7 @@ impl Plane {
             n,
             dist: n.dot(point),
             side: 0.0,
+            origin: point,
         }
     }
 

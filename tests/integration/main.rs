@@ -39,6 +39,7 @@ mod scene_fuzz;
 mod shapes;
 mod stability;
 mod tev;
+mod textures;
 mod transport;
 mod warptest;
 mod watch;
