@@ -14,6 +14,7 @@ use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
 use crate::shader::Shader;
 use crate::shape::{Corners, Shape};
+use crate::texture::MaterialTextures;
 use crate::world::{Name, Scene, Transform, WorldEnvironment, WorldLight, WorldShape};
 use glam::Vec3A;
 
@@ -27,31 +28,44 @@ pub fn extract(scene: &Scene) -> RenderScene {
     // Shapes with their materials (each distinct material stored once).
     let mut warnings = Vec::new();
     let mut materials: Vec<Material> = Vec::new();
+    let mut textures: Vec<MaterialTextures> = Vec::new();
     let mut prims = Vec::new();
     let mut normals = Vec::new();
     let mut uvs: Vec<Option<[glam::Vec2; 3]>> = Vec::new();
     let mut area_lights = Vec::new();
-    for (entity, shape, m, name, transform, emitter) in scene
+    let none = MaterialTextures::default();
+    for (entity, shape, m, tex, name, transform, emitter) in scene
         .world
         .query::<(
             hecs::Entity,
             &WorldShape,
             &Material,
+            Option<&MaterialTextures>,
             Option<&Name>,
             Option<&Transform>,
             Option<&Emitter>,
         )>()
         .iter()
     {
-        let material = match materials.iter().position(|x| x == m) {
-            Some(i) => i as u32,
-            None => {
-                materials.push(*m);
-                (materials.len() - 1) as u32
-            }
-        };
+        let tex = tex.unwrap_or(&none);
+        let material =
+            match (0..materials.len()).position(|i| materials[i] == *m && textures[i] == *tex) {
+                Some(i) => i as u32,
+                None => {
+                    materials.push(*m);
+                    textures.push(tex.clone());
+                    (materials.len() - 1) as u32
+                }
+            };
         let place = Placement::new(transform, origin);
+        // Texture coordinates are kept only where a texture reads them: other triangles stay
+        // flat, shaded as before at no cost.
+        let textured = !tex.is_empty();
         let dropped = shape.extract(&place, &mut |shape, corners| {
+            let corners = Corners {
+                uvs: corners.uvs.filter(|_| textured),
+                ..corners
+            };
             let smooth = match corners {
                 Corners::NONE => FLAT,
                 Corners { normals: n, uvs: t } => {
@@ -92,7 +106,12 @@ pub fn extract(scene: &Scene) -> RenderScene {
     }
     // Under the physically based model a Phong surface reflects at most what it receives.
     if s.model == Model::Physical {
-        for m in &mut materials {
+        // A textured one is scaled where its texture is looked up (`MaterialTextures::apply`).
+        for (m, _) in materials
+            .iter_mut()
+            .zip(&textures)
+            .filter(|(_, t)| t.is_empty())
+        {
             if let Material::Phong(p) = m
                 && let Some(scaled) = p.energy_conserving()
             {
@@ -194,6 +213,12 @@ pub fn extract(scene: &Scene) -> RenderScene {
         camera,
         geometry,
         materials,
+        // Kept only when some material is textured: shading then looks them up.
+        textures: if textures.iter().all(MaterialTextures::is_empty) {
+            Vec::new()
+        } else {
+            textures
+        },
         lights,
         emitters,
         background: s.background,

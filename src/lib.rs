@@ -7,7 +7,8 @@
 //! - [`render`](mod@render): the render scene, its effects, the tiled render loop, images and output;
 //! - [`shader`]: one file per shader, given the parts of the scene it reads;
 //! - [`accel`]: ray queries over the flat primitives (SIMD packets and a BVH);
-//! - [`shape`], [`material`], [`light`], [`camera`]: the closed sets, one file per variant;
+//! - [`shape`], [`material`], [`light`], [`camera`], [`texture`]: the closed sets, one file per
+//!   variant;
 //! - [`geometry`], [`sampling`], [`mesh`], [`raster`], [`effects`], [`stats`]: leaf maths and
 //!   data.
 //!
@@ -31,6 +32,7 @@ pub mod scene;
 pub mod shader;
 pub mod shape;
 pub mod stats;
+pub mod texture;
 pub mod world;
 
 pub use extract::extract;

@@ -79,6 +79,12 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 /// Read the image at `path` (OpenEXR, or PNG decoded from sRGB): the message names the reason
 /// it cannot be read, without the path (the caller places it).
 pub fn load(path: &Path) -> Result<Raster, String> {
+    load_with(path, false)
+}
+
+/// [`load`]; with `raw`, PNG values are taken as they are stored (scaled to [0, 1]), not
+/// decoded from sRGB: for data such as roughness or normal maps.
+pub fn load_with(path: &Path, raw: bool) -> Result<Raster, String> {
     use image::{DynamicImage, ImageReader, Limits};
     let reader = ImageReader::open(path)
         .map_err(|e| format!("cannot read image {}: {e}", path.display()))?
@@ -112,7 +118,7 @@ pub fn load(path: &Path) -> Result<Raster, String> {
     );
     // The decoded image is dropped once converted (unless it was already linear RGB).
     let rgb = image.into_rgb32f().into_raw();
-    let decode = |c: f32| if linear { c } else { srgb_to_linear(c) };
+    let decode = |c: f32| if linear || raw { c } else { srgb_to_linear(c) };
     let texels = rgb
         .chunks_exact(3)
         .map(|p| [decode(p[0]), decode(p[1]), decode(p[2])])

@@ -395,7 +395,7 @@ impl Geometry {
     }
 
     /// The primitive with index `index` (what a hit refers to).
-    #[inline]
+    #[inline(always)]
     pub fn prim(&self, index: u32) -> Prim {
         let i = index as usize;
         if i >= self.attrs.len() {

@@ -14,6 +14,7 @@ use rtis::render::estimate::{self, human_seconds};
 use rtis::sampling::PixelFilter;
 use rtis::scene::{self, Scene};
 use rtis::shader::Shader;
+use rtis::texture::{MaterialTextures, Texture, TextureKind};
 use rtis::world::{
     Emitter, Material, MaterialName, Name, Projection, Transform, WorldEnvironment, WorldLight,
     WorldShape,
@@ -41,24 +42,57 @@ fn rgb(v: Vec3A) -> String {
     format!("({}, {}, {})", num(v.x), num(v.y), num(v.z))
 }
 
-fn material(m: &Material) -> String {
+/// A texture as a scene file writes it (an image by its absolute path).
+fn texture(t: &Texture) -> String {
+    let tr = &t.transform;
+    let uv = format!(
+        "uv_transform: (scale: ({}, {}), rotate: {}, offset: ({}, {}))",
+        num(tr.scale.x),
+        num(tr.scale.y),
+        num(tr.rotate),
+        num(tr.offset.x),
+        num(tr.offset.y)
+    );
+    match &t.kind {
+        TextureKind::Checkerboard(c) => format!(
+            "Checkerboard(color0: {}, color1: {}, {uv})",
+            rgb(c.color0),
+            rgb(c.color1)
+        ),
+        TextureKind::Image(i) => format!(
+            "Image(path: {:?}, filter: {:?}, wrap: {:?}, raw: {}, {uv})",
+            i.source.display().to_string(),
+            i.filter,
+            i.wrap,
+            i.raw
+        ),
+    }
+}
+
+fn material(m: &Material, t: Option<&MaterialTextures>) -> String {
+    // A parameter's texture, else its constant.
+    let paint = |tex: Option<&Texture>, c: Vec3A| tex.map_or_else(|| rgb(c), texture);
+    let reflectance = t.and_then(|t| t.reflectance.as_ref());
+    let specular = t.and_then(|t| t.specular.as_ref());
     match m {
         Material::Phong(p) => format!(
             "Phong(kd: {}, ks: {}, shininess: {})",
-            rgb(p.kd),
-            rgb(p.ks),
+            paint(reflectance, p.kd),
+            paint(specular, p.ks),
             num(p.shininess)
         ),
-        Material::Mirror(m) => format!("Mirror(color: {})", rgb(m.color)),
+        Material::Mirror(m) => format!("Mirror(color: {})", paint(reflectance, m.color)),
         Material::Conductor(c) => format!(
             "Conductor(eta: {}, k: {}, specular_reflectance: {})",
             rgb(c.eta),
             rgb(c.k),
             rgb(c.specular_reflectance)
         ),
-        Material::Transmissive(t) => {
-            format!("Transmissive(ior: {}, color: {})", num(t.ior), rgb(t.color))
-        }
+        Material::Transmissive(g) => format!(
+            "Transmissive(ior: {}, color: {})",
+            num(g.ior),
+            paint(reflectance, g.color)
+        ),
         Material::Bsdf(b) => bsdf(b),
     }
 }
@@ -256,8 +290,12 @@ pub fn to_ron(scene: &Scene) -> String {
 
     // The materials table: each name once, in name order.
     let mut table: BTreeMap<String, String> = BTreeMap::new();
-    for (m, name) in scene.world.query::<(&Material, &MaterialName)>().iter() {
-        table.insert(name.0.clone(), material(m));
+    for (m, t, name) in scene
+        .world
+        .query::<(&Material, Option<&MaterialTextures>, &MaterialName)>()
+        .iter()
+    {
+        table.insert(name.0.clone(), material(m, t));
     }
     if !table.is_empty() {
         out.push_str("    materials: {\n");
@@ -269,7 +307,7 @@ pub fn to_ron(scene: &Scene) -> String {
 
     // One line per entity, in the order of the file.
     let mut entities: Vec<(hecs::Entity, String)> = Vec::new();
-    for (id, name, sh, m, mname, t, light, env, emitter) in scene
+    for (id, name, sh, m, mname, tex, t, light, env, emitter) in scene
         .world
         .query::<(
             hecs::Entity,
@@ -277,6 +315,7 @@ pub fn to_ron(scene: &Scene) -> String {
             Option<&WorldShape>,
             Option<&Material>,
             Option<&MaterialName>,
+            Option<&MaterialTextures>,
             Option<&Transform>,
             Option<&WorldLight>,
             Option<&WorldEnvironment>,
@@ -293,7 +332,7 @@ pub fn to_ron(scene: &Scene) -> String {
         }
         match (m, mname) {
             (_, Some(n)) => fields.push(format!("material: Named({:?})", n.0)),
-            (Some(m), None) => fields.push(format!("material: {}", material(m))),
+            (Some(m), None) => fields.push(format!("material: {}", material(m, tex))),
             (None, None) => {}
         }
         if let Some(t) = t

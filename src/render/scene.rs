@@ -9,6 +9,7 @@ use crate::material::{Material, Model};
 use crate::sampling::{PixelFilter, Sampler};
 use crate::shader::{RayAudit, Shader, Tracer};
 use crate::stats::RayStats;
+use crate::texture::MaterialTextures;
 use glam::{DVec3, Vec3A};
 
 /// Largest image side in pixels.
@@ -84,6 +85,8 @@ pub struct RenderScene {
     pub geometry: Geometry,
     /// Materials, indexed by `Prim::material`.
     pub materials: Vec<Material>,
+    /// Their textures at the same indices, or empty when no material is textured.
+    pub textures: Vec<MaterialTextures>,
     /// Point lights.
     pub lights: Vec<Light>,
     /// Area lights (emitting primitives), chosen by power.
@@ -154,6 +157,7 @@ impl RenderScene {
         Tracer {
             geometry: &self.geometry,
             materials: &self.materials,
+            textures: &self.textures,
             lights: &self.lights,
             emitters: &self.emitters,
             background: self.background,

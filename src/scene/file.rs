@@ -21,11 +21,17 @@ use crate::material::rough_dielectric::RoughDielectric;
 use crate::material::rough_plastic::RoughPlastic;
 use crate::material::{Bsdf, Coating, Material, Mirror, Phong, Transmissive};
 use crate::mesh::MeshData;
+use crate::raster::Raster;
 use crate::render::{Film, MAX_SIDE, MAX_SPP};
 use crate::shader::{Global, Path, Shader};
 use crate::shape::WorldShape;
+use crate::texture::{
+    Checkerboard, ImageTexture, MaterialTextures, TexelFilter, Texture, TextureKind, UvTransform,
+    Wrap,
+};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 pub use crate::material::Model;
@@ -486,20 +492,21 @@ pub enum MaterialDesc {
     Named(String),
     /// Diffuse plus glossy: `r(wi, wo) = kd (wi.n) + ks (wo.wr)^shininess`.
     Phong {
-        /// Diffuse coefficient, a reflectance in [0, 1] per channel.
-        kd: Reflectance,
-        /// Specular coefficient, a reflectance in [0, 1] per channel (default black).
-        #[serde(default = "black")]
-        ks: Reflectance,
+        /// Diffuse coefficient, a reflectance in [0, 1] per channel, or a texture.
+        kd: Paint,
+        /// Specular coefficient, a reflectance in [0, 1] per channel, or a texture (default
+        /// black).
+        #[serde(default = "black_paint")]
+        ks: Paint,
         /// Phong exponent, from 0 to 1e6 (default 1).
         #[serde(default = "shininess")]
         shininess: NonNegative,
     },
     /// A perfect mirror tinted by `color`.
     Mirror {
-        /// Tint, a reflectance in [0, 1] per channel (default white).
-        #[serde(default = "unit")]
-        color: Reflectance,
+        /// Tint, a reflectance in [0, 1] per channel, or a texture (default white).
+        #[serde(default = "white_paint")]
+        color: Paint,
     },
     /// A smooth metal (Mitsuba 3's `conductor`): the mirror reflection weighted by the Fresnel
     /// term of the complex index `eta + i k` per channel, times `specular_reflectance`. The
@@ -633,16 +640,209 @@ pub enum MaterialDesc {
     Transmissive {
         /// Index of refraction, from 0.01 to 100.
         ior: Ior,
-        /// Tint, a reflectance in [0, 1] per channel (default white).
-        #[serde(default = "unit")]
-        color: Reflectance,
+        /// Tint, a reflectance in [0, 1] per channel, or a texture (default white).
+        #[serde(default = "white_paint")]
+        color: Paint,
     },
 }
 
+/// A reflectance as written: a constant `(r, g, b)`, or a texture looked up at each hit.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum Paint {
+    /// The same everywhere, each channel in [0, 1].
+    Constant(Reflectance),
+    /// A texture (its values clamped to [0, 1] where looked up).
+    Texture(TextureDesc),
+}
+
+fn black_paint() -> Paint {
+    Paint::Constant(black())
+}
+fn white_paint() -> Paint {
+    Paint::Constant(unit())
+}
+
+impl Paint {
+    /// The constant, or white in place of a texture (the material's other checks see a
+    /// surface that reflects; the texture replaces it at every hit).
+    fn constant(&self) -> glam::Vec3A {
+        match self {
+            Paint::Constant(r) => r.0.as_vec3a(),
+            Paint::Texture(_) => glam::Vec3A::ONE,
+        }
+    }
+
+    /// The texture, read by `load` (a path as written and `raw`).
+    fn texture(&self, load: &mut ImageLoader) -> Result<Option<Texture>, String> {
+        match self {
+            Paint::Constant(_) => Ok(None),
+            Paint::Texture(t) => t.to_world(load).map(Some),
+        }
+    }
+}
+
+/// Reads an image a texture names: its path as written and `raw`, to its texels and the file
+/// they came from.
+pub type ImageLoader<'a> = dyn FnMut(&str, bool) -> Result<(Arc<Raster>, PathBuf), String> + 'a;
+
+/// A texture as written.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub enum TextureDesc {
+    /// Mitsuba 3's `checkerboard`: `color0` where the fractional parts of `u` and `v` are both
+    /// below or both above 1/2, `color1` elsewhere.
+    Checkerboard {
+        /// Default 0.4, as Mitsuba's.
+        #[serde(default = "checker0")]
+        color0: Reflectance,
+        /// Default 0.2, as Mitsuba's.
+        #[serde(default = "checker1")]
+        color1: Reflectance,
+        /// Map of the coordinates (default none).
+        #[serde(default)]
+        uv_transform: UvTransformDesc,
+    },
+    /// Mitsuba 3's `bitmap`: an image (PNG decoded from sRGB unless `raw`, or OpenEXR),
+    /// relative to this file's folder.
+    Image {
+        /// The image file.
+        path: String,
+        /// `Bilinear` (default) or `Nearest`.
+        #[serde(default)]
+        filter: TexelFilter,
+        /// `Repeat` (default), `Clamp` or `Mirror`.
+        #[serde(default)]
+        wrap: Wrap,
+        /// Take PNG values as stored, not decoded from sRGB (default false).
+        #[serde(default)]
+        raw: bool,
+        /// Map of the coordinates (default none).
+        #[serde(default)]
+        uv_transform: UvTransformDesc,
+    },
+}
+
+fn checker0() -> Reflectance {
+    Reflectance(glam::DVec3::splat(0.4))
+}
+fn checker1() -> Reflectance {
+    Reflectance(glam::DVec3::splat(0.2))
+}
+
+/// A map of texture coordinates as written: scale, then rotate (degrees), then offset.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(rename = "UvTransform", deny_unknown_fields)]
+pub struct UvTransformDesc {
+    /// Factors on `u` and `v` (default `(1, 1)`).
+    #[serde(default = "unit_uv")]
+    pub scale: (f64, f64),
+    /// Rotation in degrees, counter-clockwise in `(u, v)` (default 0).
+    #[serde(default)]
+    pub rotate: f64,
+    /// Added last (default `(0, 0)`).
+    #[serde(default)]
+    pub offset: (f64, f64),
+}
+
+impl Default for UvTransformDesc {
+    fn default() -> Self {
+        UvTransformDesc {
+            scale: (1.0, 1.0),
+            rotate: 0.0,
+            offset: (0.0, 0.0),
+        }
+    }
+}
+
+fn unit_uv() -> (f64, f64) {
+    (1.0, 1.0)
+}
+
+impl UvTransformDesc {
+    /// The world's map, or why its numbers are not (each finite and within 1e9).
+    fn to_world(self) -> Result<UvTransform, String> {
+        let all = [
+            self.scale.0,
+            self.scale.1,
+            self.rotate,
+            self.offset.0,
+            self.offset.1,
+        ];
+        if let Some(bad) = all.iter().find(|v| !v.is_finite() || v.abs() > 1e9) {
+            return Err(format!(
+                "uv_transform: {bad} is not a finite number within 1e9"
+            ));
+        }
+        Ok(UvTransform {
+            scale: glam::Vec2::new(self.scale.0 as f32, self.scale.1 as f32),
+            rotate: self.rotate as f32,
+            offset: glam::Vec2::new(self.offset.0 as f32, self.offset.1 as f32),
+        })
+    }
+}
+
+impl TextureDesc {
+    /// The world's texture, its image read by `load`.
+    pub fn to_world(&self, load: &mut ImageLoader) -> Result<Texture, String> {
+        Ok(match self {
+            TextureDesc::Checkerboard {
+                color0,
+                color1,
+                uv_transform,
+            } => Texture {
+                kind: TextureKind::Checkerboard(Checkerboard {
+                    color0: color0.0.as_vec3a(),
+                    color1: color1.0.as_vec3a(),
+                }),
+                transform: uv_transform.to_world()?,
+            },
+            TextureDesc::Image {
+                path,
+                filter,
+                wrap,
+                raw,
+                uv_transform,
+            } => Texture {
+                kind: TextureKind::Image({
+                    let (raster, source) = load(path, *raw)?;
+                    ImageTexture {
+                        raster,
+                        source,
+                        raw: *raw,
+                        filter: *filter,
+                        wrap: *wrap,
+                    }
+                }),
+                transform: uv_transform.to_world()?,
+            },
+        })
+    }
+}
+
 impl MaterialDesc {
+    /// The textures of its parameters (none for a `Named` reference), their images read by
+    /// `load`.
+    pub fn textures(&self, load: &mut ImageLoader) -> Result<MaterialTextures, String> {
+        Ok(match self {
+            MaterialDesc::Phong { kd, ks, .. } => MaterialTextures {
+                reflectance: kd.texture(load)?,
+                specular: ks.texture(load)?,
+            },
+            MaterialDesc::Mirror { color } | MaterialDesc::Transmissive { color, .. } => {
+                MaterialTextures {
+                    reflectance: color.texture(load)?,
+                    specular: None,
+                }
+            }
+            _ => MaterialTextures::default(),
+        })
+    }
+
     /// The material, `Ok(None)` for a `Named` reference (resolved by the loader), or why the
     /// fields do not make one (a conductor given both a named metal and `eta` or `k`, or only
-    /// one of `eta` and `k`).
+    /// one of `eta` and `k`). A textured parameter is white here ([`MaterialDesc::textures`]
+    /// replaces it at each hit).
     pub fn to_world(&self) -> Result<Option<Material>, String> {
         let rgb = |c: &Reflectance| c.0.as_vec3a();
         Ok(Some(match self {
@@ -715,14 +915,16 @@ impl MaterialDesc {
                 ),
             })),
             MaterialDesc::Phong { kd, ks, shininess } => Material::Phong(Phong {
-                kd: rgb(kd),
-                ks: rgb(ks),
+                kd: kd.constant(),
+                ks: ks.constant(),
                 shininess: shininess.0 as f32,
             }),
-            MaterialDesc::Mirror { color } => Material::Mirror(Mirror { color: rgb(color) }),
+            MaterialDesc::Mirror { color } => Material::Mirror(Mirror {
+                color: color.constant(),
+            }),
             MaterialDesc::Transmissive { ior, color } => Material::Transmissive(Transmissive {
                 ior: ior.0 as f32,
-                color: rgb(color),
+                color: color.constant(),
             }),
         }))
     }
@@ -792,16 +994,17 @@ fn relative_ior(int_ior: Ior, ext_ior: Ior) -> Result<f32, String> {
     Ok(eta)
 }
 
-/// An entry of the `materials` table: any material written inline, never `Named`.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+/// An entry of the `materials` table: any material written inline, never `Named`; with what
+/// was written, for its textures (read where the table's file is).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(try_from = "MaterialDesc")]
-pub struct TableMaterial(pub Material);
+pub struct TableMaterial(pub Material, pub MaterialDesc);
 
 impl TryFrom<MaterialDesc> for TableMaterial {
     type Error = String;
     fn try_from(m: MaterialDesc) -> Result<Self, String> {
         match m.to_world()? {
-            Some(m) => Ok(TableMaterial(m)),
+            Some(world) => Ok(TableMaterial(world, m)),
             None => Err(format!(
                 "an entry of `materials` cannot be {m:?}: write the material itself, as \
                  `Phong(kd: (0.8, 0.8, 0.8))`"

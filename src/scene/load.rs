@@ -12,6 +12,7 @@ use super::spans::{self, Node};
 use super::values::{MAX_RADIANCE, Rgb};
 use crate::light::{Sky, SkyMap};
 use crate::material::Material;
+use crate::raster::Raster;
 use crate::world::{MaterialName, Name, Scene, Settings, Shader};
 use ron::extensions::Extensions;
 use std::collections::BTreeMap;
@@ -266,7 +267,8 @@ struct Resolved {
     seed: Option<u64>,
     model: Option<Model>,
     effects: Option<EffectsDesc>,
-    materials: BTreeMap<String, (Material, usize)>,
+    /// Each table material, what was written, and the index of its source.
+    materials: BTreeMap<String, (Material, MaterialDesc, usize)>,
     /// Each entity, the index of its source, and its index in that file's `entities`.
     entities: Vec<(EntityDesc, usize, usize)>,
 }
@@ -327,8 +329,8 @@ fn resolve(
     base.seed = file.seed.or(base.seed);
     base.model = file.model.or(base.model);
     base.effects = file.effects.or(base.effects);
-    for (name, TableMaterial(m)) in file.materials.unwrap_or_default() {
-        base.materials.insert(name, (m, idx));
+    for (name, TableMaterial(m, desc)) in file.materials.unwrap_or_default() {
+        base.materials.insert(name, (m, desc, idx));
     }
     // An entity named like one of the base's replaces it in place; others are appended.
     for (i, e) in file.entities.unwrap_or_default().into_iter().enumerate() {
@@ -445,6 +447,8 @@ impl Resolved {
         };
         // Where the scene's environment light is written, once one is met.
         let mut sky_at: Option<String> = None;
+        // Each image textures read, once, by its path and whether it is raw.
+        let mut images: BTreeMap<(PathBuf, bool), Arc<Raster>> = BTreeMap::new();
         for (EntityDesc(e), idx, i) in &self.entities {
             let src = &self.sources[*idx];
             // Where a component's value is written: the value of `field`, then `inner` inside
@@ -543,11 +547,23 @@ impl Resolved {
             }
             match &e.material {
                 Some(MaterialDesc::Named(n)) => match self.materials.get(n) {
-                    Some((m, _)) => {
-                        bsdf_allowed(m, &settings)
-                            .map_err(|why| src.error(place("material", Some("Named")), why))?;
+                    Some((m, desc, tidx)) => {
+                        let at = place("material", Some("Named"));
+                        bsdf_allowed(m, &settings).map_err(|why| src.error(at, why))?;
+                        // Its images, relative to the file whose table wrote it.
+                        let dir = self.sources[*tidx].dir.as_deref();
+                        let textures = desc
+                            .textures(&mut |path, raw| {
+                                load_image(&mut images, &mut files, dir, path, raw)
+                            })
+                            .map_err(|why| {
+                                src.error(at, format!("material \"{}\": {why}", clip(n, 60)))
+                            })?;
                         b.add(*m);
                         b.add(MaterialName(n.clone()));
+                        if !textures.is_empty() {
+                            b.add(textures);
+                        }
                     }
                     None => {
                         let known: Vec<_> =
@@ -563,16 +579,26 @@ impl Resolved {
                         ));
                     }
                 },
-                Some(m) => {
-                    if let Some(m) = m
+                Some(desc) => {
+                    let at = place("material", None);
+                    if let Some(m) = desc
                         .to_world()
                         .and_then(|m| match m {
                             Some(m) => bsdf_allowed(&m, &settings).map(|()| Some(m)),
                             None => Ok(None),
                         })
-                        .map_err(|why| src.error(place("material", None), why))?
+                        .map_err(|why| src.error(at, why))?
                     {
+                        let dir = src.dir.as_deref();
+                        let textures = desc
+                            .textures(&mut |path, raw| {
+                                load_image(&mut images, &mut files, dir, path, raw)
+                            })
+                            .map_err(|why| src.error(at, why))?;
                         b.add(m);
+                        if !textures.is_empty() {
+                            b.add(textures);
+                        }
                     }
                 }
                 // An emitter without a material reflects nothing.
@@ -622,4 +648,26 @@ fn bsdf_allowed(m: &Material, settings: &Settings) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// The texels of the image at `path` (relative to `dir`), decoded from sRGB unless `raw`: read
+/// once per scene, whatever the number of textures that name it (`images` holds those read, and
+/// `files` gains each file read, for `rtis watch`).
+fn load_image(
+    images: &mut BTreeMap<(PathBuf, bool), Arc<Raster>>,
+    files: &mut Vec<PathBuf>,
+    dir: Option<&Path>,
+    path: &str,
+    raw: bool,
+) -> Result<(Arc<Raster>, PathBuf), String> {
+    let file = dir.unwrap_or(Path::new("")).join(path);
+    let absolute = std::path::absolute(&file).unwrap_or(file.clone());
+    let key = (absolute.clone(), raw);
+    if let Some(r) = images.get(&key) {
+        return Ok((r.clone(), absolute));
+    }
+    files.push(file.clone());
+    let r = Arc::new(crate::raster::load_with(&file, raw)?);
+    images.insert(key, r.clone());
+    Ok((r, absolute))
 }

@@ -642,6 +642,51 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
         Error::UnclosedBlockComment => "a `/*` comment is not closed: end it with `*/`".into(),
         Error::ExpectedStringEnd => "a string is not closed: end it with `\"`".into(),
         Error::ExceededRecursionLimit => "brackets nested too deeply (more than 128 levels)".into(),
+        // A colour-or-texture that is neither: say what each would look like.
+        Error::Message(m) if m.contains("untagged enum Paint") => {
+            // `Name(` is reported at its bracket: the name is the word before it.
+            let before = text[..start].trim_end();
+            let name: String = before
+                .chars()
+                .rev()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+                .collect();
+            let field = field_before(text, before.len() - name.len())
+                .map_or("this value".to_string(), |f| format!("`{f}`"));
+            // A tuple is meant as a reflectance: its own error says what is wrong with it.
+            if name.is_empty()
+                && let Some(tuple) = bracketed(text, start)
+                && let Err(e) = ron::from_str::<super::values::Reflectance>(tuple)
+            {
+                return match e.code {
+                    Error::Message(m) => format!("{field}: {m}"),
+                    Error::ExpectedDifferentLength { found, .. } => format!(
+                        "expected 3 values, found {found}: {field} is a reflectance `(r, g, b)`, \
+                         each channel from 0 to 1, or a texture"
+                    ),
+                    other => format!("{field}: {other}"),
+                };
+            }
+            let empty = bracketed(text, start).is_some_and(|b| b[1..b.len() - 1].trim().is_empty());
+            let why = if !name.is_empty() && empty {
+                format!(
+                    "`{name}()` with no field cannot be told from a colour here: give one, as \
+                     `{name}(color0: (0.4, 0.4, 0.4))`"
+                )
+            } else if !name.is_empty() {
+                format!("`{name}` is not a texture, or its fields are not")
+            } else {
+                format!("{found_q} is neither")
+            };
+            format!(
+                "{field} takes a reflectance `(r, g, b)` or a texture, \
+                 `Checkerboard(color0: (0.9, 0.9, 0.9), color1: (0.1, 0.1, 0.1))` or \
+                 `Image(path: \"wood.png\")`: {why}"
+            )
+        }
         // A value its type refused: name the field it was given for.
         Error::Message(m) => match field_before(text, start) {
             Some(f) if m.starts_with("must be") => format!("`{f}` {m}"),
@@ -657,6 +702,30 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
             }
         }
     }
+}
+
+/// The text of the bracketed value starting at `start` (at its opening `(`), through its
+/// matching `)`; `None` if it does not start with one or is not closed.
+fn bracketed(text: &str, start: usize) -> Option<&str> {
+    let rest = text.get(start..)?;
+    let open = rest.find(|c: char| !c.is_whitespace())?;
+    if !rest[open..].starts_with('(') {
+        return None;
+    }
+    let mut depth = 0;
+    for (i, c) in rest[open..].char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' => {
+                depth -= 1;
+                if depth == 0 {
+                    return Some(&rest[open..open + i + 1]);
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }
 
 /// Where the value that a refused-value error points into starts: for a tuple whose closing

@@ -23,6 +23,7 @@ use crate::light::{Emitters, Light};
 use crate::material::{Material, Model};
 use crate::sampling::Sampler;
 use crate::stats::{RayKind, RayStats};
+use crate::texture::MaterialTextures;
 use glam::Vec3A;
 
 /// Longest chain of consecutive mirror/glass bounces any shader follows.
@@ -72,6 +73,8 @@ pub struct Tracer<'a> {
     pub geometry: &'a Geometry,
     /// Materials, indexed by `Prim::material`.
     pub materials: &'a [Material],
+    /// The textures of the materials at the same indices (empty when none is textured).
+    pub textures: &'a [MaterialTextures],
     /// Point lights.
     pub lights: &'a [Light],
     /// Area lights, indexed by `Prim::light`.

@@ -123,7 +123,7 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
             break;
         }
         // Scatter: the next ray, its weight g(wi) / pdf(wi) and its kind.
-        let (next_ray, weight, next) = match (si.material, model) {
+        let (next_ray, weight, next) = match (si.material(), model) {
             (Material::Phong(phong), _) => {
                 l += beta * next_event(tr, &si, phong, p);
                 if !tr.effects.indirect {

@@ -17,7 +17,7 @@ use glam::Vec3A;
 use std::f32::consts::PI;
 
 /// A hit seen from the ray that found it.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Interaction<'a> {
     /// The hit.
     pub hit: Hit,
@@ -26,8 +26,12 @@ pub struct Interaction<'a> {
     /// Unit shading normal on the side of `wo` (two-sided shading): the geometric normal, or
     /// the interpolated vertex normal of a smooth triangle.
     pub n: Vec3A,
-    /// The surface's material (in the render's table: an interaction does not copy it).
+    /// The surface's material as the render's table holds it (an interaction does not copy
+    /// it); [`Interaction::material`] is what shades, its textures looked up.
     pub material: &'a Material,
+    /// The material with its textured parameters looked up here, when it has textures (boxed:
+    /// an untextured hit carries one empty pointer).
+    pub textured: Option<Box<Material>>,
     /// Where rays leaving the hit start.
     pub origins: Origins,
     /// The surface's area light, or [`NO_LIGHT`].
@@ -41,6 +45,18 @@ impl<'a> Interaction<'a> {
         let materials: &'a [Material] = tr.materials;
         let wo = -ray.d;
         let prim = tr.geometry.prim(hit.prim);
+        let i = prim.material as usize;
+        let textured = match tr.textures.get(i) {
+            Some(t) if !t.is_empty() => {
+                let uv = tr.geometry.uv(&prim, hit.p);
+                Some(Box::new(t.apply(
+                    &materials[i],
+                    uv,
+                    tr.model == Model::Physical,
+                )))
+            }
+            _ => None,
+        };
         let ng = if hit.n.dot(wo) < 0.0 { -hit.n } else { hit.n };
         // The shading normal stays on the viewer's side of the surface.
         let ns = tr.geometry.shading_normal(&prim, hit.p, ng);
@@ -49,10 +65,17 @@ impl<'a> Interaction<'a> {
             hit,
             wo,
             n,
-            material: &materials[prim.material as usize],
+            material: &materials[i],
+            textured,
             origins: Origins::new(&hit),
             light: prim.light,
         }
+    }
+
+    /// The material that shades here: the table's, its textured parameters looked up.
+    #[inline]
+    pub fn material(&self) -> &Material {
+        self.textured.as_deref().unwrap_or(self.material)
     }
 
     /// A ray leaving the surface in unit direction `w`, started off the surface on `w`'s side.
@@ -64,7 +87,7 @@ impl<'a> Interaction<'a> {
     /// The BSDF `bsdf` of this surface in its local frame: `z` the shading normal turned to
     /// the outside (the geometric normal's side), `x` the shape's tangent made orthogonal to it.
     #[inline]
-    pub fn shading(&self, tr: &Tracer, bsdf: &'a Bsdf) -> Shading<'a> {
+    pub fn shading<'b>(&self, tr: &Tracer, bsdf: &'b Bsdf) -> Shading<'b> {
         let n = if self.n.dot(self.hit.n) < 0.0 {
             -self.n
         } else {
@@ -463,7 +486,7 @@ pub const SHADOW_END: f32 = 1.0 - 1e-4;
 /// entering, `ior` leaving) and reflects under total internal reflection.
 #[inline]
 pub fn specular_bounce(si: &Interaction, effects: Effects) -> Option<(Ray, Vec3A, RayKind)> {
-    match si.material {
+    match si.material() {
         Material::Phong(_) | Material::Bsdf(_) => None,
         Material::Mirror(m) => {
             if !effects.reflection {
@@ -496,7 +519,7 @@ pub fn specular_bounce(si: &Interaction, effects: Effects) -> Option<(Ray, Vec3A
 }
 
 /// Where a chain of mirror and glass bounces ends.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 #[allow(
     clippy::large_enum_variant,
     reason = "returned by value and matched at once by the caller; boxing the Phong variant \
@@ -562,16 +585,14 @@ pub fn follow_specular<'a>(
         if see_first || chain > 0 {
             le += beta * emitted(tr, &si);
         }
-        match si.material {
-            Material::Phong(phong) => {
-                let phong = *phong;
-                return (ChainEnd::Phong { si, phong, beta }, le);
-            }
-            Material::Bsdf(bsdf) => {
-                let shading = si.shading(tr, bsdf);
-                return (ChainEnd::Bsdf { si, shading, beta }, le);
-            }
-            _ => {}
+        // Phong as textured here; a BSDF (never textured) from the table, which outlives `si`.
+        if let Material::Phong(phong) = si.material() {
+            let phong = *phong;
+            return (ChainEnd::Phong { si, phong, beta }, le);
+        }
+        if let Material::Bsdf(bsdf) = si.material {
+            let shading = si.shading(tr, bsdf);
+            return (ChainEnd::Bsdf { si, shading, beta }, le);
         }
         if chain == max_specular {
             break;

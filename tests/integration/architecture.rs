@@ -15,6 +15,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("shape", 1),
     ("material", 1),
     ("light", 1),
+    ("texture", 1),
     ("camera", 1),
     ("accel", 2),
     ("shader", 3),

@@ -1,5 +1,8 @@
 //! Texture coordinates (src/accel/mod.rs, `Geometry::uv`), Mitsuba 3's conventions: exact
-//! values at known points of every shape, through a ray that hits there.
+//! values at known points of every shape, through a ray that hits there (each shape textured:
+//! only a textured shape keeps its corners' coordinates). Textures
+//! (src/texture/): the checkerboard at known points, an image's texels decoded from sRGB or
+//! raw, a texture's mean over its shape, an image read once, and located errors.
 
 use crate::common::scene;
 use glam::{Vec2, Vec3A};
@@ -26,7 +29,7 @@ fn close(a: Vec2, b: Vec2) -> bool {
 /// its centre: +x at (0, 1/2), +y a quarter round, -x half, -y three quarters, +z the pole.
 #[test]
 fn sphere_coordinates() {
-    let e = "(shape: Sphere(center: (1, 2, 3), radius: 2), material: Phong(kd: (1, 1, 1)))";
+    let e = "(shape: Sphere(center: (1, 2, 3), radius: 2), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))";
     let c = Vec3A::new(1.0, 2.0, 3.0);
     for (d, want) in [
         (Vec3A::X, Vec2::new(0.0, 0.5)),
@@ -48,14 +51,14 @@ fn sphere_coordinates() {
 #[test]
 fn rectangle_and_triangle_coordinates() {
     let rect = "(shape: Rectangle(corner: (-1, -1, 5), u: (2, 0, 0), v: (0, 3, 0)),
-                 material: Phong(kd: (1, 1, 1)))";
+                 material: Phong(kd: Checkerboard(color0: (1, 1, 1))))";
     for (s, t) in [(0.25f32, 0.5f32), (0.75, 0.25), (0.1, 0.9)] {
         let p = Vec3A::new(-1.0 + 2.0 * s, -1.0 + 3.0 * t, 5.0);
         let uv = uv_at(rect, Vec3A::ZERO, p);
         assert!(close(uv, Vec2::new(s, t)), "({s}, {t}): {uv}");
     }
     let mirrored = "(shape: Rectangle(corner: (-1, -1, 5), u: (2, 0, 0), v: (0, 3, 0)),
-                     material: Phong(kd: (1, 1, 1)),
+                     material: Phong(kd: Checkerboard(color0: (1, 1, 1))),
                      transform: (scale: (-1, 1, 1)))";
     // Mirrored in x, the point (s, t) lands at x = -(-1 + 2 s).
     let p = Vec3A::new(1.0 - 2.0 * 0.25, -1.0 + 3.0 * 0.5, 5.0);
@@ -63,7 +66,7 @@ fn rectangle_and_triangle_coordinates() {
     assert!(close(uv, Vec2::new(0.25, 0.5)), "mirrored: {uv}");
 
     let tri = "(shape: Triangle(a: (0, 0, 4), b: (2, 0, 4), c: (0, 2, 4)),
-                material: Phong(kd: (1, 1, 1)))";
+                material: Phong(kd: Checkerboard(color0: (1, 1, 1))))";
     let p = Vec3A::new(2.0 * 0.2, 2.0 * 0.3, 4.0);
     let uv = uv_at(tri, Vec3A::ZERO, p);
     assert!(close(uv, Vec2::new(0.2, 0.3)), "triangle: {uv}");
@@ -74,11 +77,11 @@ fn rectangle_and_triangle_coordinates() {
 #[test]
 fn plane_coordinates() {
     let floor = "(shape: InfinitePlane(point: (1, -1, 2), normal: (0, 1, 0)),
-                  material: Phong(kd: (1, 1, 1)))";
+                  material: Phong(kd: Checkerboard(color0: (1, 1, 1))))";
     let uv = uv_at(floor, Vec3A::new(3.0, 1.0, -1.0), -Vec3A::Y);
     assert!(close(uv, Vec2::new(2.0, -3.0)), "floor: {uv}");
     let wall = "(shape: InfinitePlane(point: (5, 0, 0), normal: (-1, 0.2, 0)),
-                 material: Phong(kd: (1, 1, 1)))";
+                 material: Phong(kd: Checkerboard(color0: (1, 1, 1))))";
     // The ray meets the wall at (5.1, 0.5, 1.5); the wall's u is z and its v is y, from its
     // point (5, 0, 0).
     let uv = uv_at(wall, Vec3A::new(0.0, 0.5, 1.5), Vec3A::X);
@@ -97,7 +100,7 @@ fn mesh_coordinates_flip_v() {
     )
     .unwrap();
     let e = format!(
-        "(shape: Mesh(path: {:?}), material: Phong(kd: (1, 1, 1)))",
+        "(shape: Mesh(path: {:?}), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))",
         obj
     );
     // At the first vertex's corner: (0.1, 1 - 0.2); half-way along the second edge.
@@ -111,4 +114,170 @@ fn mesh_coordinates_flip_v() {
         (uv - Vec2::new(0.9, 0.5)).abs().max_element() < 1e-3,
         "{uv}"
     );
+}
+
+/// `entities` seen from above, lit by a sun straight down of irradiance pi under the Physical
+/// model: on a Lambertian floor each pixel's radiance is exactly the `kd` at its centre.
+fn floor_kd(entities: &str) -> rtis::render::film::Image {
+    let text = format!(
+        "Scene(film: (width: 8, height: 8, spp: 1), shader: Direct(), model: Physical,
+               camera: Orthographic(position: (0, 5, 0), look_at: (0, 0, 0), up: (0, 0, 1),
+                                    height: 4),
+               entities: [{entities}
+                 (light: Directional(direction: (0, -1, 0), irradiance: (3.14159265, 3.14159265, 3.14159265)))])"
+    );
+    crate::common::render_str(&text).image
+}
+
+/// The checkerboard on a floor (its coordinates `(x, z)` from the plane's point): `color0`
+/// where the fractional parts are both below or both above 1/2, `color1` elsewhere, at every
+/// pixel centre (one pixel is half a unit).
+#[test]
+fn checkerboard_at_known_points() {
+    let img = floor_kd(
+        "(shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+          material: Phong(kd: Checkerboard(color0: (0.9, 0.8, 0.7), color1: (0.1, 0.2, 0.3)))),",
+    );
+    for row in 0..8u32 {
+        for col in 0..8u32 {
+            let (x, z) = (
+                (col as f32 + 0.5 - 4.0) * 0.5,
+                (4.0 - row as f32 - 0.5) * 0.5,
+            );
+            let (fx, fz) = (x - x.floor(), z - z.floor());
+            let want = if (fx > 0.5) == (fz > 0.5) { 0.9 } else { 0.1 };
+            let got = img.get(col, row).x;
+            assert!(
+                (got - want).abs() < 1e-5,
+                "({col}, {row}) at ({x}, {z}): {got}"
+            );
+        }
+    }
+}
+
+/// Write a `w x h` image of 8-bit codes `code(x, y)` (grey) as PNG, and return its path.
+fn grey_png(name: &str, w: u32, h: u32, code: impl Fn(u32, u32) -> u8) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("rtis-tex-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("image.png");
+    image::GrayImage::from_fn(w, h, |x, y| image::Luma([code(x, y)]))
+        .save(&path)
+        .unwrap();
+    path
+}
+
+/// A rectangle filling the view from above, its corner at the picture's top left: texture
+/// coordinates `((col + 1/2) / 8, (row + 1/2) / 8)` at pixel `(col, row)`.
+fn rectangle(kd: &str) -> String {
+    format!(
+        "(shape: Rectangle(corner: (-2, 0, 2), u: (4, 0, 0), v: (0, 0, -4)),
+          material: Phong(kd: {kd})),"
+    )
+}
+
+/// An 8-bit PNG, nearest texel: each pixel is its texel's sRGB code decoded (IEC 61966-2-1),
+/// the image's top row at `v = 0`; with `raw: true`, the code over 255.
+#[test]
+fn image_texels_decode_from_srgb_or_raw() {
+    let codes = [[0u8, 10, 128, 255], [64, 200, 30, 100]];
+    let path = grey_png("codes", 4, 2, |x, y| codes[y as usize][x as usize]);
+    for raw in [false, true] {
+        let kd = format!("Image(path: {path:?}, filter: Nearest, raw: {raw})");
+        let img = floor_kd(&rectangle(&kd));
+        for row in 0..8u32 {
+            for col in 0..8u32 {
+                let c = codes[(row / 4) as usize][(col / 2) as usize] as f32 / 255.0;
+                let want = if raw {
+                    c
+                } else {
+                    rtis::raster::srgb_to_linear(c)
+                };
+                let got = img.get(col, row).x;
+                assert!(
+                    (got - want).abs() < 1e-5,
+                    "raw {raw}, ({col}, {row}): {got} vs {want}"
+                );
+            }
+        }
+    }
+}
+
+/// A texture's mean over its rectangle is the image's mean: with repeat, the bilinear
+/// interpolant's integral over the unit square is the texels' mean, and the render of the
+/// rectangle filling the view (16 stratified samples a pixel) estimates it.
+#[test]
+fn a_textures_mean_over_its_shape_is_the_images() {
+    let code = |x: u32, y: u32| ((x * 37 + y * 101 + x * y * 13) % 256) as u8;
+    let path = grey_png("mean", 16, 16, code);
+    let want: f64 = (0..16)
+        .flat_map(|y| (0..16).map(move |x| (x, y)))
+        .map(|(x, y)| rtis::raster::srgb_to_linear(code(x, y) as f32 / 255.0) as f64)
+        .sum::<f64>()
+        / 256.0;
+    let text = format!(
+        "Scene(film: (width: 64, height: 64, spp: 16), shader: Direct(), model: Physical,
+               camera: Orthographic(position: (0, 5, 0), look_at: (0, 0, 0), up: (0, 0, 1),
+                                    height: 4),
+               entities: [{}
+                 (light: Directional(direction: (0, -1, 0), irradiance: (3.14159265, 3.14159265, 3.14159265)))])",
+        rectangle(&format!("Image(path: {path:?})"))
+    );
+    let r = crate::common::render_str(&text);
+    let (mean, _) = crate::common::mean_and_se(&r);
+    assert!((mean - want).abs() < 2e-3 * want, "{mean} against {want}");
+}
+
+/// An image named by two materials is read once: both textures hold the same texels.
+#[test]
+fn an_image_is_read_once() {
+    let path = grey_png("once", 2, 2, |x, _| (x * 100) as u8);
+    let text = format!(
+        "Scene(entities: [
+            (shape: Sphere(center: (0, 0, 3), radius: 1), material: Phong(kd: Image(path: {path:?}))),
+            (shape: Sphere(center: (3, 0, 3), radius: 1), material: Mirror(color: Image(path: {path:?}))),
+            (light: Point(position: (0, 3, 0), intensity: (1, 1, 1)))])"
+    );
+    let s = scene(&text);
+    let rasters: Vec<_> = s
+        .world
+        .query::<&rtis::texture::MaterialTextures>()
+        .iter()
+        .filter_map(|t| match &t.reflectance.as_ref()?.kind {
+            rtis::texture::TextureKind::Image(i) => Some(i.raster.clone()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(rasters.len(), 2);
+    assert!(std::sync::Arc::ptr_eq(&rasters[0], &rasters[1]));
+}
+
+/// Located errors: a missing image names the file and the system's reason; a value that is
+/// neither a reflectance nor a texture says what each looks like; a uv_transform beyond 1e9.
+#[test]
+fn texture_errors_are_located() {
+    let err = |kd: &str| {
+        let text = format!(
+            "Scene(entities: [(shape: Sphere(center: (0, 0, 3), radius: 1),\n  material: Phong(kd: {kd}))])"
+        );
+        rtis::scene::load_str(&text, "t.ron", None)
+            .err()
+            .unwrap()
+            .to_string()
+    };
+    let e = err("Image(path: \"no-such.png\")");
+    assert!(e.contains("t.ron:2:") && e.contains("no-such.png"), "{e}");
+    assert!(e.to_lowercase().contains("no such file"), "{e}");
+    let e = err("Checkerboard()");
+    assert!(e.contains("give one"), "{e}");
+    let e = err("Checker(color0: (1, 1, 1))");
+    assert!(
+        e.contains("`Checker` is not a texture") && e.contains("Image(path:"),
+        "{e}"
+    );
+    let e = err("(2, 0, 0)");
+    assert!(e.contains("`kd`: reflectance (2, 0, 0) out of range"), "{e}");
+    let e = err("(0.5, 0.5)");
+    assert!(e.contains("expected 3 values, found 2"), "{e}");
+    let e = err("Checkerboard(uv_transform: (scale: (1e10, 1)))");
+    assert!(e.contains("within 1e9"), "{e}");
 }

@@ -45,13 +45,15 @@ const GROUP_NODES: usize = 512;
 /// True if the waves give the depth-first walk's result, and fit their memory bounds: there is
 /// a tree to trace (`D >= 1`), no hit draws random numbers (no area-light samples), one
 /// sample's tree has at most [`MAX_NODES`] nodes, and there are at most [`MAX_LIGHTS`] point
-/// lights, and no environment light (the waves' escaped rays see the background).
+/// lights, no environment light (the waves' escaped rays see the background), and no texture
+/// (the waves read a hit's material from its primitive).
 pub fn applies(tr: &Tracer, g: &Global) -> bool {
     let draws = tr.effects.emission && !tr.emitters.is_empty() && g.light_samples > 0;
     let sky = tr.effects.emission && tr.emitters.environment.is_some();
     g.max_depth >= 1
         && !draws
         && !sky
+        && tr.textures.is_empty()
         && nodes_per_sample(g) <= MAX_NODES
         && tr.lights.len() <= MAX_LIGHTS
 }

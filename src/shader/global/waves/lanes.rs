@@ -405,6 +405,8 @@ unsafe fn chunk<L: Floats>(
                 wo: -vec3(&dv, 0, i),
                 n: vec3(&v, NS, i),
                 material: &materials[e.material as usize],
+                // The waves do not run where materials have textures.
+                textured: None,
                 origins: Origins {
                     front: vec3(&v, FRONT, i),
                     back: vec3(&v, BACK, i),
