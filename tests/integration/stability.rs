@@ -122,6 +122,29 @@ fn cases(default: u32) -> u32 {
         .unwrap_or(default)
 }
 
+/// A PNG of `w x 1` texels of varied codes, written once per test run; its path.
+fn texture_file(w: u32) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("rtis-stability-{}", std::process::id()));
+    let path = dir.join(format!("row{w}.png"));
+    if !path.exists() {
+        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = dir.join(format!("row{w}.{}.png", rand_suffix()));
+        image::RgbImage::from_fn(w, 1, |x, _| {
+            image::Rgb([(x % 256) as u8, (x * 7 % 256) as u8, 255 - (x % 256) as u8])
+        })
+        .save(&tmp)
+        .unwrap();
+        // Written aside and renamed, so that tests on other threads never read half a file.
+        std::fs::rename(&tmp, &path).unwrap();
+    }
+    path
+}
+
+/// A number unique to this thread, for temporary names.
+fn rand_suffix() -> String {
+    format!("{:?}", std::thread::current().id()).replace(|c: char| !c.is_ascii_alphanumeric(), "")
+}
+
 mod random_scenes {
     use super::*;
     use proptest::prelude::*;
@@ -167,6 +190,21 @@ mod random_scenes {
                     num(s)
                 )),
             rgb01().prop_map(|c| format!("Mirror(color: {c})")),
+            // Textures: a checkerboard at extreme scales, and images of 1x1 and 8192x1 texels
+            // (each filter and wrap), on Phong, a mirror and glass.
+            (
+                prop_oneof![
+                    Just("Checkerboard(color0: (1, 1, 1), color1: (0, 0, 0), uv_transform: (scale: (1e6, 1e-6), rotate: 33))".to_string()),
+                    Just(format!("Image(path: {:?}, filter: Nearest, wrap: Mirror)", texture_file(1))),
+                    Just(format!("Image(path: {:?}, wrap: Clamp, raw: true)", texture_file(8192))),
+                ],
+                0u8..3,
+            )
+                .prop_map(|(t, m)| match m {
+                    0 => format!("Phong(kd: {t}, ks: {t}, shininess: 10)"),
+                    1 => format!("Mirror(color: {t})"),
+                    _ => format!("Transmissive(ior: 1.5, color: {t})"),
+                }),
             // Metals: three named ones (a mirror among them), and eta and k at the ends of
             // their range, 0 to 1000 (eta 0 with k 0 reflects everything at every angle).
             (

@@ -275,7 +275,10 @@ fn texture_errors_are_located() {
         "{e}"
     );
     let e = err("(2, 0, 0)");
-    assert!(e.contains("`kd`: reflectance (2, 0, 0) out of range"), "{e}");
+    assert!(
+        e.contains("`kd`: reflectance (2, 0, 0) out of range"),
+        "{e}"
+    );
     let e = err("(0.5, 0.5)");
     assert!(e.contains("expected 3 values, found 2"), "{e}");
     let e = err("Checkerboard(uv_transform: (scale: (1e10, 1)))");
@@ -299,7 +302,10 @@ fn textures_match_mitsuba() {
     let (mse, explained) =
         crate::common::block_mse(&a.image, &b.image, &r, 0.002932, &|_, _| false);
     eprintln!("textures: block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}");
-    assert!(mse < 1.5 * explained, "block MSE {mse:.3e} vs {explained:.3e}");
+    assert!(
+        mse < 1.5 * explained,
+        "block MSE {mse:.3e} vs {explained:.3e}"
+    );
     let mean = Vec3A::new(0.382143, 0.425077, 0.420579);
     let m = (a.image.mean() + b.image.mean()) * 0.5;
     assert!(
