@@ -12,6 +12,9 @@ filter. Mitsuba's rectangles are placed by a `to_world` whose axes are rtis's `u
 about their centre, so their `(u, v)` run from the corner as rtis's do; Mitsuba's spheres have
 their poles on `z`, as rtis's.
 
+With `--filter gaussian` both use Mitsuba's default pixel filter, `gaussian` (stddev 0.5), and
+the files are tests/data/texture_gaussian.ron and mitsuba_texture_gaussian_<W>x<H>_spp<N>.exr.
+
 It writes tests/data/mitsuba_texture_<W>x<H>_spp<N>.exr (linear float32 RGB, Mitsuba's
 orientation: flip left-right before comparing with rtis) and a .json beside it with the
 version, variant, spp, seconds, the image mean and `noise_rmse`. tests/integration/textures.rs
@@ -20,7 +23,7 @@ compares rtis with it.
 Setup: pip install mitsuba numpy; apt-get install libllvm19 (else --variant scalar_rgb).
 
 Usage:
-    python3 bench/mitsuba_texture_reference.py [--spp 4096] [--variant llvm_ad_rgb]
+    python3 bench/mitsuba_texture_reference.py [--spp 4096] [--variant llvm_ad_rgb] [--filter gaussian]
 """
 
 import argparse
@@ -73,14 +76,17 @@ def rect_to_world(mi, corner, u, v):
     return mi.ScalarTransform4f(m.tolist())
 
 
-def mitsuba_dict(mi, spp, seed=0):
+def mitsuba_dict(mi, spp, seed=0, gaussian=False):
     rgb = lambda c: {"type": "rgb", "value": c}
+    camera = sensor(mi, "perspective", EYE, TARGET, UP, FOV, WIDTH, HEIGHT, spp, seed)
+    if gaussian:
+        camera["film"]["rfilter"] = {"type": "gaussian", "stddev": 0.5}
     bitmap = {"type": "bitmap", "filename": TEXTURE, "filter_type": "bilinear", "wrap_mode": "repeat"}
     c0, c1, scale = CHECKS
     return {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
-        "sensor": sensor(mi, "perspective", EYE, TARGET, UP, FOV, WIDTH, HEIGHT, spp, seed),
+        "sensor": camera,
         "sky": {"type": "constant", "radiance": rgb(SKY)},
         "sun": {"type": "directional", "direction": SUN[0], "irradiance": rgb(SUN[1])},
         "floor": {"type": "rectangle", "to_world": rect_to_world(mi, *FLOOR),
@@ -94,15 +100,16 @@ def mitsuba_dict(mi, spp, seed=0):
     }
 
 
-def rtis_scene(spp):
+def rtis_scene(spp, gaussian=False):
     c0, c1, scale = CHECKS
+    pixel_filter = ", filter: Gaussian(stddev: 0.5)" if gaussian else ""
     image = 'Image(path: "texture.png")'
     return "\n".join([
         "// Written by bench/mitsuba_texture_reference.py; Mitsuba 3's image of the same scene is",
         "// beside it (tests/integration/textures.rs compares them). A checkerboard floor, and a",
         "// sphere and a panel wearing tests/data/texture.png, under a constant sky and a sun.",
         "Scene(",
-        f"    film: (width: {WIDTH}, height: {HEIGHT}, spp: {spp}),",
+        f"    film: (width: {WIDTH}, height: {HEIGHT}, spp: {spp}{pixel_filter}),",
         f"    camera: Perspective(position: {tup(EYE)}, look_at: {tup(TARGET)}, up: {tup(UP)}, "
         f"fov: {num(FOV)}),",
         "    shader: Path(rr_depth: 5),",
@@ -127,18 +134,21 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--spp", type=int, default=4096)
     ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--filter", choices=["box", "gaussian"], default="box")
     args = ap.parse_args()
+    gaussian = args.filter == "gaussian"
+    tag = "texture_gaussian" if gaussian else "texture"
     if args.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ:
         os.environ["DRJIT_LIBLLVM_PATH"] = LIBLLVM
     import mitsuba as mi
 
     mi.set_variant(args.variant)
     mi.Bitmap(texture_codes(), pixel_format=mi.Bitmap.PixelFormat.RGB).write(TEXTURE)
-    with open(os.path.join(ROOT, "tests/data", "texture.ron"), "w") as f:
-        f.write(rtis_scene(64))
-    img, half_rmse, seconds = render_halves(mi, lambda n, seed: mitsuba_dict(mi, n, seed), args.spp,
-                                            WIDTH, HEIGHT)
-    stem = os.path.join(ROOT, "tests/data", f"mitsuba_texture_{WIDTH}x{HEIGHT}_spp{args.spp}")
+    with open(os.path.join(ROOT, "tests/data", f"{tag}.ron"), "w") as f:
+        f.write(rtis_scene(64, gaussian))
+    img, half_rmse, seconds = render_halves(mi, lambda n, seed: mitsuba_dict(mi, n, seed, gaussian),
+                                            args.spp, WIDTH, HEIGHT)
+    stem = os.path.join(ROOT, "tests/data", f"mitsuba_{tag}_{WIDTH}x{HEIGHT}_spp{args.spp}")
     meta = write_reference(mi, stem, img, half_rmse, seconds, args.variant, args.spp)
     print(json.dumps(meta))
 
