@@ -14,8 +14,8 @@ use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
 use crate::shader::Shader;
 use crate::shape::{Corners, Shape};
-use crate::texture::MaterialTextures;
-use crate::world::{Name, Scene, Transform, WorldEnvironment, WorldLight, WorldShape};
+use crate::texture::{Footprint, MaterialTextures};
+use crate::world::{Name, Projection, Scene, Transform, WorldEnvironment, WorldLight, WorldShape};
 use glam::Vec3A;
 
 /// Build the render data of a loaded scene.
@@ -213,6 +213,20 @@ pub fn extract(scene: &Scene) -> RenderScene {
         camera,
         geometry,
         materials,
+        footprint: {
+            // A pixel's angle (perspective) or height (orthographic).
+            let rows = s.film.height as f32;
+            match s.camera.projection {
+                Projection::Perspective { fov, .. } => Footprint {
+                    spread: 2.0 * (fov.to_radians() as f32 / 2.0).tan() / rows,
+                    base: 0.0,
+                },
+                Projection::Orthographic { height } => Footprint {
+                    spread: 0.0,
+                    base: height as f32 / rows,
+                },
+            }
+        },
         // Kept only when some material is textured: shading then looks them up.
         textures: if textures.iter().all(MaterialTextures::is_empty) {
             Vec::new()

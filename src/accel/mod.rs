@@ -546,6 +546,42 @@ impl Geometry {
     }
 }
 
+impl Geometry {
+    /// How fast the texture coordinates change along the surface of `prim` at `p`: the
+    /// largest of `|grad u|` and `|grad v|` there, per scene unit (a footprint's width in
+    /// coordinates is its width in scene units times this).
+    #[inline]
+    pub fn uv_rate(&self, prim: &Prim, p: glam::Vec3A) -> f32 {
+        match prim.shape {
+            Shape::Plane(_) => 1.0,
+            Shape::Sphere(s) => {
+                // u turns once around a circle of radius r sin(theta), v half a great circle.
+                let d = ((p - s.c) / s.r).clamp(glam::Vec3A::splat(-1.0), glam::Vec3A::ONE);
+                let sin = (1.0 - d.z * d.z).max(0.0).sqrt().max(1e-3);
+                let tau = std::f32::consts::TAU;
+                (1.0 / (tau * s.r * sin)).max(2.0 / (tau * s.r))
+            }
+            Shape::Triangle(t) => {
+                // grad b1 and grad b2 in the triangle's plane, then u and v by their corners.
+                let (e1, e2) = (t.v[1] - t.v[0], t.v[2] - t.v[0]);
+                let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+                let det = d00 * d11 - d01 * d01;
+                let g1 = (d11 * e1 - d01 * e2) / det;
+                let g2 = (d00 * e2 - d01 * e1) / det;
+                let [t0, t1, t2] = match self.uvs.get(prim.smooth as usize) {
+                    Some(&c) if prim.smooth != FLAT => c,
+                    _ => [glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y],
+                };
+                let (a, b) = (t1 - t0, t2 - t0);
+                let gu = a.x * g1 + b.x * g2;
+                let gv = a.y * g1 + b.y * g2;
+                let rate = gu.length().max(gv.length());
+                if rate.is_finite() { rate } else { 0.0 }
+            }
+        }
+    }
+}
+
 /// The barycentric coordinates `(b1, b2)` of point `p` in triangle `t` (the weights of its
 /// second and third vertices), by the normal equations of `p - v0 = b1 e1 + b2 e2`.
 #[inline]

@@ -11,6 +11,7 @@ use crate::material::{Material, Model};
 use crate::render::{RenderScene, film::Image, render};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
 use crate::shader::{Global, Path, Shader};
+use crate::texture::{TexelFilter, TextureKind, mip_levels};
 use std::fmt::Write as _;
 
 /// One setting of the ladder.
@@ -26,6 +27,8 @@ pub struct Rung {
     pub spp: u32,
     /// The microfacet normals every rough material samples in this rung, if not its own.
     pub normals: Option<NormalSampling>,
+    /// The lookup every image texture uses in this rung, if not its own.
+    pub texture_filter: Option<TexelFilter>,
 }
 
 /// The result of one rung.
@@ -85,7 +88,28 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
         shader,
         spp,
         normals: None,
+        texture_filter: None,
     };
+    // Image textures: the scene's shader at growing spp with every image looked up bilinearly
+    // (unfiltered) and trilinearly (by the footprint), against the supersampled reference.
+    if scene.textures.iter().any(|t| {
+        [&t.reflectance, &t.specular]
+            .into_iter()
+            .flatten()
+            .any(|t| matches!(t.kind, TextureKind::Image(_)))
+    }) {
+        for (family, filter) in [
+            ("Texture bilinear", TexelFilter::Bilinear),
+            ("Texture trilinear", TexelFilter::Trilinear),
+        ] {
+            for spp in [1, 4, 16, 64] {
+                rungs.push(Rung {
+                    texture_filter: Some(filter),
+                    ..rung(family, format!("spp={spp}"), scene.shader, spp)
+                });
+            }
+        }
+    }
     match scene.shader {
         Shader::Path(p) => {
             let physical = scene.model == Model::Physical;
@@ -275,6 +299,18 @@ pub fn sweep(
         if let Some(normals) = r.normals {
             for m in s.materials.iter_mut().filter_map(microfacet_mut) {
                 m.sampling = normals;
+            }
+        }
+        if let Some(filter) = r.texture_filter {
+            for t in s.textures.iter_mut() {
+                for tex in [&mut t.reflectance, &mut t.specular].into_iter().flatten() {
+                    if let TextureKind::Image(i) = &mut tex.kind {
+                        if filter == TexelFilter::Trilinear && i.mips.is_empty() {
+                            i.mips = std::sync::Arc::new(mip_levels(&i.raster));
+                        }
+                        i.filter = filter;
+                    }
+                }
             }
         }
         let mut times = Vec::new();

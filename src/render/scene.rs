@@ -9,7 +9,7 @@ use crate::material::{Material, Model};
 use crate::sampling::{PixelFilter, Sampler};
 use crate::shader::{RayAudit, Shader, Tracer};
 use crate::stats::RayStats;
-use crate::texture::MaterialTextures;
+use crate::texture::{Footprint, MaterialTextures};
 use glam::{DVec3, Vec3A};
 
 /// Largest image side in pixels.
@@ -87,6 +87,9 @@ pub struct RenderScene {
     pub materials: Vec<Material>,
     /// Their textures at the same indices, or empty when no material is textured.
     pub textures: Vec<MaterialTextures>,
+    /// A pixel's footprint on surfaces, from the camera and the film ([`Footprint`]); each
+    /// sample's is this over the square root of the film's spp.
+    pub footprint: Footprint,
     /// Point lights.
     pub lights: Vec<Light>,
     /// Area lights (emitting primitives), chosen by power.
@@ -158,6 +161,7 @@ impl RenderScene {
             geometry: &self.geometry,
             materials: &self.materials,
             textures: &self.textures,
+            footprint: self.footprint.per_sample(self.film.spp),
             lights: &self.lights,
             emitters: &self.emitters,
             background: self.background,

@@ -27,7 +27,7 @@ use crate::shader::{Global, Path, Shader};
 use crate::shape::WorldShape;
 use crate::texture::{
     Checkerboard, ImageTexture, MaterialTextures, TexelFilter, Texture, TextureKind, UvTransform,
-    Wrap,
+    Wrap, mip_levels,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -708,7 +708,7 @@ pub enum TextureDesc {
     Image {
         /// The image file.
         path: String,
-        /// `Bilinear` (default) or `Nearest`.
+        /// `Bilinear` (default), `Nearest` or `Trilinear` (MIP levels by the footprint).
         #[serde(default)]
         filter: TexelFilter,
         /// `Repeat` (default), `Clamp` or `Mirror`.
@@ -806,8 +806,14 @@ impl TextureDesc {
             } => Texture {
                 kind: TextureKind::Image({
                     let (raster, source) = load(path, *raw)?;
+                    // The MIP pyramid, for trilinear lookups only.
+                    let mips = match filter {
+                        TexelFilter::Trilinear => mip_levels(&raster),
+                        _ => Vec::new(),
+                    };
                     ImageTexture {
                         raster,
+                        mips: Arc::new(mips),
                         source,
                         raw: *raw,
                         filter: *filter,

@@ -23,7 +23,7 @@ use crate::light::{Emitters, Light};
 use crate::material::{Material, Model};
 use crate::sampling::Sampler;
 use crate::stats::{RayKind, RayStats};
-use crate::texture::MaterialTextures;
+use crate::texture::{Footprint, MaterialTextures};
 use glam::Vec3A;
 
 /// Longest chain of consecutive mirror/glass bounces any shader follows.
@@ -75,6 +75,8 @@ pub struct Tracer<'a> {
     pub materials: &'a [Material],
     /// The textures of the materials at the same indices (empty when none is textured).
     pub textures: &'a [MaterialTextures],
+    /// A sample's footprint on surfaces, for filtering textures.
+    pub footprint: Footprint,
     /// Point lights.
     pub lights: &'a [Light],
     /// Area lights, indexed by `Prim::light`.

@@ -49,9 +49,12 @@ impl<'a> Interaction<'a> {
         let textured = match tr.textures.get(i) {
             Some(t) if !t.is_empty() => {
                 let uv = tr.geometry.uv(&prim, hit.p);
+                // The footprint of the sample here, in texture coordinates.
+                let width = tr.footprint.width(hit.p, hit.n) * tr.geometry.uv_rate(&prim, hit.p);
                 Some(Box::new(t.apply(
                     &materials[i],
                     uv,
+                    width,
                     tr.model == Model::Physical,
                 )))
             }

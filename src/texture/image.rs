@@ -17,6 +17,9 @@ pub enum TexelFilter {
     /// The four nearest texels, weighted by distance (Mitsuba's default).
     #[default]
     Bilinear,
+    /// Bilinear in the two MIP levels whose texels best match the hit's footprint, blended
+    /// (pbrt-v4's `Trilinear`): a far, dense image averages instead of aliasing.
+    Trilinear,
 }
 
 /// What lies beyond the image's edges.
@@ -60,33 +63,82 @@ pub struct ImageTexture {
     pub filter: TexelFilter,
     /// Beyond the edges.
     pub wrap: Wrap,
+    /// Levels 1, 2, ... of the MIP pyramid (each half the last, rounded up, by 2x2 box
+    /// averages), built for [`TexelFilter::Trilinear`] only; empty otherwise.
+    pub mips: Arc<Vec<Raster>>,
+}
+
+/// The MIP levels above `raster`: each half the one below (rounded up) on each side, its texel
+/// the mean of the (up to) four below it, down to 1x1. A third more memory than the image.
+pub fn mip_levels(raster: &Raster) -> Vec<Raster> {
+    let mut levels: Vec<Raster> = Vec::new();
+    loop {
+        let below = levels.last().unwrap_or(raster);
+        let (w, h) = (below.width, below.height);
+        if w == 1 && h == 1 {
+            return levels;
+        }
+        let (w2, h2) = (w.div_ceil(2), h.div_ceil(2));
+        let mut texels = Vec::with_capacity(w2 * h2);
+        for j in 0..h2 {
+            for i in 0..w2 {
+                let mut sum = [0.0f32; 3];
+                let mut n = 0.0;
+                for y in 2 * j..(2 * j + 2).min(h) {
+                    for x in 2 * i..(2 * i + 2).min(w) {
+                        let t = below.at(x, y);
+                        (0..3).for_each(|c| sum[c] += t[c]);
+                        n += 1.0;
+                    }
+                }
+                texels.push(sum.map(|s| s / n));
+            }
+        }
+        let next = Raster::new(w2, h2, texels).expect("a level of at least 1x1 texels");
+        levels.push(next);
+    }
 }
 
 impl ImageTexture {
-    /// The colour at `uv`.
+    /// The colour at `uv`, for a footprint `width` wide in texture coordinates (read by
+    /// [`TexelFilter::Trilinear`] only).
     #[inline]
-    pub fn eval(&self, uv: Vec2) -> Vec3A {
-        let (w, h) = (self.raster.width, self.raster.height);
-        let texel = |i: i64, j: i64| {
-            Vec3A::from(self.raster.at(self.wrap.index(i, w), self.wrap.index(j, h)))
-        };
-        let x = uv.x as f64 * w as f64;
-        let y = uv.y as f64 * h as f64;
+    pub fn eval(&self, uv: Vec2, width: f32) -> Vec3A {
         match self.filter {
-            TexelFilter::Nearest => texel(x.floor() as i64, y.floor() as i64),
-            TexelFilter::Bilinear => {
-                let (x, y) = (x - 0.5, y - 0.5);
-                let (x0, y0) = (x.floor(), y.floor());
-                let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-                let (i, j) = (x0 as i64, y0 as i64);
-                let top = texel(i, j) * (1.0 - fx) + texel(i + 1, j) * fx;
-                let bottom = texel(i, j + 1) * (1.0 - fx) + texel(i + 1, j + 1) * fx;
-                top * (1.0 - fy) + bottom * fy
+            TexelFilter::Nearest => {
+                let (w, h) = (self.raster.width, self.raster.height);
+                let (x, y) = (uv.x as f64 * w as f64, uv.y as f64 * h as f64);
+                let (i, j) = (x.floor() as i64, y.floor() as i64);
+                Vec3A::from(self.raster.at(self.wrap.index(i, w), self.wrap.index(j, h)))
+            }
+            TexelFilter::Bilinear => bilinear(&self.raster, self.wrap, uv),
+            TexelFilter::Trilinear => {
+                // The level whose texels are as wide as the footprint: log2 of the footprint in
+                // level-0 texels (of the longer side), between the finest and the coarsest.
+                let texels = width * self.raster.width.max(self.raster.height) as f32;
+                let top = self.mips.len() as f32;
+                let level = if texels > 1.0 {
+                    texels.log2().min(top)
+                } else {
+                    0.0
+                };
+                let l0 = level.floor() as usize;
+                let t = level - l0 as f32;
+                let at = |l: usize| match l {
+                    0 => &*self.raster,
+                    _ => &self.mips[(l - 1).min(self.mips.len() - 1)],
+                };
+                let a = bilinear(at(l0), self.wrap, uv);
+                if t == 0.0 {
+                    a
+                } else {
+                    a * (1.0 - t) + bilinear(at(l0 + 1), self.wrap, uv) * t
+                }
             }
         }
     }
 
-    /// The largest channel of any texel.
+    /// The largest channel of any texel (every MIP level is a mean of them).
     pub fn max_value(&self) -> f32 {
         self.raster
             .texels
@@ -96,6 +148,21 @@ impl ImageTexture {
     }
 }
 
+/// `raster` at `uv`, bilinear between the texel centres, beyond the edges by `wrap`.
+#[inline]
+fn bilinear(raster: &Raster, wrap: Wrap, uv: Vec2) -> Vec3A {
+    let (w, h) = (raster.width, raster.height);
+    let texel = |i: i64, j: i64| Vec3A::from(raster.at(wrap.index(i, w), wrap.index(j, h)));
+    let x = uv.x as f64 * w as f64 - 0.5;
+    let y = uv.y as f64 * h as f64 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+    let (i, j) = (x0 as i64, y0 as i64);
+    let top = texel(i, j) * (1.0 - fx) + texel(i + 1, j) * fx;
+    let bottom = texel(i, j + 1) * (1.0 - fx) + texel(i + 1, j + 1) * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -103,8 +170,10 @@ mod tests {
     fn image(filter: TexelFilter, wrap: Wrap) -> ImageTexture {
         // A 2x2 image: 0 and 1 on top, 2 and 3 below.
         let texels = (0..4).map(|i| [i as f32; 3]).collect();
+        let raster = Raster::new(2, 2, texels).unwrap();
         ImageTexture {
-            raster: Arc::new(Raster::new(2, 2, texels).unwrap()),
+            mips: Arc::new(mip_levels(&raster)),
+            raster: Arc::new(raster),
             source: "test".into(),
             raw: false,
             filter,
@@ -112,12 +181,27 @@ mod tests {
         }
     }
 
+    /// Trilinear: a footprint below a texel reads level 0 (bilinear); one as wide as the image
+    /// reads its 1x1 top, the mean; half-way in log2 blends the two levels by half.
+    #[test]
+    fn trilinear_picks_the_level_of_the_footprint() {
+        let t = image(TexelFilter::Trilinear, Wrap::Repeat);
+        let uv = Vec2::new(0.25, 0.25);
+        assert_eq!(t.eval(uv, 0.1), t.eval(uv, 0.0));
+        assert_eq!(t.eval(uv, 0.1).x, 0.0);
+        assert_eq!(t.eval(uv, 1.0).x, 1.5);
+        assert_eq!(t.eval(uv, 100.0).x, 1.5);
+        let half = t.eval(uv, std::f32::consts::SQRT_2 / 2.0).x;
+        assert!((half - 0.75).abs() < 1e-5, "{half}");
+        assert_eq!(mip_levels(&t.raster).len(), 1);
+    }
+
     /// Texel centres give their texel; half-way between two, the mean; a quarter of the way,
     /// the weighted mean; the top row is at v = 0.
     #[test]
     fn bilinear_values_between_texels() {
         let t = image(TexelFilter::Bilinear, Wrap::Clamp);
-        let at = |u: f32, v: f32| t.eval(Vec2::new(u, v)).x;
+        let at = |u: f32, v: f32| t.eval(Vec2::new(u, v), 0.0).x;
         assert_eq!(at(0.25, 0.25), 0.0);
         assert_eq!(at(0.75, 0.25), 1.0);
         assert_eq!(at(0.25, 0.75), 2.0);
@@ -125,13 +209,17 @@ mod tests {
         assert_eq!(at(0.5, 0.5), 1.5);
         assert_eq!(at(0.375, 0.25), 0.25);
         let n = image(TexelFilter::Nearest, Wrap::Clamp);
-        assert_eq!(n.eval(Vec2::new(0.49, 0.51)).x, 2.0);
+        assert_eq!(n.eval(Vec2::new(0.49, 0.51), 0.0).x, 2.0);
     }
 
     /// Past the edges: repeat wraps to the other side, clamp keeps the edge, mirror reflects.
     #[test]
     fn wrap_modes_at_the_borders() {
-        let at = |wrap, u: f32| image(TexelFilter::Nearest, wrap).eval(Vec2::new(u, 0.25)).x;
+        let at = |wrap, u: f32| {
+            image(TexelFilter::Nearest, wrap)
+                .eval(Vec2::new(u, 0.25), 0.0)
+                .x
+        };
         assert_eq!(at(Wrap::Repeat, 1.25), 0.0);
         assert_eq!(at(Wrap::Repeat, -0.25), 1.0);
         assert_eq!(at(Wrap::Clamp, 1.75), 1.0);
@@ -141,8 +229,8 @@ mod tests {
         assert_eq!(at(Wrap::Mirror, -0.25), 0.0);
         // Bilinear across the seam: repeat blends the last column with the first.
         let t = image(TexelFilter::Bilinear, Wrap::Repeat);
-        assert_eq!(t.eval(Vec2::new(0.0, 0.25)).x, 0.5);
+        assert_eq!(t.eval(Vec2::new(0.0, 0.25), 0.0).x, 0.5);
         let t = image(TexelFilter::Bilinear, Wrap::Clamp);
-        assert_eq!(t.eval(Vec2::new(0.0, 0.25)).x, 0.0);
+        assert_eq!(t.eval(Vec2::new(0.0, 0.25), 0.0).x, 0.0);
     }
 }

@@ -8,7 +8,7 @@ mod checkerboard;
 mod image;
 
 pub use checkerboard::Checkerboard;
-pub use image::{ImageTexture, TexelFilter, Wrap};
+pub use image::{ImageTexture, TexelFilter, Wrap, mip_levels};
 
 use glam::{Vec2, Vec3A};
 
@@ -46,6 +46,40 @@ impl UvTransform {
     }
 }
 
+/// How wide one camera sample's share of the image is on a surface, from the camera alone
+/// (pbrt-v4's `Camera::Approximate_dp_dxy`, isotropic): at a point `p` (render coordinates,
+/// the camera at the origin) on a surface of unit normal `n`, `(spread |p| + base) / |cos|`, with
+/// `cos` between the view direction and `n` (at least 1/20: grazing footprints stop growing).
+/// Used for every hit, camera rays' and others', as pbrt does.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Footprint {
+    /// Growth with distance: a perspective pixel's angle.
+    pub spread: f32,
+    /// Width at the camera: an orthographic pixel's height.
+    pub base: f32,
+}
+
+impl Footprint {
+    /// One sample's share when a pixel has `spp` (stratified: each covers its stratum), the
+    /// pixel's over `sqrt(spp)`.
+    #[inline]
+    pub fn per_sample(self, spp: u32) -> Footprint {
+        let k = 1.0 / (spp.max(1) as f32).sqrt();
+        Footprint {
+            spread: self.spread * k,
+            base: self.base * k,
+        }
+    }
+
+    /// The width in scene units at `p` on a surface of unit normal `n`.
+    #[inline]
+    pub fn width(&self, p: Vec3A, n: Vec3A) -> f32 {
+        let d = p.length();
+        let cos = if d > 0.0 { (p.dot(n) / d).abs() } else { 1.0 };
+        (self.spread * d + self.base) / cos.max(0.05)
+    }
+}
+
 /// What a texture looks like.
 #[derive(Clone, Debug, PartialEq)]
 pub enum TextureKind {
@@ -65,13 +99,14 @@ pub struct Texture {
 }
 
 impl Texture {
-    /// The colour at texture coordinates `uv`.
+    /// The colour at texture coordinates `uv`, for a footprint `width` wide in them (which
+    /// the transform's scale widens).
     #[inline]
-    pub fn eval(&self, uv: Vec2) -> Vec3A {
+    pub fn eval(&self, uv: Vec2, width: f32) -> Vec3A {
         let uv = self.transform.apply(uv);
         match &self.kind {
             TextureKind::Checkerboard(c) => c.eval(uv),
-            TextureKind::Image(i) => i.eval(uv),
+            TextureKind::Image(i) => i.eval(uv, width * self.transform.scale.abs().max_element()),
         }
     }
 
@@ -122,20 +157,22 @@ impl MaterialTextures {
         self.reflectance.is_none() && self.specular.is_none()
     }
 
-    /// `material` with its textured parameters looked up at `uv`, each channel clamped to
-    /// [0, 1] (a reflectance); under the physically based model (`physical`) a Phong material
-    /// whose `kd + ks` then exceeds 1 is scaled down as a constant one is at extraction.
+    /// `material` with its textured parameters looked up at `uv` for a footprint `width` wide
+    /// in texture coordinates, each channel clamped to [0, 1] (a reflectance); under the
+    /// physically based model (`physical`) a Phong material whose `kd + ks` then exceeds 1 is
+    /// scaled down as a constant one is at extraction.
     #[inline]
     pub fn apply(
         &self,
         material: &crate::material::Material,
         uv: Vec2,
+        width: f32,
         physical: bool,
     ) -> crate::material::Material {
         use crate::material::Material;
         let at = |t: &Option<Texture>| {
             t.as_ref()
-                .map(|t| t.eval(uv).clamp(Vec3A::ZERO, Vec3A::ONE))
+                .map(|t| t.eval(uv, width).clamp(Vec3A::ZERO, Vec3A::ONE))
         };
         let mut m = *material;
         match &mut m {

@@ -200,6 +200,7 @@ golden_tests! {
     cornell_lens => "cornell-lens.ron",
     cornell_n_bounce => "cornell-n-bounce.ron",
     cornell_physical => "cornell-physical.ron",
+    checkerboard => "checkerboard.ron",
     cornell_two_bounce => "cornell-two-bounce.ron",
     materials => "materials.ron",
     materials_beckmann => "materials-beckmann.ron",

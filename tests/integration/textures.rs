@@ -345,3 +345,59 @@ fn textures_match_mitsuba() {
         "the filter is not seen: {mse:.3e} vs {explained:.3e}"
     );
 }
+
+/// Trilinear filtering by the footprint: a black and white checker image on a floor running to
+/// the horizon, at one sample a pixel. Near the camera, where a pixel covers less than a
+/// texel, trilinear reads level 0: the bilinear image, to the bit. Far away, where a pixel
+/// covers many checks, trilinear gives their mean (1/2) with little spread from pixel to pixel,
+/// while bilinear aliases (black or white by chance).
+#[test]
+fn trilinear_does_not_alias_at_the_horizon() {
+    let path = grey_png(
+        "checks",
+        2,
+        2,
+        |x, y| if (x + y) % 2 == 0 { 0 } else { 255 },
+    );
+    let render = |filter: &str| {
+        let text = format!(
+            "Scene(film: (width: 64, height: 48, spp: 1), shader: Direct(), model: Physical,
+                   camera: Perspective(position: (0, 1, 0), look_at: (0, 0.8, 10), fov: 40),
+                   entities: [
+                     (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+                      material: Phong(kd: Image(path: {path:?}, filter: {filter}, raw: true))),
+                     (light: Directional(direction: (0, -1, 0),
+                                         irradiance: (3.14159265, 3.14159265, 3.14159265)))])"
+        );
+        crate::common::render_str(&text).image
+    };
+    let (tri, bi) = (render("Trilinear"), render("Bilinear"));
+    // The bottom rows are near (a pixel there is a fraction of a texel): the same bits.
+    for col in 0..64 {
+        assert_eq!(tri.get(col, 47), bi.get(col, 47), "near, column {col}");
+    }
+    // The rows just below the horizon (near row 22.6): the floor 15 to 60 units away.
+    let band = |img: &rtis::render::film::Image| {
+        let v: Vec<f64> = (24..28)
+            .flat_map(|r| (0..64).map(move |c| (c, r)))
+            .map(|(c, r)| img.get(c, r).x as f64)
+            .collect();
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        let sd = (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / v.len() as f64).sqrt();
+        (m, sd, v.len())
+    };
+    let (m_tri, sd_tri, n) = band(&tri);
+    let (_, sd_bi, _) = band(&bi);
+    assert_eq!(n, 256);
+    assert!(
+        (m_tri - 0.5).abs() < 0.05 && sd_tri < 0.1,
+        "trilinear: mean {m_tri}, spread {sd_tri}"
+    );
+    eprintln!(
+        "far band: trilinear mean {m_tri:.3}, spread {sd_tri:.3}; bilinear spread {sd_bi:.3}"
+    );
+    assert!(
+        sd_bi > 0.15 && sd_bi > 3.0 * sd_tri,
+        "bilinear should alias: spread {sd_bi}"
+    );
+}
