@@ -17,7 +17,7 @@ pub const MAX_TEXELS: u64 = 1 << 28;
 pub const MAX_SIDE: u32 = 1 << 16;
 
 /// A rectangle of linear RGB texels, row by row from the top.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct Raster {
     /// Texels per row (at least 1).
     pub width: usize,
@@ -25,6 +25,20 @@ pub struct Raster {
     pub height: usize,
     /// `width * height` texels, linear RGB, each channel finite and `>= 0`.
     pub texels: Vec<[f32; 3]>,
+}
+
+impl std::fmt::Debug for Raster {
+    /// The size and a hash of the texels (what tells two renders apart), not the texels.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let hash = self
+            .texels
+            .iter()
+            .flatten()
+            .fold(0xcbf2_9ce4_8422_2325u64, |h, c| {
+                (h ^ c.to_bits() as u64).wrapping_mul(0x0000_0100_0000_01b3)
+            });
+        write!(f, "Raster({}x{}, {hash:016x})", self.width, self.height)
+    }
 }
 
 impl Raster {
@@ -43,7 +57,7 @@ impl Raster {
         {
             let t = texels[i];
             return Err(format!(
-                "texel ({}, {}) (column, row from the top left) is ({}, {}, {}): radiance is \
+                "texel ({}, {}) (column, row from the top left) is ({}, {}, {}): a texel is \
                  finite and not negative",
                 i % width,
                 i / width,

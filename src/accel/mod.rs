@@ -363,7 +363,7 @@ impl Geometry {
         use glam::Vec2;
         match prim.shape {
             Shape::Triangle(t) => {
-                let (b1, b2) = barycentric(&t, p);
+                let (b1, b2) = barycentric_by_areas(&t, p);
                 match self.uvs.get(prim.smooth as usize) {
                     Some(&[t0, t1, t2]) if prim.smooth != FLAT => {
                         (1.0 - b1 - b2) * t0 + b1 * t1 + b2 * t2
@@ -580,6 +580,22 @@ impl Geometry {
             }
         }
     }
+}
+
+/// The barycentric coordinates `(b1, b2)` of point `p` in triangle `t` as ratios of signed
+/// areas, `((p - v0) x e2) . c / c . c` and `(e1 x (p - v0)) . c / c . c` with `c = e1 x e2`:
+/// accurate on thin triangles, where the normal equations of [`barycentric`] cancel (texture
+/// coordinates need it; shading normals keep [`barycentric`], whose bits the goldens hold).
+/// Zero for a triangle of no area.
+#[inline]
+fn barycentric_by_areas(t: &crate::shape::Triangle, p: glam::Vec3A) -> (f32, f32) {
+    let (e1, e2, ep) = (t.v[1] - t.v[0], t.v[2] - t.v[0], p - t.v[0]);
+    let c = e1.cross(e2);
+    let cc = c.dot(c);
+    if !(cc > 0.0) {
+        return (0.0, 0.0);
+    }
+    (ep.cross(e2).dot(c) / cc, e1.cross(ep).dot(c) / cc)
 }
 
 /// The barycentric coordinates `(b1, b2)` of point `p` in triangle `t` (the weights of its

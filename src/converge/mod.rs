@@ -256,7 +256,7 @@ pub fn reference_half(scene: &RenderScene, spp: u32, h: u64) -> RenderScene {
 /// A key that changes whenever anything that affects the reference image changes.
 pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
     let text = format!(
-        "reference v3 (two independent halves)|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}",
+        "reference v3 (two independent halves)|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}",
         scene.camera,
         scene.geometry.prims().collect::<Vec<_>>(),
         scene.materials,
@@ -267,6 +267,10 @@ pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
         spp,
         scene.seed,
         scene.model,
+        scene.film.filter,
+        scene.textures,
+        scene.geometry.uvs,
+        scene.emitters.environment,
     );
     metrics::fnv1a(text.as_bytes())
 }

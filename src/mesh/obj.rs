@@ -72,8 +72,21 @@ pub fn load_obj(path: &Path) -> Result<MeshData, String> {
     if !all_normals || mesh.normals.contains(&DVec3::ZERO) {
         mesh.normals.clear();
     }
-    if !all_uvs || mesh.uvs.iter().any(|t| !t.is_finite()) {
+    if !all_uvs {
         mesh.uvs.clear();
+    }
+    if let Some(bad) = mesh
+        .uvs
+        .iter()
+        .find(|t| !t.is_finite() || t.abs().max_element() > 1e9)
+    {
+        return Err(format!(
+            "mesh {}: texture coordinate ({}, {}) (with v flipped) is not finite or beyond \
+             +-1e9",
+            path.display(),
+            bad.x,
+            bad.y
+        ));
     }
     if let Some(bad) = mesh
         .positions

@@ -62,8 +62,12 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
         f.width,
         f.height,
     );
-    // Only a scene with an environment or a filter other than the box hashes them, so that
-    // earlier passes of other scenes still merge.
+    // Only a scene with an environment, textures or a filter other than the box hashes them,
+    // so that earlier passes of other scenes still merge (a scene with an infinite plane hashes
+    // the plane's point since textures came: its earlier passes are refused, never mixed).
+    if !scene.textures.is_empty() {
+        let _ = write!(h, "|{:?}|{:?}", scene.textures, scene.geometry.uvs);
+    }
     if let Some(env) = &scene.emitters.environment {
         let _ = write!(h, "|{env:?}");
     }

@@ -24,26 +24,6 @@ pub enum PixelFilter {
 }
 
 impl PixelFilter {
-    /// Half the width of its support, in pixels.
-    pub fn radius(&self) -> f64 {
-        match *self {
-            PixelFilter::Box => 0.5,
-            PixelFilter::Gaussian { stddev } => 4.0 * stddev as f64,
-        }
-    }
-
-    /// The profile `f(x)` at `x` pixels from the pixel's centre, up to a constant.
-    pub fn profile(&self, x: f64) -> f64 {
-        let inside = f64::from(x.abs() <= self.radius());
-        match *self {
-            PixelFilter::Box => inside,
-            PixelFilter::Gaussian { stddev } => {
-                let s = stddev as f64;
-                (-x * x / (2.0 * s * s)).exp() * inside
-            }
-        }
-    }
-
     /// Where in the pixel (`[0, 1)^2` for the box; around the centre `(1/2, 1/2)` for the
     /// others) the sample of stratified position `(dx, dy)` goes: each axis warped by the
     /// inverse of the profile's cumulative distribution. The box keeps `(dx, dy)`, bit for bit.

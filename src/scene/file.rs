@@ -774,6 +774,13 @@ impl UvTransformDesc {
                 "uv_transform: {bad} is not a finite number within 1e9"
             ));
         }
+        if self.scale.0.abs() < 1e-9 || self.scale.1.abs() < 1e-9 {
+            return Err(format!(
+                "uv_transform: a scale of ({}, {}) flattens the texture to a line; each factor \
+                 must be at least 1e-9 in size",
+                self.scale.0, self.scale.1
+            ));
+        }
         Ok(UvTransform {
             scale: glam::Vec2::new(self.scale.0 as f32, self.scale.1 as f32),
             rotate: self.rotate as f32,

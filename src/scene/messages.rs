@@ -671,6 +671,20 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
                 };
             }
             let empty = bracketed(text, start).is_some_and(|b| b[1..b.len() - 1].trim().is_empty());
+            // A named texture: its own error says which field is wrong.
+            if !name.is_empty()
+                && !empty
+                && let Some(fields) = bracketed(text, start)
+                && let Err(e) = ron::Options::default()
+                    .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+                    .from_str::<super::file::TextureDesc>(&format!("{name}{fields}"))
+            {
+                let why = match e.code {
+                    Error::Message(m) => m,
+                    other => other.to_string(),
+                };
+                return format!("{field}: in `{name}(...)`: {why}");
+            }
             let why = if !name.is_empty() && empty {
                 format!(
                     "`{name}()` with no field cannot be told from a colour here: give one, as \

@@ -79,9 +79,12 @@ impl WorldShape {
         let mirrors = at.mirrors();
         let mut triangle = |v: [Vec3A; 3], c: Corners| {
             let (v, c) = if mirrors {
+                // Coordinates follow their vertices; a triangle without them keeps the
+                // barycentric (b1, b2) of its vertices as written, now the third and second.
+                let bary = [glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y];
                 let c = Corners {
                     normals: c.normals.map(|[a, b, c]| [a, c, b]),
-                    uvs: c.uvs.map(|[a, b, c]| [a, c, b]),
+                    uvs: Some(c.uvs.unwrap_or(bary)).map(|[a, b, c]| [a, c, b]),
                 };
                 ([v[0], v[2], v[1]], c)
             } else {

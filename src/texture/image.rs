@@ -51,7 +51,7 @@ impl Wrap {
 }
 
 /// An image texture.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct ImageTexture {
     /// The texels, shared by every texture that reads the same file.
     pub raster: Arc<Raster>,
@@ -66,6 +66,32 @@ pub struct ImageTexture {
     /// Levels 1, 2, ... of the MIP pyramid (each half the last, rounded up, by 2x2 box
     /// averages), built for [`TexelFilter::Trilinear`] only; empty otherwise.
     pub mips: Arc<Vec<Raster>>,
+}
+
+/// Two textures are the same if they read the same texels (shared: an image is read once per
+/// scene) in the same way; the texels are not compared one by one.
+impl PartialEq for ImageTexture {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.raster, &other.raster)
+            && Arc::ptr_eq(&self.mips, &other.mips)
+            && self.filter == other.filter
+            && self.wrap == other.wrap
+            && self.raw == other.raw
+    }
+}
+
+/// A texel coordinate `x` (texel widths from the image's edge) as the floor's integer and the
+/// fraction above it: non-finite coordinates (a degenerate hit) read texel 0, and the rest are
+/// held within 1e12 texels (where `f64` no longer tells texels apart anyway), so that the
+/// integers and their neighbours never overflow.
+#[inline]
+fn texel_coordinate(x: f64) -> (i64, f32) {
+    if !x.is_finite() {
+        return (0, 0.0);
+    }
+    let x = x.clamp(-1e12, 1e12);
+    let x0 = x.floor();
+    (x0 as i64, (x - x0) as f32)
 }
 
 /// The MIP levels above `raster`: each half the one below (rounded up) on each side, its texel
@@ -107,8 +133,8 @@ impl ImageTexture {
         match self.filter {
             TexelFilter::Nearest => {
                 let (w, h) = (self.raster.width, self.raster.height);
-                let (x, y) = (uv.x as f64 * w as f64, uv.y as f64 * h as f64);
-                let (i, j) = (x.floor() as i64, y.floor() as i64);
+                let (i, _) = texel_coordinate(uv.x as f64 * w as f64);
+                let (j, _) = texel_coordinate(uv.y as f64 * h as f64);
                 Vec3A::from(self.raster.at(self.wrap.index(i, w), self.wrap.index(j, h)))
             }
             TexelFilter::Bilinear => bilinear(&self.raster, self.wrap, uv),
@@ -137,15 +163,6 @@ impl ImageTexture {
             }
         }
     }
-
-    /// The largest channel of any texel (every MIP level is a mean of them).
-    pub fn max_value(&self) -> f32 {
-        self.raster
-            .texels
-            .iter()
-            .flatten()
-            .fold(0.0, |m, &c| m.max(c))
-    }
 }
 
 /// `raster` at `uv`, bilinear between the texel centres, beyond the edges by `wrap`.
@@ -153,11 +170,8 @@ impl ImageTexture {
 fn bilinear(raster: &Raster, wrap: Wrap, uv: Vec2) -> Vec3A {
     let (w, h) = (raster.width, raster.height);
     let texel = |i: i64, j: i64| Vec3A::from(raster.at(wrap.index(i, w), wrap.index(j, h)));
-    let x = uv.x as f64 * w as f64 - 0.5;
-    let y = uv.y as f64 * h as f64 - 0.5;
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-    let (i, j) = (x0 as i64, y0 as i64);
+    let (i, fx) = texel_coordinate(uv.x as f64 * w as f64 - 0.5);
+    let (j, fy) = texel_coordinate(uv.y as f64 * h as f64 - 0.5);
     let top = texel(i, j) * (1.0 - fx) + texel(i + 1, j) * fx;
     let bottom = texel(i, j + 1) * (1.0 - fx) + texel(i + 1, j + 1) * fx;
     top * (1.0 - fy) + bottom * fy
@@ -232,5 +246,10 @@ mod tests {
         assert_eq!(t.eval(Vec2::new(0.0, 0.25), 0.0).x, 0.5);
         let t = image(TexelFilter::Bilinear, Wrap::Clamp);
         assert_eq!(t.eval(Vec2::new(0.0, 0.25), 0.0).x, 0.0);
+        // Far and non-finite coordinates read a texel, never overflow: clamp holds the edge.
+        assert_eq!(t.eval(Vec2::new(1e30, 0.25), 0.0).x, 1.0);
+        assert_eq!(t.eval(Vec2::new(f32::NAN, f32::INFINITY), 0.0).x, 0.0);
+        let r = image(TexelFilter::Bilinear, Wrap::Repeat);
+        assert!(r.eval(Vec2::new(-1e30, 1e20), 0.0).is_finite());
     }
 }

@@ -109,14 +109,6 @@ impl Texture {
             TextureKind::Image(i) => i.eval(uv, width * self.transform.scale.abs().max_element()),
         }
     }
-
-    /// The largest value of any channel anywhere (for checking ranges).
-    pub fn max_value(&self) -> f32 {
-        match &self.kind {
-            TextureKind::Checkerboard(c) => c.color0.max(c.color1).max_element(),
-            TextureKind::Image(i) => i.max_value(),
-        }
-    }
 }
 
 #[cfg(test)]

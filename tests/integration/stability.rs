@@ -191,12 +191,16 @@ mod random_scenes {
                 )),
             rgb01().prop_map(|c| format!("Mirror(color: {c})")),
             // Textures: a checkerboard at extreme scales, and images of 1x1 and 8192x1 texels
-            // (each filter and wrap), on Phong, a mirror and glass.
+            // (each filter and wrap, transforms up to 1e9 and down to 1e-9), on Phong, a mirror
+            // and glass.
             (
                 prop_oneof![
                     Just("Checkerboard(color0: (1, 1, 1), color1: (0, 0, 0), uv_transform: (scale: (1e6, 1e-6), rotate: 33))".to_string()),
                     Just(format!("Image(path: {:?}, filter: Nearest, wrap: Mirror)", texture_file(1))),
                     Just(format!("Image(path: {:?}, wrap: Clamp, raw: true)", texture_file(8192))),
+                    Just(format!("Image(path: {:?}, filter: Nearest, wrap: Repeat, uv_transform: (scale: (1e9, -1e9)))", texture_file(8192))),
+                    Just(format!("Image(path: {:?}, filter: Trilinear, uv_transform: (scale: (1e-9, 3), rotate: 45))", texture_file(8192))),
+                    Just(format!("Image(path: {:?}, filter: Trilinear, wrap: Mirror)", texture_file(1))),
                 ],
                 0u8..3,
             )

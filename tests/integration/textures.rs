@@ -60,10 +60,18 @@ fn rectangle_and_triangle_coordinates() {
     let mirrored = "(shape: Rectangle(corner: (-1, -1, 5), u: (2, 0, 0), v: (0, 3, 0)),
                      material: Phong(kd: Checkerboard(color0: (1, 1, 1))),
                      transform: (scale: (-1, 1, 1)))";
-    // Mirrored in x, the point (s, t) lands at x = -(-1 + 2 s).
-    let p = Vec3A::new(1.0 - 2.0 * 0.25, -1.0 + 3.0 * 0.5, 5.0);
-    let uv = uv_at(mirrored, Vec3A::ZERO, p);
-    assert!(close(uv, Vec2::new(0.25, 0.5)), "mirrored: {uv}");
+    // Mirrored in x, the point (s, t) lands at x = -(-1 + 2 s); in both triangles.
+    for (s, t) in [(0.2f32, 0.7f32), (0.8, 0.1)] {
+        let p = Vec3A::new(1.0 - 2.0 * s, -1.0 + 3.0 * t, 5.0);
+        let uv = uv_at(mirrored, Vec3A::ZERO, p);
+        assert!(close(uv, Vec2::new(s, t)), "mirrored ({s}, {t}): {uv}");
+    }
+    // A mirrored triangle keeps the barycentric coordinates of its vertices as written.
+    let tri = "(shape: Triangle(a: (0, 0, 4), b: (2, 0, 4), c: (0, 2, 4)),
+                material: Phong(kd: Checkerboard(color0: (1, 1, 1))),
+                transform: (scale: (-1, 1, 1)))";
+    let uv = uv_at(tri, Vec3A::ZERO, Vec3A::new(-2.0 * 0.2, 2.0 * 0.3, 4.0));
+    assert!(close(uv, Vec2::new(0.2, 0.3)), "mirrored triangle: {uv}");
 
     let tri = "(shape: Triangle(a: (0, 0, 4), b: (2, 0, 4), c: (0, 2, 4)),
                 material: Phong(kd: Checkerboard(color0: (1, 1, 1))))";
@@ -270,10 +278,14 @@ fn texture_errors_are_located() {
     let e = err("Checkerboard()");
     assert!(e.contains("give one"), "{e}");
     let e = err("Checker(color0: (1, 1, 1))");
-    assert!(
-        e.contains("`Checker` is not a texture") && e.contains("Image(path:"),
-        "{e}"
-    );
+    assert!(e.contains("`Checkerboard` or `Image`"), "{e}");
+    // An error inside a texture is its own.
+    let e = err("Image(path: \"a.png\", wrap: Repet)");
+    assert!(e.contains("`Repeat`, `Clamp`, or `Mirror`"), "{e}");
+    let e = err("Checkerboard(color0: (2, 0, 0))");
+    assert!(e.contains("reflectance (2, 0, 0) out of range"), "{e}");
+    let e = err("Checkerboard(uv_transform: (scale: (0, 1)))");
+    assert!(e.contains("flattens the texture"), "{e}");
     let e = err("(2, 0, 0)");
     assert!(
         e.contains("`kd`: reflectance (2, 0, 0) out of range"),
@@ -400,4 +412,45 @@ fn trilinear_does_not_alias_at_the_horizon() {
         sd_bi > 0.15 && sd_bi > 3.0 * sd_tri,
         "bilinear should alias: spread {sd_bi}"
     );
+}
+
+/// The textured path changes nothing but the lookup: a checkerboard of one colour renders the
+/// bits of that colour as a constant, under Direct and Path, the Course and Physical models,
+/// and with `kd + ks` above 1 under Physical (scaled down at each hit as at extraction), on
+/// Phong, a mirror and glass.
+#[test]
+fn a_one_colour_texture_renders_as_its_constant() {
+    let scene = |kd: &str, ks: &str, color: &str, shader: &str, model: &str| {
+        format!(
+            "Scene(film: (width: 24, height: 18, spp: 4), shader: {shader}, model: {model},
+                   camera: Perspective(position: (0, 1, -3), look_at: (0, 0.5, 2), fov: 50),
+                   entities: [
+                     (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+                      material: Phong(kd: {kd}, ks: {ks}, shininess: 20)),
+                     (shape: Sphere(center: (-0.7, 0.5, 2), radius: 0.5), material: Mirror(color: {color})),
+                     (shape: Sphere(center: (0.7, 0.5, 2), radius: 0.5), material: Transmissive(ior: 1.5, color: {color})),
+                     (light: Point(position: (1, 3, -1), intensity: (10, 10, 10)))])"
+        )
+    };
+    let tex = |c: &str| format!("Checkerboard(color0: {c}, color1: {c})");
+    for (shader, model) in [
+        ("Direct()", "Course"),
+        ("Path(max_depth: 4)", "Physical"),
+        ("Global(samples: 4, max_depth: 2)", "Course"),
+    ] {
+        for (kd, ks) in [
+            ("(0.6, 0.5, 0.4)", "(0.2, 0.2, 0.2)"),
+            ("(0.9, 0.9, 0.9)", "(0.5, 0.5, 0.5)"),
+        ] {
+            let color = "(0.9, 0.8, 0.7)";
+            let plain = crate::common::render_str(&scene(kd, ks, color, shader, model));
+            let textured =
+                crate::common::render_str(&scene(&tex(kd), &tex(ks), &tex(color), shader, model));
+            assert_eq!(
+                crate::common::bits(&plain.image),
+                crate::common::bits(&textured.image),
+                "{shader} {model}, kd {kd}, ks {ks}"
+            );
+        }
+    }
 }

@@ -151,7 +151,7 @@ impl Order {
 /// in `order`, with no random numbers drawn between them. Where `order` applies, every order
 /// gives the same bits and counts the same rays (`tests/integration/global_waves.rs` checks it).
 pub fn incident_all(tr: &mut Tracer, g: &Global, rays: &[Ray], order: Order) -> Vec<Vec3A> {
-    debug_assert!(order.applies(tr, g), "{order:?} does not apply");
+    assert!(order.applies(tr, g), "{order:?} does not apply");
     match order {
         Order::DepthFirst => {
             let mut stack = Vec::with_capacity(g.max_depth as usize + 1);
