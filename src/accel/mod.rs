@@ -592,7 +592,7 @@ fn barycentric_by_areas(t: &crate::shape::Triangle, p: glam::Vec3A) -> (f32, f32
     let (e1, e2, ep) = (t.v[1] - t.v[0], t.v[2] - t.v[0], p - t.v[0]);
     let c = e1.cross(e2);
     let cc = c.dot(c);
-    if !(cc > 0.0) {
+    if cc.is_nan() || cc <= 0.0 {
         return (0.0, 0.0);
     }
     (ep.cross(e2).dot(c) / cc, e1.cross(ep).dot(c) / cc)
