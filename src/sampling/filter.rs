@@ -6,7 +6,8 @@
 //! The filters are separable, `f(x, y) = f(x) f(y)`, and each axis is warped by the inverse of
 //! its profile's cumulative distribution, so stratified positions stay stratified.
 
-use std::f64::consts::{FRAC_2_SQRT_PI, SQRT_2};
+use super::erf_inv;
+use std::f64::consts::SQRT_2;
 
 /// The pixel filter of a film.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -44,61 +45,9 @@ impl PixelFilter {
     }
 }
 
-/// The inverse error function on `(-1, 1)`: Giles' single-precision approximation ("Approximating
-/// the erfinv function", GPU Computing Gems, 2011), refined by two Newton steps on `erf`.
-pub fn erf_inv(x: f64) -> f64 {
-    let w = -((1.0 - x) * (1.0 + x)).ln();
-    let mut y = if w < 5.0 {
-        let w = w - 2.5;
-        let p = [
-            2.810_226_36e-08,
-            3.432_739_39e-07,
-            -3.523_387_7e-06,
-            -4.391_506_54e-06,
-            0.000_218_580_87,
-            -0.001_253_725_03,
-            -0.004_177_681_64,
-            0.246_640_727,
-            1.501_409_41,
-        ];
-        p.iter().fold(0.0, |acc, c| acc * w + c) * x
-    } else {
-        let w = w.sqrt() - 3.0;
-        let p = [
-            -0.000_200_214_257,
-            0.000_100_950_558,
-            0.001_349_343_22,
-            -0.003_673_428_44,
-            0.005_739_507_73,
-            -0.007_622_461_3,
-            0.009_438_870_47,
-            1.001_674_06,
-            2.832_976_82,
-        ];
-        p.iter().fold(0.0, |acc, c| acc * w + c) * x
-    };
-    for _ in 0..2 {
-        y -= (libm::erf(y) - x) / (FRAC_2_SQRT_PI * (-y * y).exp());
-    }
-    y
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// erf_inv inverts erf to 1e-12 from the centre to the tails.
-    #[test]
-    fn erf_inv_inverts_erf() {
-        for x in [-0.999_99, -0.9, -0.3, 0.0, 1e-9, 0.5, 0.95, 0.999_936] {
-            let y = erf_inv(x);
-            assert!(
-                (libm::erf(y) - x).abs() < 1e-12,
-                "{x}: erf({y}) = {}",
-                libm::erf(y)
-            );
-        }
-    }
 
     /// The Gaussian's warp puts the median at the centre, is odd about it, keeps within the
     /// radius, and puts 68.27% of samples within one standard deviation (the truncation at 4

@@ -1,6 +1,7 @@
 //! Random numbers, sample warps and sampling strategies.
 
 pub mod distribution;
+mod erf;
 pub mod filter;
 pub mod hemisphere;
 mod pixel;
@@ -9,6 +10,7 @@ mod strategy;
 pub mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
+pub use erf::erf_inv;
 pub use filter::PixelFilter;
 pub use pixel::pixel_sample;
 pub use rng::{Sampler, mix};
