@@ -12,6 +12,21 @@ import time
 import numpy as np
 
 
+LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+
+
+def load_mitsuba(variant):
+    """Mitsuba 3 set to `variant`; an llvm variant finds Debian's libLLVM unless
+    DRJIT_LIBLLVM_PATH says otherwise."""
+    import os
+    if variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ:
+        os.environ["DRJIT_LIBLLVM_PATH"] = LIBLLVM
+    import mitsuba as mi
+
+    mi.set_variant(variant)
+    return mi
+
+
 def sensor(mi, kind, eye, target, up, fov, width, height, spp, seed, **extra):
     """A Mitsuba sensor of `kind` (`perspective`, `thinlens` with its `extra` fields) at `eye`
     looking at `target`, with a vertical `fov` as rtis's, an hdrfilm of `width x height` with

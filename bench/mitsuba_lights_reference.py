@@ -26,10 +26,9 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import num, render_halves, sensor, tup, write_reference
+from mitsuba_halves import load_mitsuba, num, render_halves, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 WIDTH, HEIGHT = 160, 120
 EYE, TARGET, UP, FOV = [0.0, 1.2, -2.0], [0.0, 0.6, 5.0], [0, 1, 0], 40
 APERTURE, FOCUS = 0.12, 7.0
@@ -103,11 +102,7 @@ def main():
     args = ap.parse_args()
     with open(os.path.join(ROOT, "tests/data", "lens_spot.ron"), "w") as f:
         f.write(rtis_scene(64))
-    if args.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ:
-        os.environ["DRJIT_LIBLLVM_PATH"] = LIBLLVM
-    import mitsuba as mi
-
-    mi.set_variant(args.variant)
+    mi = load_mitsuba(args.variant)
     img, half_rmse, seconds = render_halves(mi, lambda n, seed: mitsuba_dict(mi, n, seed), args.spp,
                                             WIDTH, HEIGHT)
     stem = os.path.join(ROOT, "tests/data", f"mitsuba_lens_spot_{WIDTH}x{HEIGHT}_spp{args.spp}")

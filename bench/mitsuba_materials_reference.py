@@ -34,10 +34,9 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import num, render_halves, sensor, tup, write_reference
+from mitsuba_halves import load_mitsuba, num, render_halves, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 WIDTH, HEIGHT = 192, 128
 EYE, TARGET, UP, FOV = [0, 5.0, -4.4], [0, 0.2, 1.35], [0, 1, 0], 38
 SKY = [0.25, 0.3, 0.4]
@@ -187,11 +186,7 @@ def main():
             f.write(rtis_scene(name, 64))
     if args.write_scenes:
         return
-    if args.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ:
-        os.environ["DRJIT_LIBLLVM_PATH"] = LIBLLVM
-    import mitsuba as mi
-
-    mi.set_variant(args.variant)
+    mi = load_mitsuba(args.variant)
     for name in names:
         img, half_rmse, seconds = render_halves(
             mi, lambda n, seed: mitsuba_dict(mi, name, n, seed), args.spp, WIDTH, HEIGHT)

@@ -29,10 +29,9 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import num, render_halves, sensor, tup, write_reference
+from mitsuba_halves import load_mitsuba, num, render_halves, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 SKY = os.path.join(ROOT, "scenes/assets/sky.exr")
 SKY_SIZE = (128, 64)
 WIDTH, HEIGHT = 160, 120
@@ -121,11 +120,7 @@ def main():
     ap.add_argument("--spp", type=int, default=4096)
     ap.add_argument("--variant", default="llvm_ad_rgb")
     args = ap.parse_args()
-    if args.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ:
-        os.environ["DRJIT_LIBLLVM_PATH"] = LIBLLVM
-    import mitsuba as mi
-
-    mi.set_variant(args.variant)
+    mi = load_mitsuba(args.variant)
     os.makedirs(os.path.dirname(SKY), exist_ok=True)
     mi.Bitmap(sky_texels(*SKY_SIZE)).write(SKY)
     with open(os.path.join(ROOT, "tests/data", "sky.ron"), "w") as f:

@@ -32,10 +32,9 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import num, render_halves, sensor, tup, write_reference
+from mitsuba_halves import load_mitsuba, num, render_halves, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-LIBLLVM = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
 TEXTURE = os.path.join(ROOT, "tests/data/texture.png")
 WIDTH, HEIGHT = 160, 120
 EYE, TARGET, UP, FOV = [0.0, 2.0, -4.0], [0.0, 0.8, 1.0], [0, 1, 0], 45
@@ -138,11 +137,7 @@ def main():
     args = ap.parse_args()
     gaussian = args.filter == "gaussian"
     tag = "texture_gaussian" if gaussian else "texture"
-    if args.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ:
-        os.environ["DRJIT_LIBLLVM_PATH"] = LIBLLVM
-    import mitsuba as mi
-
-    mi.set_variant(args.variant)
+    mi = load_mitsuba(args.variant)
     mi.Bitmap(texture_codes(), pixel_format=mi.Bitmap.PixelFormat.RGB).write(TEXTURE)
     with open(os.path.join(ROOT, "tests/data", f"{tag}.ron"), "w") as f:
         f.write(rtis_scene(64, gaussian))

@@ -184,14 +184,11 @@ fn the_blur_of_a_point_off_focus_is_the_circle_of_confusion() {
 /// the image means agree within 1%.
 #[test]
 fn lens_spots_and_sun_match_mitsuba() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/lens_spot.ron");
-    let mut s = rtis::scene::load_path(&path).unwrap_or_else(|e| panic!("{e}"));
-    s.settings.film.spp = 64;
-    let a = crate::common::render_scene(&s);
-    s.settings.seed = 4321;
-    let b = crate::common::render_scene(&s);
-    let r = crate::common::mitsuba_reference("mitsuba_lens_spot_160x120_spp4096.exr");
-    let (mse, explained) = crate::common::block_mse(&a.image, &b.image, &r, 0.00243, &|_, _| false);
+    let (mse, explained, m) = crate::common::against_mitsuba(
+        "lens_spot.ron",
+        "mitsuba_lens_spot_160x120_spp4096.exr",
+        0.00243,
+    );
     eprintln!(
         "lens, spots and sun: block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}"
     );
@@ -200,7 +197,6 @@ fn lens_spots_and_sun_match_mitsuba() {
         "block MSE {mse:.3e} vs {explained:.3e}"
     );
     let mean = Vec3A::new(0.069236, 0.070572, 0.064752);
-    let m = (a.image.mean() + b.image.mean()) * 0.5;
     assert!(
         ((m - mean) / mean).abs().max_element() < 0.01,
         "mean {m} vs {mean}"

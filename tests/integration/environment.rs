@@ -350,22 +350,14 @@ fn environment_errors_are_located() {
 /// within 1%.
 #[test]
 fn a_sky_matches_mitsuba() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sky.ron");
-    let mut s = rtis::scene::load_path(&path).unwrap_or_else(|e| panic!("{e}"));
-    s.settings.film.spp = 64;
-    let a = render_scene(&s);
-    s.settings.seed = 4321;
-    let b = render_scene(&s);
-    let r = crate::common::mitsuba_reference("mitsuba_sky_160x120_spp16384.exr");
-    let (mse, explained) =
-        crate::common::block_mse(&a.image, &b.image, &r, 0.005355, &|_, _| false);
+    let (mse, explained, m) =
+        crate::common::against_mitsuba("sky.ron", "mitsuba_sky_160x120_spp16384.exr", 0.005355);
     eprintln!("sky: block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}");
     assert!(
         mse < 1.5 * explained,
         "block MSE {mse:.3e} vs {explained:.3e}"
     );
     let mean = Vec3A::new(0.334792, 0.374639, 0.493499);
-    let m = (a.image.mean() + b.image.mean()) * 0.5;
     assert!(
         ((m - mean) / mean).abs().max_element() < 0.01,
         "mean {m} vs {mean}"

@@ -297,22 +297,6 @@ fn texture_errors_are_located() {
     assert!(e.contains("within 1e9"), "{e}");
 }
 
-/// Two renders of 64 spp of `scene` (in tests/data), and their block MSE against Mitsuba's
-/// `reference` of noise `noise`, with what noise explains; the mean of the renders.
-fn against_mitsuba(scene: &str, reference: &str, noise: f64) -> (f64, f64, Vec3A) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(scene);
-    let mut s = rtis::scene::load_path(&path).unwrap_or_else(|e| panic!("{e}"));
-    s.settings.film.spp = 64;
-    let a = crate::common::render_scene(&s);
-    s.settings.seed = 4321;
-    let b = crate::common::render_scene(&s);
-    let r = crate::common::mitsuba_reference(reference);
-    let (mse, explained) = crate::common::block_mse(&a.image, &b.image, &r, noise, &|_, _| false);
-    (mse, explained, (a.image.mean() + b.image.mean()) * 0.5)
-}
-
 /// Side by side with Mitsuba 3 (bench/mitsuba_texture_reference.py): a checkerboard floor, and
 /// a sphere and a panel wearing tests/data/texture.png (bilinear, repeat, sRGB), under a
 /// constant sky and a sun. Two renders of 64 spp agree with Mitsuba's 4096 spp on 4x4 blocks
@@ -335,7 +319,7 @@ fn textures_match_mitsuba() {
             0.001655,
         ),
     ] {
-        let (mse, explained, m) = against_mitsuba(scene, reference, noise);
+        let (mse, explained, m) = crate::common::against_mitsuba(scene, reference, noise);
         eprintln!("{scene}: block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}");
         assert!(
             mse < 1.5 * explained,
@@ -346,7 +330,7 @@ fn textures_match_mitsuba() {
             "{scene}: mean {m} vs {mean}"
         );
     }
-    let (mse, explained, _) = against_mitsuba(
+    let (mse, explained, _) = crate::common::against_mitsuba(
         "texture_gaussian.ron",
         "mitsuba_texture_160x120_spp4096.exr",
         0.002932,

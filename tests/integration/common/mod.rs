@@ -120,6 +120,22 @@ pub fn mitsuba_reference(file: &str) -> rtis::render::film::Image {
     .flipped_horizontally()
 }
 
+/// Two renders of 64 spp of `scene` (in tests/data), and their block MSE against Mitsuba's
+/// `reference` of noise `noise`, with what noise explains; the mean of the renders.
+pub fn against_mitsuba(scene: &str, reference: &str, noise: f64) -> (f64, f64, Vec3A) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(scene);
+    let mut s = rtis::scene::load_path(&path).unwrap_or_else(|e| panic!("{e}"));
+    s.settings.film.spp = 64;
+    let a = render_scene(&s);
+    s.settings.seed = 4321;
+    let b = render_scene(&s);
+    let r = mitsuba_reference(reference);
+    let (mse, explained) = block_mse(&a.image, &b.image, &r, noise, &|_, _| false);
+    (mse, explained, (a.image.mean() + b.image.mean()) * 0.5)
+}
+
 /// The nearest hit among `prims` by testing each in order, a later one winning at equal
 /// distance (the loop a BVH leaf and a block stand for): its index in `prims` and distance.
 pub fn nearest(prims: &[rtis::accel::Prim], ray: &rtis::geometry::Ray) -> Option<(u32, f32)> {
