@@ -24,7 +24,8 @@
 
 use super::Tracer;
 use super::surface::{
-    Interaction, Lobe, area_lights, emitted, one_light, point_lights, reflectance, specular_bounce,
+    Interaction, Lobe, area_lights, emitted, one_light, point_lights, reflectance, sky,
+    specular_bounce,
 };
 pub use super::surface::{brdf_pdf as pdf, diffuse_probability};
 use crate::geometry::{Frame, Ray};
@@ -211,13 +212,15 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
 /// none under `Light`; the power heuristic under `Mis`, against the chance
 /// `P(env) pdf_env(wi)` that the light sample of the vertex it left picks its direction.
 fn escaped(tr: &Tracer, ray: &Ray, scattered: Option<Scattered>, lights: LightSampling) -> Vec3A {
+    // What the sky sends back (surface::sky decides between background and environment).
+    let le = sky(tr, ray.d, true);
     let Some(env) = tr
         .emitters
         .environment
         .as_ref()
         .filter(|_| tr.effects.emission)
     else {
-        return tr.background;
+        return le;
     };
     let w = match (scattered, lights) {
         (None, _) | (Some(_), LightSampling::Brdf) => 1.0,
@@ -226,7 +229,7 @@ fn escaped(tr: &Tracer, ray: &Ray, scattered: Option<Scattered>, lights: LightSa
             power_heuristic(v.pdf, tr.emitters.pmf_environment() * env.pdf(ray.d))
         }
     };
-    env.radiance(ray.d) * w
+    le * w
 }
 
 /// Next-event estimation at a vertex whose surface reflects as `lobe`: Eq. 3 under the model
