@@ -582,6 +582,44 @@ impl Geometry {
     }
 }
 
+impl Geometry {
+    /// The direction in which `u` grows along the surface of `prim` at `p`, `dp/du` (not
+    /// unit; Mitsuba 3's `dp_du`), for textured surfaces' shading frames: a triangle's from
+    /// its corners' texture coordinates (pbrt-v4's `Triangle::InteractionFromIntersection`),
+    /// the shape's tangent ([`Shape::tangent`]) for a triangle without them or whose
+    /// coordinates do not span the plane; a sphere's azimuth; a plane's `u` axis
+    /// ([`Geometry::uv`]).
+    #[inline]
+    pub fn dp_du(&self, prim: &Prim, p: glam::Vec3A) -> glam::Vec3A {
+        match prim.shape {
+            Shape::Triangle(t) => {
+                let uvs = match self.uvs.get(prim.smooth as usize) {
+                    Some(&c) if prim.smooth != FLAT => c,
+                    _ => return prim.shape.tangent(p),
+                };
+                let (d02, d12) = (uvs[0] - uvs[2], uvs[1] - uvs[2]);
+                let (p02, p12) = (t.v[0] - t.v[2], t.v[1] - t.v[2]);
+                let det = d02.x * d12.y - d02.y * d12.x;
+                let dpdu = (d12.y * p02 - d02.y * p12) / det;
+                if det.abs() > 1e-12 && dpdu.is_finite() && dpdu != glam::Vec3A::ZERO {
+                    dpdu
+                } else {
+                    prim.shape.tangent(p)
+                }
+            }
+            Shape::Sphere(_) => prim.shape.tangent(p),
+            Shape::Plane(pl) => {
+                let a = pl.n.abs();
+                if a.y >= a.x && a.y >= a.z || a.x < a.z {
+                    glam::Vec3A::X
+                } else {
+                    glam::Vec3A::Z
+                }
+            }
+        }
+    }
+}
+
 /// The barycentric coordinates `(b1, b2)` of point `p` in triangle `t` as ratios of signed
 /// areas, `((p - v0) x e2) . c / c . c` and `(e1 x (p - v0)) . c / c . c` with `c = e1 x e2`:
 /// accurate on thin triangles, where the normal equations of [`barycentric`] cancel (texture

@@ -70,6 +70,15 @@ fn texture(t: &Texture) -> String {
 }
 
 fn material(m: &Material, t: Option<&MaterialTextures>) -> String {
+    let inner = unmapped(m, t);
+    match t.and_then(|t| t.normal_map.as_ref()) {
+        Some(map) => format!("NormalMap(normal_map: {}, material: {inner})", texture(map)),
+        None => inner,
+    }
+}
+
+/// The material without its normal map.
+fn unmapped(m: &Material, t: Option<&MaterialTextures>) -> String {
     // A parameter's texture, else its constant.
     let paint = |tex: Option<&Texture>, c: Vec3A| tex.map_or_else(|| rgb(c), texture);
     let reflectance = t.and_then(|t| t.reflectance.as_ref());
@@ -86,43 +95,45 @@ fn material(m: &Material, t: Option<&MaterialTextures>) -> String {
             "Conductor(eta: {}, k: {}, specular_reflectance: {})",
             rgb(c.eta),
             rgb(c.k),
-            rgb(c.specular_reflectance)
+            paint(specular, c.specular_reflectance)
         ),
         Material::Transmissive(g) => format!(
             "Transmissive(ior: {}, color: {})",
             num(g.ior),
             paint(reflectance, g.color)
         ),
-        Material::Bsdf(b) => bsdf(b),
+        Material::Bsdf(b) => bsdf(b, t.unwrap_or(&MaterialTextures::default())),
     }
 }
 
-fn bsdf(b: &Bsdf) -> String {
+fn bsdf(b: &Bsdf, t: &MaterialTextures) -> String {
+    // A parameter's texture, else its constant.
+    let paint = |tex: &Option<Texture>, c: Vec3A| tex.as_ref().map_or_else(|| rgb(c), texture);
     let coating = |c: &Coating| {
         format!(
             "int_ior: {}, ext_ior: 1, diffuse_reflectance: {}, specular_reflectance: {}, \
              nonlinear: {}",
             num(c.eta),
-            rgb(c.diffuse_reflectance),
-            rgb(c.specular_reflectance),
+            paint(&t.reflectance, c.diffuse_reflectance),
+            paint(&t.specular, c.specular_reflectance),
             c.nonlinear
         )
     };
     match b {
         Bsdf::RoughConductor(r) => format!(
             "RoughConductor({}, eta: {}, k: {}, specular_reflectance: {})",
-            microfacet(&r.microfacet),
+            microfacet(&r.microfacet, t),
             rgb(r.metal.eta),
             rgb(r.metal.k),
-            rgb(r.metal.specular_reflectance)
+            paint(&t.specular, r.metal.specular_reflectance)
         ),
         Bsdf::RoughDielectric(r) => format!(
             "RoughDielectric({}, int_ior: {}, ext_ior: 1, specular_reflectance: {}, \
              specular_transmittance: {})",
-            microfacet(&r.microfacet),
+            microfacet(&r.microfacet, t),
             num(r.eta),
-            rgb(r.specular_reflectance),
-            rgb(r.specular_transmittance)
+            paint(&t.specular, r.specular_reflectance),
+            paint(&t.transmittance, r.specular_transmittance)
         ),
         Bsdf::RoughPlastic(r) => format!(
             "RoughPlastic(distribution: {:?}, alpha: {}, sampling: {:?}, {})",
@@ -135,12 +146,14 @@ fn bsdf(b: &Bsdf) -> String {
     }
 }
 
-fn microfacet(m: &Microfacet) -> String {
+/// A distribution's fields, each roughness its texture where it has one.
+fn microfacet(m: &Microfacet, t: &MaterialTextures) -> String {
+    let alpha = |tex: &Option<Texture>, a: f32| tex.as_ref().map_or_else(|| num(a), texture);
     format!(
         "distribution: {:?}, alpha_u: {}, alpha_v: {}, sampling: {:?}",
         m.distribution,
-        num(m.alpha_x),
-        num(m.alpha_y),
+        alpha(&t.alpha_u, m.alpha_x),
+        alpha(&t.alpha_v, m.alpha_y),
         m.sampling
     )
 }

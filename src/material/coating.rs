@@ -24,6 +24,8 @@ pub struct Coating {
     /// The specular share of the mean reflectances, `s = mean(specular) / (mean(diffuse) +
     /// mean(specular))`, which steers sampling.
     pub specular_weight: f32,
+    /// The share `F_dr` of diffuse light from below that the coating reflects back down.
+    pub internal: f32,
 }
 
 impl Coating {
@@ -54,7 +56,22 @@ impl Coating {
             diffuse: diffuse_reflectance / (Vec3A::ONE - trapped),
             specular_reflectance,
             specular_weight: if d + s > 0.0 { s / (d + s) } else { 0.5 },
+            internal,
         }
+    }
+
+    /// The same coating over a base of reflectance `diffuse_reflectance`, its own reflection
+    /// tinted by `specular_reflectance` (textured reflectances, looked up at a hit): the
+    /// light trapped under it, which depends on the coating alone, is kept.
+    #[inline]
+    pub fn retinted(&self, diffuse_reflectance: Vec3A, specular_reflectance: Vec3A) -> Self {
+        Coating::new(
+            self.eta,
+            diffuse_reflectance,
+            specular_reflectance,
+            self.nonlinear,
+            self.internal,
+        )
     }
 
     /// A smooth coating: the light trapped under it is [`diffuse_fresnel_reflectance`] from

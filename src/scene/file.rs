@@ -523,8 +523,8 @@ pub enum MaterialDesc {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         k: Option<IorPart>,
         /// Tint, a reflectance in [0, 1] per channel (default white).
-        #[serde(default = "unit")]
-        specular_reflectance: Reflectance,
+        #[serde(default = "white_paint")]
+        specular_reflectance: Paint,
     },
     /// A rough metal (Mitsuba 3's `roughconductor`): microfacets, each a [`Conductor`](
     /// MaterialDesc::Conductor)'s mirror, distributed by `distribution` with roughness `alpha`,
@@ -535,13 +535,13 @@ pub enum MaterialDesc {
         distribution: Distribution,
         /// Isotropic roughness, from 1e-4 to 1 (default 0.1 unless `alpha_u` and `alpha_v`).
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha: Option<Roughness>,
+        alpha: Option<Paint<Roughness>>,
         /// Roughness along the tangent, with `alpha_v`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_u: Option<Roughness>,
+        alpha_u: Option<Paint<Roughness>>,
         /// Roughness across the tangent, with `alpha_u`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_v: Option<Roughness>,
+        alpha_v: Option<Paint<Roughness>>,
         /// A metal of Mitsuba's table, instead of `eta` and `k` (default "none": Fresnel 1).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         material: Option<MetalName>,
@@ -552,8 +552,8 @@ pub enum MaterialDesc {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         k: Option<IorPart>,
         /// Tint, a reflectance in [0, 1] per channel (default white).
-        #[serde(default = "unit")]
-        specular_reflectance: Reflectance,
+        #[serde(default = "white_paint")]
+        specular_reflectance: Paint,
         /// Which normals are sampled: `Visible` (default) or `Full`.
         #[serde(default)]
         sampling: NormalSampling,
@@ -566,13 +566,13 @@ pub enum MaterialDesc {
         distribution: Distribution,
         /// Isotropic roughness, from 1e-4 to 1 (default 0.1 unless `alpha_u` and `alpha_v`).
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha: Option<Roughness>,
+        alpha: Option<Paint<Roughness>>,
         /// Roughness along the tangent, with `alpha_v`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_u: Option<Roughness>,
+        alpha_u: Option<Paint<Roughness>>,
         /// Roughness across the tangent, with `alpha_u`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
-        alpha_v: Option<Roughness>,
+        alpha_v: Option<Paint<Roughness>>,
         /// Index of refraction inside, from 0.01 to 100 (default 1.5046, BK7 glass).
         #[serde(default = "bk7")]
         int_ior: Ior,
@@ -580,11 +580,11 @@ pub enum MaterialDesc {
         #[serde(default = "air")]
         ext_ior: Ior,
         /// Tint of the reflection, a reflectance per channel (default white).
-        #[serde(default = "unit")]
-        specular_reflectance: Reflectance,
+        #[serde(default = "white_paint")]
+        specular_reflectance: Paint,
         /// Tint of the transmission, a reflectance per channel (default white).
-        #[serde(default = "unit")]
-        specular_transmittance: Reflectance,
+        #[serde(default = "white_paint")]
+        specular_transmittance: Paint,
         /// Which normals are sampled: `Visible` (default) or `Full`.
         #[serde(default)]
         sampling: NormalSampling,
@@ -604,11 +604,11 @@ pub enum MaterialDesc {
         #[serde(default = "air")]
         ext_ior: Ior,
         /// Reflectance of the base per channel (default 0.5).
-        #[serde(default = "half")]
-        diffuse_reflectance: Reflectance,
+        #[serde(default = "half_paint")]
+        diffuse_reflectance: Paint,
         /// Tint of the coating's reflection per channel (default white).
-        #[serde(default = "unit")]
-        specular_reflectance: Reflectance,
+        #[serde(default = "white_paint")]
+        specular_reflectance: Paint,
         /// Account for the base's colour in the light trapped under the coating (default
         /// false, as Mitsuba).
         #[serde(default)]
@@ -626,11 +626,11 @@ pub enum MaterialDesc {
         #[serde(default = "air")]
         ext_ior: Ior,
         /// Reflectance of the base per channel (default 0.5).
-        #[serde(default = "half")]
-        diffuse_reflectance: Reflectance,
+        #[serde(default = "half_paint")]
+        diffuse_reflectance: Paint,
         /// Tint of the coating's reflection per channel (default white).
-        #[serde(default = "unit")]
-        specular_reflectance: Reflectance,
+        #[serde(default = "white_paint")]
+        specular_reflectance: Paint,
         /// Account for the base's colour in the light trapped under the coating (default
         /// false, as Mitsuba).
         #[serde(default)]
@@ -644,15 +644,26 @@ pub enum MaterialDesc {
         #[serde(default = "white_paint")]
         color: Paint,
     },
+    /// Mitsuba 3's `normalmap`: `material` shaded with the normal a tangent-space normal map
+    /// gives (each texel `c` the normal `2 c - 1` in the frame of the surface's `dp/du`,
+    /// the normal's cross product with it, and the normal). The map is read as stored, never
+    /// decoded from sRGB.
+    NormalMap {
+        /// The map, an `Image(...)` (or any texture).
+        normal_map: TextureDesc,
+        /// The material it bends, written inline (not `Named`, not another `NormalMap`).
+        material: Box<MaterialDesc>,
+    },
 }
 
-/// A reflectance as written: a constant `(r, g, b)`, or a texture looked up at each hit.
+/// A material parameter as written: a constant (a reflectance `(r, g, b)` by default, or a
+/// [`Roughness`]), or a texture looked up at each hit.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(untagged)]
-pub enum Paint {
-    /// The same everywhere, each channel in [0, 1].
-    Constant(Reflectance),
-    /// A texture (its values clamped to [0, 1] where looked up).
+pub enum Paint<T = Reflectance> {
+    /// The same everywhere: each channel in [0, 1], or a roughness.
+    Constant(T),
+    /// A texture (its values clamped to the constant's range where looked up).
     Texture(TextureDesc),
 }
 
@@ -661,6 +672,9 @@ fn black_paint() -> Paint {
 }
 fn white_paint() -> Paint {
     Paint::Constant(unit())
+}
+fn half_paint() -> Paint {
+    Paint::Constant(half())
 }
 
 impl Paint {
@@ -672,7 +686,20 @@ impl Paint {
             Paint::Texture(_) => glam::Vec3A::ONE,
         }
     }
+}
 
+impl Paint<Roughness> {
+    /// The roughness, or Mitsuba's default 0.1 in place of a texture (which replaces it at
+    /// every hit).
+    fn roughness(&self) -> Roughness {
+        match self {
+            Paint::Constant(r) => *r,
+            Paint::Texture(_) => Roughness(0.1),
+        }
+    }
+}
+
+impl<T> Paint<T> {
     /// The texture, read by `load` (a path as written and `raw`).
     fn texture(&self, load: &mut ImageLoader) -> Result<Option<Texture>, String> {
         match self {
@@ -841,14 +868,83 @@ impl MaterialDesc {
             MaterialDesc::Phong { kd, ks, .. } => MaterialTextures {
                 reflectance: kd.texture(load)?,
                 specular: ks.texture(load)?,
+                ..Default::default()
             },
             MaterialDesc::Mirror { color } | MaterialDesc::Transmissive { color, .. } => {
                 MaterialTextures {
                     reflectance: color.texture(load)?,
-                    specular: None,
+                    ..Default::default()
                 }
             }
-            _ => MaterialTextures::default(),
+            MaterialDesc::Conductor {
+                specular_reflectance,
+                ..
+            } => MaterialTextures {
+                specular: specular_reflectance.texture(load)?,
+                ..Default::default()
+            },
+            MaterialDesc::RoughConductor {
+                alpha,
+                alpha_u,
+                alpha_v,
+                specular_reflectance,
+                ..
+            } => {
+                let (alpha_u, alpha_v) = alpha_textures(alpha, alpha_u, alpha_v, load)?;
+                MaterialTextures {
+                    specular: specular_reflectance.texture(load)?,
+                    alpha_u,
+                    alpha_v,
+                    ..Default::default()
+                }
+            }
+            MaterialDesc::RoughDielectric {
+                alpha,
+                alpha_u,
+                alpha_v,
+                specular_reflectance,
+                specular_transmittance,
+                ..
+            } => {
+                let (alpha_u, alpha_v) = alpha_textures(alpha, alpha_u, alpha_v, load)?;
+                MaterialTextures {
+                    specular: specular_reflectance.texture(load)?,
+                    transmittance: specular_transmittance.texture(load)?,
+                    alpha_u,
+                    alpha_v,
+                    ..Default::default()
+                }
+            }
+            MaterialDesc::RoughPlastic {
+                diffuse_reflectance,
+                specular_reflectance,
+                ..
+            }
+            | MaterialDesc::Plastic {
+                diffuse_reflectance,
+                specular_reflectance,
+                ..
+            } => MaterialTextures {
+                reflectance: diffuse_reflectance.texture(load)?,
+                specular: specular_reflectance.texture(load)?,
+                ..Default::default()
+            },
+            MaterialDesc::Named(_) => MaterialTextures::default(),
+            MaterialDesc::NormalMap {
+                normal_map,
+                material,
+            } => {
+                // The map's values are data: read raw.
+                let mut map = normal_map.clone();
+                if let TextureDesc::Image { raw, .. } = &mut map {
+                    *raw = true;
+                }
+                let map = map.to_world(load)?;
+                MaterialTextures {
+                    normal_map: Some(map),
+                    ..material.textures(load)?
+                }
+            }
         })
     }
 
@@ -857,9 +953,19 @@ impl MaterialDesc {
     /// one of `eta` and `k`). A textured parameter is white here ([`MaterialDesc::textures`]
     /// replaces it at each hit).
     pub fn to_world(&self) -> Result<Option<Material>, String> {
-        let rgb = |c: &Reflectance| c.0.as_vec3a();
         Ok(Some(match self {
             MaterialDesc::Named(_) => return Ok(None),
+            MaterialDesc::NormalMap { material, .. } => match material.as_ref() {
+                MaterialDesc::Named(_) | MaterialDesc::NormalMap { .. } => {
+                    return Err(
+                        "a NormalMap's `material` is written inline, not `Named` nor \
+                                another `NormalMap`: write the material itself, as \
+                                `material: Phong(kd: (0.8, 0.8, 0.8))`"
+                            .into(),
+                    );
+                }
+                inner => return inner.to_world(),
+            },
             MaterialDesc::Conductor {
                 material,
                 eta,
@@ -877,7 +983,7 @@ impl MaterialDesc {
                 specular_reflectance,
                 sampling,
             } => {
-                let microfacet = roughness(*distribution, *alpha, *alpha_u, *alpha_v, *sampling)?;
+                let microfacet = roughness(*distribution, alpha, alpha_u, alpha_v, *sampling)?;
                 let metal = conductor(material, eta, k, specular_reflectance)?;
                 Material::Bsdf(Bsdf::RoughConductor(RoughConductor { microfacet, metal }))
             }
@@ -892,10 +998,10 @@ impl MaterialDesc {
                 specular_transmittance,
                 sampling,
             } => Material::Bsdf(Bsdf::RoughDielectric(RoughDielectric {
-                microfacet: roughness(*distribution, *alpha, *alpha_u, *alpha_v, *sampling)?,
+                microfacet: roughness(*distribution, alpha, alpha_u, alpha_v, *sampling)?,
                 eta: relative_ior(*int_ior, *ext_ior)?,
-                specular_reflectance: rgb(specular_reflectance),
-                specular_transmittance: rgb(specular_transmittance),
+                specular_reflectance: specular_reflectance.constant(),
+                specular_transmittance: specular_transmittance.constant(),
             })),
             MaterialDesc::RoughPlastic {
                 distribution,
@@ -907,10 +1013,16 @@ impl MaterialDesc {
                 nonlinear,
                 sampling,
             } => Material::Bsdf(Bsdf::RoughPlastic(RoughPlastic::new(
-                roughness(*distribution, Some(*alpha), None, None, *sampling)?,
+                roughness(
+                    *distribution,
+                    &Some(Paint::Constant(*alpha)),
+                    &None,
+                    &None,
+                    *sampling,
+                )?,
                 relative_ior(*int_ior, *ext_ior)?,
-                rgb(diffuse_reflectance),
-                rgb(specular_reflectance),
+                diffuse_reflectance.constant(),
+                specular_reflectance.constant(),
                 *nonlinear,
             ))),
             MaterialDesc::Plastic {
@@ -922,8 +1034,8 @@ impl MaterialDesc {
             } => Material::Bsdf(Bsdf::Plastic(Plastic {
                 coating: Coating::smooth(
                     relative_ior(*int_ior, *ext_ior)?,
-                    rgb(diffuse_reflectance),
-                    rgb(specular_reflectance),
+                    diffuse_reflectance.constant(),
+                    specular_reflectance.constant(),
                     *nonlinear,
                 ),
             })),
@@ -948,7 +1060,7 @@ fn conductor(
     material: &Option<MetalName>,
     eta: &Option<IorPart>,
     k: &Option<IorPart>,
-    specular_reflectance: &Reflectance,
+    specular_reflectance: &Paint,
 ) -> Result<Conductor, String> {
     let (eta, k) = match (material, eta, k) {
         (Some(m), None, None) => m.0.eta_k(),
@@ -962,7 +1074,7 @@ fn conductor(
     Ok(Conductor {
         eta,
         k,
-        specular_reflectance: specular_reflectance.0.as_vec3a(),
+        specular_reflectance: specular_reflectance.constant(),
     })
 }
 
@@ -970,14 +1082,14 @@ fn conductor(
 /// `alpha_v` together, or neither (alpha 0.1, Mitsuba's default).
 fn roughness(
     distribution: Distribution,
-    alpha: Option<Roughness>,
-    alpha_u: Option<Roughness>,
-    alpha_v: Option<Roughness>,
+    alpha: &Option<Paint<Roughness>>,
+    alpha_u: &Option<Paint<Roughness>>,
+    alpha_v: &Option<Paint<Roughness>>,
     sampling: NormalSampling,
 ) -> Result<Microfacet, String> {
     let (ax, ay) = match (alpha, alpha_u, alpha_v) {
-        (Some(a), None, None) => (a.0, a.0),
-        (None, Some(u), Some(v)) => (u.0, v.0),
+        (Some(a), None, None) => (a.roughness().0, a.roughness().0),
+        (None, Some(u), Some(v)) => (u.roughness().0, v.roughness().0),
         (None, None, None) => (0.1, 0.1),
         (Some(_), ..) => {
             return Err(
@@ -991,6 +1103,28 @@ fn roughness(
         alpha_x: ax as f32,
         alpha_y: ay as f32,
         sampling,
+    })
+}
+
+/// The textures of a rough material's roughness: `alpha`'s along and across the tangent
+/// alike, or `alpha_u`'s and `alpha_v`'s (the fields' combination is checked by
+/// [`roughness`]).
+fn alpha_textures(
+    alpha: &Option<Paint<Roughness>>,
+    alpha_u: &Option<Paint<Roughness>>,
+    alpha_v: &Option<Paint<Roughness>>,
+    load: &mut ImageLoader,
+) -> Result<(Option<Texture>, Option<Texture>), String> {
+    let read = |p: &Option<Paint<Roughness>>, load: &mut ImageLoader| match p {
+        Some(p) => p.texture(load),
+        None => Ok(None),
+    };
+    Ok(match alpha {
+        Some(a) => {
+            let t = read(&Some(a.clone()), load)?;
+            (t.clone(), t)
+        }
+        None => (read(alpha_u, load)?, read(alpha_v, load)?),
     })
 }
 

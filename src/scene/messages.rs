@@ -56,6 +56,11 @@ pub const FORMS: &[(&str, &str, Variants)] = &[
             ("RoughPlastic", "RoughPlastic(alpha: 0.1)"),
             ("Plastic", "Plastic()"),
             ("Transmissive", "Transmissive(ior: 1.5)"),
+            (
+                "NormalMap",
+                "NormalMap(normal_map: Image(path: \"bumps.png\"), material: Phong(kd: (0.8, \
+                 0.8, 0.8)))",
+            ),
         ],
     ),
     (
@@ -654,8 +659,22 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
                 .into_iter()
                 .rev()
                 .collect();
-            let field = field_before(text, before.len() - name.len())
-                .map_or("this value".to_string(), |f| format!("`{f}`"));
+            let field_name = field_before(text, before.len() - name.len());
+            let field = field_name.map_or("this value".to_string(), |f| format!("`{f}`"));
+            // A roughness (`alpha`, `alpha_u`, `alpha_v`) or a colour.
+            let constant = if field_name.is_some_and(|f| f.starts_with("alpha")) {
+                "a roughness from 1e-4 to 1"
+            } else {
+                "a reflectance `(r, g, b)`"
+            };
+            // A number is meant as a roughness: its own error says what is wrong with it.
+            if name.is_empty()
+                && let Some(number) = token_at(text, start)
+                && let Ok(v) = number.parse::<f64>()
+                && let Err(m) = super::values::Roughness::try_from(v)
+            {
+                return format!("{field}: {m}; or give a texture");
+            }
             // A tuple is meant as a reflectance: its own error says what is wrong with it.
             if name.is_empty()
                 && let Some(tuple) = bracketed(text, start)
@@ -696,7 +715,7 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
                 format!("{found_q} is neither")
             };
             format!(
-                "{field} takes a reflectance `(r, g, b)` or a texture, \
+                "{field} takes {constant} or a texture, \
                  `Checkerboard(color0: (0.9, 0.9, 0.9), color1: (0.1, 0.1, 0.1))` or \
                  `Image(path: \"wood.png\")`: {why}"
             )

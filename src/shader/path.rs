@@ -190,6 +190,10 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                 None => break,
             },
         };
+        // A normal-mapped surface sends no ray through itself (nor reflects one from below).
+        if si.leaks(next_ray.d) {
+            break;
+        }
         beta *= weight;
         depth += 1;
         // Russian roulette: survive with probability q, divide by q to stay unbiased.

@@ -32,6 +32,12 @@ pub struct Interaction<'a> {
     /// The material with its textured parameters looked up here, when it has textures (boxed:
     /// an untextured hit carries one empty pointer).
     pub textured: Option<Box<Material>>,
+    /// The direction of `dp/du` at a textured hit (the tangent of its shading frame, as
+    /// Mitsuba 3's), else `None` (the shape's own tangent).
+    pub tangent: Option<Vec3A>,
+    /// True if a normal map bent `n`: directions whose side of the shading normal differs
+    /// from their side of the geometric surface then carry no light ([`Interaction::leaks`]).
+    pub bent: bool,
     /// Where rays leaving the hit start.
     pub origins: Origins,
     /// The surface's area light, or [`NO_LIGHT`].
@@ -46,33 +52,55 @@ impl<'a> Interaction<'a> {
         let wo = -ray.d;
         let prim = tr.geometry.prim(hit.prim);
         let i = prim.material as usize;
-        let textured = match tr.textures.get(i) {
-            Some(t) if !t.is_empty() => {
-                let uv = tr.geometry.uv(&prim, hit.p);
-                // The footprint of the sample here, in texture coordinates.
-                let width = tr.footprint.width(hit.p, hit.n) * tr.geometry.uv_rate(&prim, hit.p);
-                Some(Box::new(t.apply(
-                    &materials[i],
-                    uv,
-                    width,
-                    tr.model == Model::Physical,
-                )))
-            }
-            _ => None,
-        };
         let ng = if hit.n.dot(wo) < 0.0 { -hit.n } else { hit.n };
         // The shading normal stays on the viewer's side of the surface.
         let ns = tr.geometry.shading_normal(&prim, hit.p, ng);
-        let n = if ns.dot(ng) < 0.0 { -ns } else { ns };
+        let mut n = if ns.dot(ng) < 0.0 { -ns } else { ns };
+        let (mut textured, mut tangent, mut bent) = (None, None, false);
+        if let Some(t) = tr.textures.get(i).filter(|t| !t.is_empty()) {
+            let uv = tr.geometry.uv(&prim, hit.p);
+            // The footprint of the sample here, in texture coordinates.
+            let width = tr.footprint.width(hit.p, hit.n) * tr.geometry.uv_rate(&prim, hit.p);
+            let dp_du = tr.geometry.dp_du(&prim, hit.p);
+            tangent = Some(dp_du);
+            if t.has_parameters() {
+                let physical = tr.model == Model::Physical;
+                textured = Some(Box::new(t.apply(&materials[i], uv, width, physical)));
+            }
+            if let Some(local) = t.normal(uv, width) {
+                n = normal_mapped(local, n, ng, hit.n, wo, dp_du);
+                bent = true;
+            }
+        }
         Interaction {
             hit,
             wo,
             n,
             material: &materials[i],
             textured,
+            tangent,
+            bent,
             origins: Origins::new(&hit),
             light: prim.light,
         }
+    }
+
+    /// True if light along `wi` (unit, leaving the surface) would cross the surface on one
+    /// side of the geometric normal and the other of the shading normal: at a normal-mapped
+    /// hit such a direction carries nothing, so that no light leaks through the surface and
+    /// no ray goes on from the wrong side (pbrt-v3's rule for shading normals, Veach 1997
+    /// 5.3). Never at other hits, whose images stay as they were.
+    #[inline]
+    pub fn leaks(&self, wi: Vec3A) -> bool {
+        if !self.bent {
+            return false;
+        }
+        let ng = if self.hit.n.dot(self.wo) < 0.0 {
+            -self.hit.n
+        } else {
+            self.hit.n
+        };
+        (wi.dot(ng) > 0.0) != (wi.dot(self.n) > 0.0)
     }
 
     /// The material that shades here: the table's, its textured parameters looked up.
@@ -90,13 +118,15 @@ impl<'a> Interaction<'a> {
     /// The BSDF `bsdf` of this surface in its local frame: `z` the shading normal turned to
     /// the outside (the geometric normal's side), `x` the shape's tangent made orthogonal to it.
     #[inline]
-    pub fn shading<'b>(&self, tr: &Tracer, bsdf: &'b Bsdf) -> Shading<'b> {
+    pub fn shading(&self, tr: &Tracer, bsdf: &Bsdf) -> Shading {
         let n = if self.n.dot(self.hit.n) < 0.0 {
             -self.n
         } else {
             self.n
         };
-        let tangent = tr.geometry.prim(self.hit.prim).shape.tangent(self.hit.p);
+        let tangent = self
+            .tangent
+            .unwrap_or_else(|| tr.geometry.prim(self.hit.prim).shape.tangent(self.hit.p));
         let s = tangent - n * n.dot(tangent);
         let frame = match s.try_normalize() {
             Some(s) => Frame {
@@ -106,15 +136,66 @@ impl<'a> Interaction<'a> {
             },
             None => Frame::from_normal(n),
         };
-        Shading { bsdf, frame }
+        Shading { bsdf: *bsdf, frame }
     }
+}
+
+/// The shading normal on the viewer's side that a normal map gives (Mitsuba 3's `normalmap`):
+/// the map's `local` normal in the frame of the outward shading normal (`n` turned to the side
+/// of the geometric normal `n_out`) and the tangent `dp_du` made orthogonal to it, turned back to
+/// the viewer's side (`ng`, towards `wo`), then bent by [`valid_normal`].
+#[inline]
+fn normal_mapped(
+    local: Vec3A,
+    n: Vec3A,
+    ng: Vec3A,
+    n_out: Vec3A,
+    wo: Vec3A,
+    dp_du: Vec3A,
+) -> Vec3A {
+    let outward = n.dot(n_out) < 0.0;
+    let ns = if outward { -n } else { n };
+    let frame = match (dp_du - ns * ns.dot(dp_du)).try_normalize() {
+        Some(s) => Frame {
+            s,
+            t: ns.cross(s),
+            n: ns,
+        },
+        None => Frame::from_normal(ns),
+    };
+    // Unit to rounding: the frame is orthonormal, `local` unit.
+    let mapped = frame.to_world(local);
+    valid_normal(if outward { -mapped } else { mapped }, ng, wo)
+}
+
+/// The shading normal `n` bent, where needed, so that the viewer `wo` is above it and its
+/// mirror direction above the geometric surface `ng` (all on the viewer's side; `n` itself
+/// above it too): a normal
+/// map's normal can lean so far that `wo` is below it (a black pixel) or its reflection goes
+/// through the surface. When the mirror direction `r` of `wo` about `n` is lower than `min(0.9
+/// wo.ng, 0.01)` above the surface, it is raised to that height in its own plane through `ng`,
+/// and `n` becomes the half vector of `wo` and it (Cycles' `ensure_valid_reflection`; Schussler
+/// et al. 2017 discuss the problem). Unchanged otherwise.
+#[inline]
+pub fn valid_normal(n: Vec3A, ng: Vec3A, wo: Vec3A) -> Vec3A {
+    let r = 2.0 * wo.dot(n) * n - wo;
+    let height = (0.9 * wo.dot(ng)).min(0.01);
+    if wo.dot(n) > 0.0 && n.dot(ng) > 0.0 && r.dot(ng) >= height {
+        return n;
+    }
+    // r's direction along the surface (or any, if r is the normal's opposite), lifted.
+    let along = (r - ng * r.dot(ng))
+        .try_normalize()
+        .unwrap_or_else(|| ng.any_orthonormal_vector());
+    let lifted = along * (1.0 - height * height).max(0.0).sqrt() + ng * height;
+    (wo + lifted).normalize_or(ng)
 }
 
 /// A BSDF at a hit, with the local frame it is evaluated in.
 #[derive(Clone, Copy, Debug)]
-pub struct Shading<'a> {
-    /// The material.
-    pub bsdf: &'a Bsdf,
+pub struct Shading {
+    /// The material (a copy: a textured one lives only as long as its hit).
+    pub bsdf: Bsdf,
     /// Its local frame.
     pub frame: Frame,
 }
@@ -159,7 +240,7 @@ impl Lobe for Phong {
 
 /// A BSDF's weights are `f |cos(theta_i)|` and its own sampler's density under every model and
 /// sampling strategy: the strategies and the course's reflectance are Phong's.
-impl Lobe for Shading<'_> {
+impl Lobe for Shading {
     #[inline]
     fn is_black(&self) -> bool {
         false
@@ -267,7 +348,7 @@ fn point_light<L: Lobe>(tr: &mut Tracer, si: &Interaction, lobe: &L, light: &Lig
 #[inline]
 fn point_light_ray(si: &Interaction, light: &Light, transmits: bool) -> Option<(Incident, Ray)> {
     let inc = light.incident(si.hit.p)?;
-    if !transmits && inc.wi.dot(si.n) <= 0.0 {
+    if (!transmits && inc.wi.dot(si.n) <= 0.0) || si.leaks(inc.wi) {
         return None;
     }
     let shadow = si.origins.ray(inc.wi, inc.dist * SHADOW_END);
@@ -430,7 +511,7 @@ fn light_term<L: Lobe>(
     pmf: f32,
     mis: Option<Sampling>,
 ) -> Vec3A {
-    if ls.le == Vec3A::ZERO || (!lobe.transmits() && ls.wi.dot(si.n) <= 0.0) {
+    if ls.le == Vec3A::ZERO || (!lobe.transmits() && ls.wi.dot(si.n) <= 0.0) || si.leaks(ls.wi) {
         return Vec3A::ZERO;
     }
     let pdf = pmf * ls.pdf;
@@ -543,7 +624,7 @@ pub enum ChainEnd<'a> {
         /// The hit.
         si: Interaction<'a>,
         /// Its BSDF and frame.
-        shading: Shading<'a>,
+        shading: Shading,
         /// Throughput of the chain.
         beta: Vec3A,
     },
@@ -588,12 +669,12 @@ pub fn follow_specular<'a>(
         if see_first || chain > 0 {
             le += beta * emitted(tr, &si);
         }
-        // Phong as textured here; a BSDF (never textured) from the table, which outlives `si`.
+        // Phong or a BSDF as textured here.
         if let Material::Phong(phong) = si.material() {
             let phong = *phong;
             return (ChainEnd::Phong { si, phong, beta }, le);
         }
-        if let Material::Bsdf(bsdf) = si.material {
+        if let Material::Bsdf(bsdf) = si.material() {
             let shading = si.shading(tr, bsdf);
             return (ChainEnd::Bsdf { si, shading, beta }, le);
         }

@@ -131,28 +131,59 @@ mod tests {
     }
 }
 
-/// The textures a material's parameters are read from, each in place of its constant: its
-/// reflectance (Phong's `kd`, a mirror's or glass's `color`) and its specular coefficient
-/// (Phong's `ks`). Looked up at a hit before the material is evaluated
-/// ([`MaterialTextures::apply`]).
+/// The textures a material's parameters are read from, each in place of its constant. Looked
+/// up at a hit before the material is evaluated ([`MaterialTextures::apply`]).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MaterialTextures {
-    /// Phong's `kd`; `Mirror` and `Transmissive`'s `color`.
+    /// Phong's `kd`; `Mirror` and `Transmissive`'s `color`; the plastics'
+    /// `diffuse_reflectance`.
     pub reflectance: Option<Texture>,
-    /// Phong's `ks`.
+    /// Phong's `ks`; the conductors', rough dielectric's and plastics' `specular_reflectance`.
     pub specular: Option<Texture>,
+    /// The rough dielectric's `specular_transmittance`.
+    pub transmittance: Option<Texture>,
+    /// A rough conductor's or dielectric's roughness along the tangent (`alpha_u`, or `alpha`
+    /// with [`MaterialTextures::alpha_v`] the same texture): the texture's luminance.
+    pub alpha_u: Option<Texture>,
+    /// Its roughness across the tangent (`alpha_v`).
+    pub alpha_v: Option<Texture>,
+    /// A tangent-space normal map (Mitsuba 3's `normalmap`): each texel `c` is the shading
+    /// normal `2 c - 1` in the frame of the surface's tangent, bitangent and normal.
+    pub normal_map: Option<Texture>,
 }
 
 impl MaterialTextures {
-    /// True if no parameter is textured.
+    /// True if nothing is textured.
     pub fn is_empty(&self) -> bool {
-        self.reflectance.is_none() && self.specular.is_none()
+        !self.has_parameters() && self.normal_map.is_none()
+    }
+
+    /// True if a parameter other than the normal is textured (the material is looked up at
+    /// each hit).
+    #[inline]
+    pub fn has_parameters(&self) -> bool {
+        self.reflectance.is_some()
+            || self.specular.is_some()
+            || self.transmittance.is_some()
+            || self.alpha_u.is_some()
+            || self.alpha_v.is_some()
+    }
+
+    /// The shading normal the normal map gives at `uv` for a footprint `width` wide, in the
+    /// local frame (`z` the surface's normal, `x` its tangent): `2 c - 1` for the map's
+    /// colour `c`, normalised; `+z` where that has no length. `None` without a map.
+    #[inline]
+    pub fn normal(&self, uv: Vec2, width: f32) -> Option<Vec3A> {
+        let map = self.normal_map.as_ref()?;
+        let n = map.eval(uv, width) * 2.0 - Vec3A::ONE;
+        Some(n.try_normalize().unwrap_or(Vec3A::Z))
     }
 
     /// `material` with its textured parameters looked up at `uv` for a footprint `width` wide
-    /// in texture coordinates, each channel clamped to [0, 1] (a reflectance); under the
-    /// physically based model (`physical`) a Phong material whose `kd + ks` then exceeds 1 is
-    /// scaled down as a constant one is at extraction.
+    /// in texture coordinates: each colour channel clamped to [0, 1] (a reflectance), each
+    /// roughness (luminance) to [1e-4, 1]. Under the physically based model (`physical`) a
+    /// Phong material whose `kd + ks` then exceeds 1 is scaled down as a constant one is at
+    /// extraction.
     #[inline]
     pub fn apply(
         &self,
@@ -161,35 +192,75 @@ impl MaterialTextures {
         width: f32,
         physical: bool,
     ) -> crate::material::Material {
-        use crate::material::Material;
+        use crate::material::microfacet::{MIN_ALPHA, Microfacet};
+        use crate::material::{Bsdf, Material};
         let at = |t: &Option<Texture>| {
             t.as_ref()
                 .map(|t| t.eval(uv, width).clamp(Vec3A::ZERO, Vec3A::ONE))
         };
+        let set = |c: &mut Vec3A, t: &Option<Texture>| {
+            if let Some(v) = at(t) {
+                *c = v;
+            }
+        };
+        // Roughness: the luminance (Rec. 709 weights, as Mitsuba's one-channel lookup); a
+        // grey texel's own value, exactly.
+        let rough = |m: &mut Microfacet| {
+            let lum = |t: &Option<Texture>| {
+                t.as_ref().map(|t| {
+                    let c = t.eval(uv, width);
+                    let y = if c.x == c.y && c.y == c.z {
+                        c.x
+                    } else {
+                        0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+                    };
+                    y.clamp(MIN_ALPHA, 1.0)
+                })
+            };
+            if let Some(a) = lum(&self.alpha_u) {
+                m.alpha_x = a;
+            }
+            if let Some(a) = lum(&self.alpha_v) {
+                m.alpha_y = a;
+            }
+        };
         let mut m = *material;
         match &mut m {
             Material::Phong(p) => {
-                if let Some(kd) = at(&self.reflectance) {
-                    p.kd = kd;
-                }
-                if let Some(ks) = at(&self.specular) {
-                    p.ks = ks;
-                }
+                set(&mut p.kd, &self.reflectance);
+                set(&mut p.ks, &self.specular);
                 if physical && let Some(scaled) = p.energy_conserving() {
                     *p = scaled;
                 }
             }
-            Material::Mirror(mirror) => {
-                if let Some(c) = at(&self.reflectance) {
-                    mirror.color = c;
-                }
+            Material::Mirror(mirror) => set(&mut mirror.color, &self.reflectance),
+            Material::Transmissive(glass) => set(&mut glass.color, &self.reflectance),
+            Material::Conductor(c) => set(&mut c.specular_reflectance, &self.specular),
+            Material::Bsdf(Bsdf::RoughConductor(b)) => {
+                set(&mut b.metal.specular_reflectance, &self.specular);
+                rough(&mut b.microfacet);
             }
-            Material::Transmissive(glass) => {
-                if let Some(c) = at(&self.reflectance) {
-                    glass.color = c;
-                }
+            Material::Bsdf(Bsdf::RoughDielectric(b)) => {
+                set(&mut b.specular_reflectance, &self.specular);
+                set(&mut b.specular_transmittance, &self.transmittance);
+                rough(&mut b.microfacet);
             }
-            Material::Conductor(_) | Material::Bsdf(_) => {}
+            Material::Bsdf(Bsdf::RoughPlastic(b)) => {
+                let c = &b.coating;
+                let (kd, ks) = (
+                    at(&self.reflectance).unwrap_or(c.diffuse_reflectance),
+                    at(&self.specular).unwrap_or(c.specular_reflectance),
+                );
+                b.coating = c.retinted(kd, ks);
+            }
+            Material::Bsdf(Bsdf::Plastic(b)) => {
+                let c = &b.coating;
+                let (kd, ks) = (
+                    at(&self.reflectance).unwrap_or(c.diffuse_reflectance),
+                    at(&self.specular).unwrap_or(c.specular_reflectance),
+                );
+                b.coating = c.retinted(kd, ks);
+            }
         }
         m
     }

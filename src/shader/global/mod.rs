@@ -114,6 +114,10 @@ fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Ve
             for _ in 0..g.samples {
                 let (u1, u2) = tr.sampler.next_2d();
                 let wj = frame.to_world(hemisphere::uniform(u1, u2));
+                // A normal-mapped surface takes no light through itself.
+                if si.leaks(wj) {
+                    continue;
+                }
                 let l_i = incident(tr, g, si.spawn(wj), &mut stack);
                 sum += l_i * reflectance(model, phong, wj, wo, n);
             }

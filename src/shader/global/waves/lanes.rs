@@ -407,6 +407,8 @@ unsafe fn chunk<L: Floats>(
                 material: &materials[e.material as usize],
                 // The waves do not run where materials have textures.
                 textured: None,
+                tangent: None,
+                bent: false,
                 origins: Origins {
                     front: vec3(&v, FRONT, i),
                     back: vec3(&v, BACK, i),
