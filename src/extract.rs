@@ -8,13 +8,14 @@
 use crate::accel::{FLAT, Geometry, Prim};
 use crate::geometry::{Aabb, Placement};
 use crate::light::{
-    AreaLight, Emitter, Emitters, Emitting, Light, NO_LIGHT, PointLight, SpotLight,
+    AreaLight, EmissionTexture, Emitter, Emitters, Emitting, Light, NO_LIGHT, PointLight,
+    RadianceTexture, SpotLight,
 };
 use crate::material::{Material, Model};
 use crate::render::{RenderScene, effects};
 use crate::shader::Shader;
 use crate::shape::{Corners, Shape};
-use crate::texture::{Footprint, MaterialTextures};
+use crate::texture::{Footprint, MaterialTextures, Texture};
 use crate::world::{Name, Projection, Scene, Transform, WorldEnvironment, WorldLight, WorldShape};
 use glam::Vec3A;
 
@@ -33,8 +34,10 @@ pub fn extract(scene: &Scene) -> RenderScene {
     let mut normals = Vec::new();
     let mut uvs: Vec<Option<[glam::Vec2; 3]>> = Vec::new();
     let mut area_lights = Vec::new();
+    // The textures of emitters whose radiance is textured.
+    let mut emission_textures: Vec<Texture> = Vec::new();
     let none = MaterialTextures::default();
-    for (entity, shape, m, tex, name, transform, emitter) in scene
+    for (entity, shape, m, tex, name, transform, (emitter, radiance)) in scene
         .world
         .query::<(
             hecs::Entity,
@@ -43,7 +46,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
             Option<&MaterialTextures>,
             Option<&Name>,
             Option<&Transform>,
-            Option<&Emitter>,
+            (Option<&Emitter>, Option<&RadianceTexture>),
         )>()
         .iter()
     {
@@ -60,7 +63,12 @@ pub fn extract(scene: &Scene) -> RenderScene {
         let place = Placement::new(transform, origin);
         // Texture coordinates are kept only where a texture reads them: other triangles stay
         // flat, shaded as before at no cost.
-        let textured = !tex.is_empty();
+        let textured = !tex.is_empty() || radiance.is_some();
+        // A textured emitter's texture, stored once for all of its primitives.
+        let emission = radiance.map(|RadianceTexture(t)| {
+            emission_textures.push(t.clone());
+            ((emission_textures.len() - 1) as u32, t.mean())
+        });
         let dropped = shape.extract(&place, &mut |shape, corners| {
             let corners = Corners {
                 uvs: corners.uvs.filter(|_| textured),
@@ -85,7 +93,23 @@ pub fn extract(scene: &Scene) -> RenderScene {
             };
             let light = match (emitter, emitting) {
                 (Some(&emitter), Some(shape)) => {
-                    area_lights.push(AreaLight::new(shape, emitter));
+                    area_lights.push(match emission {
+                        Some((index, mean)) => AreaLight::textured(
+                            shape,
+                            emitter,
+                            EmissionTexture {
+                                index,
+                                // A triangle without coordinates: its barycentric defaults.
+                                uvs: corners.uvs.unwrap_or([
+                                    glam::Vec2::ZERO,
+                                    glam::Vec2::X,
+                                    glam::Vec2::Y,
+                                ]),
+                                mean,
+                            },
+                        ),
+                        None => AreaLight::new(shape, emitter),
+                    });
                     (area_lights.len() - 1) as u32
                 }
                 _ => NO_LIGHT,
@@ -182,7 +206,8 @@ pub fn extract(scene: &Scene) -> RenderScene {
         .iter()
         .next()
         .map(|env| env.extract(scene_radius));
-    let emitters = Emitters::with_points(area_lights, environment, &[]);
+    let mut emitters = Emitters::with_points(area_lights, environment, &[]);
+    emitters.textures = emission_textures;
 
     // The effects, derived once from the parts, before the render scene is assembled.
     let derived = effects::derive(

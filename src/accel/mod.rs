@@ -371,15 +371,7 @@ impl Geometry {
                     _ => Vec2::new(b1, b2),
                 }
             }
-            Shape::Sphere(s) => {
-                let d = ((p - s.c) / s.r).clamp(glam::Vec3A::splat(-1.0), glam::Vec3A::ONE);
-                let phi = d.y.atan2(d.x).rem_euclid(std::f32::consts::TAU);
-                let u = phi / std::f32::consts::TAU;
-                Vec2::new(
-                    if u >= 1.0 { 0.0 } else { u },
-                    d.z.acos() / std::f32::consts::PI,
-                )
-            }
+            Shape::Sphere(s) => crate::shape::sphere_uv((p - s.c) / s.r),
             Shape::Plane(pl) => {
                 let d = p - pl.origin;
                 let a = pl.n.abs();

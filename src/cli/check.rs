@@ -16,8 +16,8 @@ use rtis::scene::{self, Scene};
 use rtis::shader::Shader;
 use rtis::texture::{MaterialTextures, Texture, TextureKind};
 use rtis::world::{
-    Emitter, Material, MaterialName, Name, Projection, Transform, WorldEnvironment, WorldLight,
-    WorldShape,
+    Emitter, Material, MaterialName, Name, Projection, RadianceTexture, Transform,
+    WorldEnvironment, WorldLight, WorldShape,
 };
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -320,7 +320,7 @@ pub fn to_ron(scene: &Scene) -> String {
 
     // One line per entity, in the order of the file.
     let mut entities: Vec<(hecs::Entity, String)> = Vec::new();
-    for (id, name, sh, m, mname, tex, t, light, env, emitter) in scene
+    for (id, name, sh, m, mname, tex, t, light, env, (emitter, radiance)) in scene
         .world
         .query::<(
             hecs::Entity,
@@ -332,7 +332,7 @@ pub fn to_ron(scene: &Scene) -> String {
             Option<&Transform>,
             Option<&WorldLight>,
             Option<&WorldEnvironment>,
-            Option<&Emitter>,
+            (Option<&Emitter>, Option<&RadianceTexture>),
         )>()
         .iter()
     {
@@ -404,9 +404,10 @@ pub fn to_ron(scene: &Scene) -> String {
             ));
         }
         if let Some(e) = emitter {
+            // A textured radiance is its texture (the constant factor is white).
+            let radiance = radiance.map_or_else(|| rgb(e.radiance), |r| texture(&r.0));
             fields.push(format!(
-                "emitter: Emitter(radiance: {}, two_sided: {})",
-                rgb(e.radiance),
+                "emitter: Emitter(radiance: {radiance}, two_sided: {})",
                 e.two_sided
             ));
         }

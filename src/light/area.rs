@@ -8,7 +8,8 @@
 
 use crate::sampling::warp::{cone_one_minus_cos, uniform_sphere, uniform_triangle};
 use crate::shape::{Shape, Sphere, Triangle};
-use glam::Vec3A;
+use crate::texture::Texture;
+use glam::{Vec2, Vec3A};
 use std::f32::consts::{PI, TAU};
 
 /// The emitter component of an entity: its shape emits `radiance` on the side its normal points
@@ -20,6 +21,24 @@ pub struct Emitter {
     pub radiance: Vec3A,
     /// Emit from both sides of the surface.
     pub two_sided: bool,
+}
+
+/// The world component of an emitter whose radiance varies over its surface: the texture,
+/// looked up at each point's texture coordinates, times the [`Emitter`]'s radiance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RadianceTexture(pub Texture);
+
+/// An area light's textured radiance in the render data: the texture's index in
+/// [`crate::light::Emitters::textures`], its corners' texture coordinates (a triangle's), and
+/// the texture's mean (which weighs the light's power).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmissionTexture {
+    /// Index of the texture.
+    pub index: u32,
+    /// A triangle's corners' `(u, v)` (unused for a sphere).
+    pub uvs: [Vec2; 3],
+    /// The texture's mean over its image.
+    pub mean: Vec3A,
 }
 
 /// The shape of an area light, in render coordinates.
@@ -64,6 +83,8 @@ pub struct AreaLight {
     pub emitter: Emitter,
     /// Its surface area, computed once: every light sample and every MIS weight reads it.
     area: f32,
+    /// Its textured radiance, if any (then `emitter.radiance` is the texture's factor).
+    pub texture: Option<EmissionTexture>,
 }
 
 /// A point sampled on an area light, seen from the shaded point.
@@ -77,6 +98,9 @@ pub struct LightSample {
     pub le: Vec3A,
     /// Density of `wi` per unit solid angle.
     pub pdf: f32,
+    /// The sampled point's texture coordinates when the light is textured (else zero); `le`
+    /// is then still the constant factor, which [`crate::light::Emitters::textured`] scales.
+    pub uv: Vec2,
 }
 
 impl AreaLight {
@@ -90,6 +114,15 @@ impl AreaLight {
             shape,
             emitter,
             area,
+            texture: None,
+        }
+    }
+
+    /// The light of `shape` emitting as `emitter` times `texture`.
+    pub fn textured(shape: Emitting, emitter: Emitter, texture: EmissionTexture) -> Self {
+        AreaLight {
+            texture: Some(texture),
+            ..AreaLight::new(shape, emitter)
         }
     }
 
@@ -103,7 +136,8 @@ impl AreaLight {
     /// the weight of this light when one is chosen per shading point.
     pub fn power(&self) -> f32 {
         let sides = if self.emitter.two_sided { 2.0 } else { 1.0 };
-        PI * self.area() * sides * self.emitter.radiance.element_sum() / 3.0
+        let mean = self.texture.map_or(Vec3A::ONE, |t| t.mean);
+        PI * self.area() * sides * (self.emitter.radiance * mean).element_sum() / 3.0
     }
 
     /// Radiance leaving the surface of geometric normal `n` in direction `w` (unit, away from
@@ -121,7 +155,7 @@ impl AreaLight {
     /// when the sample has no density (`p` on the light, an edge-on triangle).
     #[inline]
     pub fn sample(&self, p: Vec3A, u1: f32, u2: f32) -> Option<LightSample> {
-        let (q, nq, pdf) = match self.shape {
+        let (q, nq, pdf, uv) = match self.shape {
             Emitting::Sphere(s) => {
                 let f = s.c - p;
                 let d2 = f.length_squared();
@@ -129,7 +163,7 @@ impl AreaLight {
                 if !by_cone(d2, s.r) {
                     // Inside or on the surface: uniform by area, converted to solid angle below.
                     let n = uniform_sphere(u1, u2);
-                    (s.c + s.r * n, n, None)
+                    (s.c + s.r * n, n, None, self.sphere_uv(n))
                 } else {
                     // Outside: uniform in the cone of directions the sphere subtends.
                     let sin2_max = r2 / d2;
@@ -147,12 +181,16 @@ impl AreaLight {
                     let n = frame
                         .to_world(Vec3A::new(sin_a * cos_p, sin_a * sin_p, cos_a))
                         .normalize();
-                    (s.c + s.r * n, n, Some(1.0 / (TAU * one_minus_cos_max)))
+                    let pdf = 1.0 / (TAU * one_minus_cos_max);
+                    (s.c + s.r * n, n, Some(pdf), self.sphere_uv(n))
                 }
             }
             Emitting::Triangle(t) => {
                 let [b0, b1, b2] = uniform_triangle(u1, u2);
-                (b0 * t.v[0] + b1 * t.v[1] + b2 * t.v[2], t.n, None)
+                let uv = self.texture.map_or(Vec2::ZERO, |t| {
+                    b0 * t.uvs[0] + b1 * t.uvs[1] + b2 * t.uvs[2]
+                });
+                (b0 * t.v[0] + b1 * t.v[1] + b2 * t.v[2], t.n, None, uv)
             }
         };
         let to = q - p;
@@ -171,7 +209,17 @@ impl AreaLight {
             dist,
             le: self.emitted(nq, -wi),
             pdf,
+            uv,
         })
+    }
+
+    /// A textured sphere's coordinates at its unit direction `n` from the centre (else zero).
+    #[inline]
+    fn sphere_uv(&self, n: Vec3A) -> Vec2 {
+        match self.texture {
+            Some(_) => crate::shape::sphere_uv(n),
+            None => Vec2::ZERO,
+        }
     }
 
     /// Density per unit solid angle with which [`AreaLight::sample`] from `p` picks the

@@ -3,6 +3,7 @@
 
 use super::{AreaLight, EnvironmentLight};
 use crate::geometry::Ray;
+use crate::texture::Texture;
 use glam::Vec3A;
 
 /// [`crate::light`]'s index of a primitive that emits nothing.
@@ -29,6 +30,8 @@ pub struct Emitters {
     pub lights: Vec<AreaLight>,
     /// The environment light, if the scene has one (at most one).
     pub environment: Option<EnvironmentLight>,
+    /// The textures of the lights with textured radiance ([`AreaLight::texture`]).
+    pub textures: Vec<Texture>,
     /// `cdf[i]`: the power of lights `0..=i` over the total; the last is 1. Double precision,
     /// and sampled with 53-bit numbers, so that a light whose share is below f32's 2^-24 grid
     /// (one small triangle of a million) is still chosen as often as [`Emitters::pmf`] says.
@@ -78,8 +81,20 @@ impl Emitters {
         Emitters {
             lights,
             environment,
+            textures: Vec::new(),
             cdf,
             pmf,
+        }
+    }
+
+    /// `le`, the radiance `light` emits as its constant factor gives it, times its texture at
+    /// `uv` for a footprint `width` wide in texture coordinates (0 for a light sample: the
+    /// finest level); `le` itself for an untextured light.
+    #[inline]
+    pub fn textured(&self, light: &AreaLight, le: Vec3A, uv: glam::Vec2, width: f32) -> Vec3A {
+        match light.texture {
+            Some(t) if le != Vec3A::ZERO => le * self.textures[t.index as usize].eval(uv, width),
+            _ => le,
         }
     }
 

@@ -125,6 +125,7 @@ impl EnvironmentLight {
             dist: f32::INFINITY,
             le: le * self.scale,
             pdf,
+            uv: glam::Vec2::ZERO,
         })
     }
 

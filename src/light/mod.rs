@@ -16,7 +16,7 @@ mod point;
 mod sky_map;
 mod spot;
 
-pub use area::{AreaLight, Emitter, Emitting, LightSample};
+pub use area::{AreaLight, EmissionTexture, Emitter, Emitting, LightSample, RadianceTexture};
 pub use directional::DirectionalLight;
 pub use emitters::{Chosen, Emitters, NO_LIGHT};
 pub use environment::{EnvironmentLight, Sky, WorldEnvironment};

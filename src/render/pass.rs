@@ -68,6 +68,15 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
     if !scene.textures.is_empty() {
         let _ = write!(h, "|{:?}|{:?}", scene.textures, scene.geometry.uvs);
     }
+    if !scene.emitters.textures.is_empty() {
+        let textured = scene.emitters.lights.iter().map(|l| l.texture);
+        let _ = write!(
+            h,
+            "|{:?}|{:?}",
+            scene.emitters.textures,
+            textured.collect::<Vec<_>>()
+        );
+    }
     if let Some(env) = &scene.emitters.environment {
         let _ = write!(h, "|{env:?}");
     }

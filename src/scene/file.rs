@@ -12,7 +12,7 @@ use super::values::{
 use crate::camera::{Projection, WorldCamera, WorldLens};
 use crate::effects::Switches;
 use crate::geometry::Transform;
-use crate::light::{Emitter, Sky, WorldEnvironment, WorldLight};
+use crate::light::{Emitter, RadianceTexture, Sky, WorldEnvironment, WorldLight};
 use crate::material::conductor::{Conductor, Metal};
 use crate::material::microfacet::Microfacet;
 use crate::material::plastic::Plastic;
@@ -1489,11 +1489,12 @@ impl LightDesc {
 
 /// An emitter as written: the entity's shape emits `radiance` from its surface (a diffuse area
 /// light).
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(rename = "Emitter", deny_unknown_fields)]
 pub struct EmitterDesc {
-    /// Emitted radiance, W/(m^2 sr) per channel, >= 0.
-    pub radiance: Rgb,
+    /// Emitted radiance, W/(m^2 sr) per channel, >= 0; or a texture whose values are the
+    /// radiance at each point (an OpenEXR image's as stored, a PNG's decoded from sRGB).
+    pub radiance: Paint<Rgb>,
     /// Emit from both sides (default `false`: only on the side the shape's normal points to,
     /// outward for spheres, `(b - a) x (c - a)` for triangles, `u x v` for rectangles).
     #[serde(default)]
@@ -1501,12 +1502,21 @@ pub struct EmitterDesc {
 }
 
 impl EmitterDesc {
-    /// The world's emitter component.
+    /// The world's emitter component (a textured radiance is white here: its texture,
+    /// [`EmitterDesc::texture`], gives it at each point).
     pub fn to_world(&self) -> Emitter {
         Emitter {
-            radiance: self.radiance.0.as_vec3a(),
+            radiance: match &self.radiance {
+                Paint::Constant(c) => c.0.as_vec3a(),
+                Paint::Texture(_) => glam::Vec3A::ONE,
+            },
             two_sided: self.two_sided,
         }
+    }
+
+    /// The texture of its radiance, if it has one, its image read by `load`.
+    pub fn texture(&self, load: &mut ImageLoader) -> Result<Option<RadianceTexture>, String> {
+        Ok(self.radiance.texture(load)?.map(RadianceTexture))
     }
 }
 

@@ -544,6 +544,13 @@ impl Resolved {
             }
             if let Some(emitter) = &e.emitter {
                 b.add(emitter.to_world());
+                let dir = src.dir.as_deref();
+                let texture = emitter
+                    .texture(&mut |path, raw| load_image(&mut images, &mut files, dir, path, raw))
+                    .map_err(|why| src.error(place("emitter", Some("radiance")), why))?;
+                if let Some(t) = texture {
+                    b.add(t);
+                }
             }
             match &e.material {
                 Some(MaterialDesc::Named(n)) => match self.materials.get(n) {

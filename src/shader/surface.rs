@@ -278,7 +278,16 @@ pub fn emitted(tr: &Tracer, si: &Interaction) -> Vec3A {
     if si.light == NO_LIGHT || !tr.effects.emission {
         return Vec3A::ZERO;
     }
-    tr.emitters.lights[si.light as usize].emitted(si.hit.n, si.wo)
+    let light = &tr.emitters.lights[si.light as usize];
+    let le = light.emitted(si.hit.n, si.wo);
+    if light.texture.is_none() {
+        return le;
+    }
+    // A textured light's radiance at the hit, filtered by the sample's footprint there.
+    let prim = tr.geometry.prim(si.hit.prim);
+    let uv = tr.geometry.uv(&prim, si.hit.p);
+    let width = tr.footprint.width(si.hit.p, si.hit.n) * tr.geometry.uv_rate(&prim, si.hit.p);
+    tr.emitters.textured(light, le, uv, width)
 }
 
 /// Radiance that a ray of unit direction `d` leaving the scene brings back: the background; or,
@@ -475,9 +484,11 @@ fn area_sample<L: Lobe>(
     (u1, u2): (f32, f32),
     mis: Option<Sampling>,
 ) -> Vec3A {
-    let Some(ls) = light.sample(si.hit.p, u1, u2) else {
+    let Some(mut ls) = light.sample(si.hit.p, u1, u2) else {
         return Vec3A::ZERO;
     };
+    // A textured light's radiance at the sampled point (its finest texels).
+    ls.le = tr.emitters.textured(light, ls.le, ls.uv, 0.0);
     light_term(tr, si, lobe, &ls, pmf, mis)
 }
 

@@ -14,7 +14,7 @@ mod sphere;
 mod triangle;
 
 pub use plane::Plane;
-pub use sphere::Sphere;
+pub use sphere::{Sphere, sphere_uv};
 pub use triangle::Triangle;
 
 use crate::geometry::{Aabb, BvhRay, Placement, Ray};

@@ -117,3 +117,17 @@ impl Sphere {
         }
     }
 }
+
+/// A sphere's texture coordinates (Mitsuba 3's) at the unit direction `d` from its centre:
+/// `u = phi / (2 pi)` with `phi = atan2(y, x)` in [0, 2 pi), `v = theta / pi` with `theta =
+/// acos(z)`.
+#[inline]
+pub fn sphere_uv(d: Vec3A) -> glam::Vec2 {
+    let d = d.clamp(Vec3A::splat(-1.0), Vec3A::ONE);
+    let phi = d.y.atan2(d.x).rem_euclid(std::f32::consts::TAU);
+    let u = phi / std::f32::consts::TAU;
+    glam::Vec2::new(
+        if u >= 1.0 { 0.0 } else { u },
+        d.z.acos() / std::f32::consts::PI,
+    )
+}

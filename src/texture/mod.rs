@@ -99,6 +99,29 @@ pub struct Texture {
 }
 
 impl Texture {
+    /// The mean colour over its image (or its two squares): an emitter's power reads it.
+    pub fn mean(&self) -> Vec3A {
+        match &self.kind {
+            TextureKind::Checkerboard(c) => (c.color0 + c.color1) / 2.0,
+            TextureKind::Image(i) => {
+                let r = &i.raster;
+                let sum = r.texels.iter().fold([0f64; 3], |acc, t| {
+                    [
+                        acc[0] + t[0] as f64,
+                        acc[1] + t[1] as f64,
+                        acc[2] + t[2] as f64,
+                    ]
+                });
+                let n = r.texels.len().max(1) as f64;
+                Vec3A::new(
+                    (sum[0] / n) as f32,
+                    (sum[1] / n) as f32,
+                    (sum[2] / n) as f32,
+                )
+            }
+        }
+    }
+
     /// The colour at texture coordinates `uv`, for a footprint `width` wide in them (which
     /// the transform's scale widens).
     #[inline]

@@ -17,7 +17,7 @@
 pub use crate::camera::{Projection, WorldCamera};
 pub use crate::effects::Switches;
 pub use crate::geometry::Transform;
-pub use crate::light::{Emitter, WorldEnvironment, WorldLight};
+pub use crate::light::{Emitter, RadianceTexture, WorldEnvironment, WorldLight};
 pub use crate::material::{Material, Model};
 pub use crate::render::Film;
 pub use crate::shader::Shader;

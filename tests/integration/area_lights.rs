@@ -632,3 +632,85 @@ fn one_light_per_vertex_is_unbiased() {
         );
     }
 }
+
+/// A point on a floor below the middle of the left half (`x < 0`) of a square emitter (the
+/// `emitter` entity), seen by a camera that sees only it: 64 pixels, each an independent
+/// estimate of its radiance.
+fn below_square(emitter: &str, shader: &str) -> rtis::render::Rendered {
+    common::render_str(&format!(
+        "Scene(film: (width: 8, height: 8, spp: 64), shader: {shader}, model: Physical,
+               camera: Orthographic(position: (-0.5, 0.5, 0), look_at: (-0.5, 0, 0),
+                                    up: (0, 0, 1), height: 1e-4),
+               entities: [
+                 (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)),
+                  material: Phong(kd: (1, 1, 1))),
+                 {emitter}])"
+    ))
+}
+
+/// The square `x, z` in [-1, 1] at height 1, facing down, its `u` along `x`.
+fn square(radiance: &str) -> String {
+    format!(
+        "(shape: Rectangle(corner: (-1, 1, -1), u: (2, 0, 0), v: (0, 0, 2)),
+          emitter: (radiance: {radiance}))"
+    )
+}
+
+/// A textured emitter: a square whose radiance is 1 on its left half (`u < 1/2`, a
+/// checkerboard stretched along `v`) and 0 on its right lights a point below its left half as
+/// the left half alone does, under every strategy that finds it: light samples read the
+/// texture where they land, BRDF-sampled rays where they hit (a mirrored lookup would give the
+/// far half's light, several times less). And a checkerboard of one colour renders the bits of
+/// that constant.
+#[test]
+fn a_textured_emitter_lights_as_its_texture() {
+    let half = square(
+        "Checkerboard(color0: (1, 1, 1), color1: (0, 0, 0), \
+                       uv_transform: (scale: (1, 0.5)))",
+    );
+    let left = "(shape: Rectangle(corner: (-1, 1, -1), u: (1, 0, 0), v: (0, 0, 2)),
+                 emitter: (radiance: (1, 1, 1)))";
+    for shader in [
+        "Direct(light_samples: 4)",
+        "Path(max_depth: 1, lights: Light)",
+        "Path(max_depth: 1, lights: Brdf)",
+        "Path(max_depth: 1, lights: Mis)",
+    ] {
+        let (want, se_want) = mean_and_se(&below_square(left, shader));
+        let (got, se) = mean_and_se(&below_square(&half, shader));
+        let z = (got - want) / (se * se + se_want * se_want).sqrt();
+        eprintln!("{shader}: textured {got:.5} +- {se:.5}, left half {want:.5}; z {z:.2}");
+        assert!(z.abs() < 4.5, "{shader}: {got} vs {want} (z {z})");
+        let one = "Checkerboard(color0: (0.3, 0.4, 0.5), color1: (0.3, 0.4, 0.5))";
+        assert_eq!(
+            common::bits(&below_square(&square("(0.3, 0.4, 0.5)"), shader).image),
+            common::bits(&below_square(&square(one), shader).image),
+            "{shader}"
+        );
+    }
+}
+
+/// A textured emitter seen directly: each pixel of a square filling the view shows the
+/// checkerboard's colour at the pixel's `(u, v)`.
+#[test]
+fn a_textured_emitter_is_seen_as_its_texture() {
+    let r = common::render_str(
+        "Scene(film: (width: 8, height: 8, spp: 1), shader: Path(max_depth: 1), model: Physical,
+               camera: Orthographic(position: (0, 0, -5), look_at: (0, 0, 0), up: (0, 1, 0),
+                                    height: 2),
+               entities: [
+                 (shape: Rectangle(corner: (-1, 1, 0), u: (2, 0, 0), v: (0, -2, 0)),
+                  emitter: (radiance: Checkerboard(color0: (0.9, 0.8, 0.7),
+                                                   color1: (0.1, 0.2, 0.3)),
+                            two_sided: true))])",
+    );
+    for row in 0..8u32 {
+        for col in 0..8u32 {
+            // Seen from -z with y up, x grows to the right: u with the column, v with the row.
+            let (u, v) = ((col as f32 + 0.5) / 8.0, (row as f32 + 0.5) / 8.0);
+            let want = if (u > 0.5) == (v > 0.5) { 0.9 } else { 0.1 };
+            let got = r.image.get(col, row).x;
+            assert!((got - want).abs() < 1e-6, "({col}, {row}): {got}");
+        }
+    }
+}
