@@ -64,6 +64,17 @@ pub fn extract(scene: &Scene) -> RenderScene {
         // Texture coordinates are kept only where a texture reads them: other triangles stay
         // flat, shaded as before at no cost.
         let textured = !tex.is_empty() || radiance.is_some();
+        if textured
+            && let WorldShape::Mesh(mesh) = shape
+            && mesh.uvs.is_empty()
+        {
+            let label = name.map_or_else(|| format!("entity {}", entity.id()), |n| n.0.clone());
+            warnings.push(format!(
+                "{label}: a textured mesh without texture coordinates (an OBJ file without `vt`, \
+                 or a TriangleMesh): each triangle maps the texture by its barycentric \
+                 coordinates, (0, 0), (1, 0) and (0, 1) at its corners"
+            ));
+        }
         // A textured emitter's texture, stored once for all of its primitives.
         let emission = radiance.map(|RadianceTexture(t)| {
             emission_textures.push(t.clone());

@@ -459,6 +459,15 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
                 );
             }
             let field = field_at(text, start);
+            // A texture where the field takes none.
+            if let (Some(f), Some("Image" | "Checkerboard")) = (field, found.as_deref()) {
+                return format!(
+                    "`{f}` takes no texture: only colours and roughnesses do (`kd`, `ks`, \
+                     `color`, the `*_reflectance` and `specular_transmittance` fields, `alpha`, \
+                     an emitter's `radiance`){}",
+                    hint(field)
+                );
+            }
             format!("expected `(` here, found {found_q}{}", hint(field))
         }
         Error::ExpectedArray
@@ -664,6 +673,8 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
             // A roughness (`alpha`, `alpha_u`, `alpha_v`) or a colour.
             let constant = if field_name.is_some_and(|f| f.starts_with("alpha")) {
                 "a roughness from 1e-4 to 1"
+            } else if field_name == Some("radiance") {
+                "a radiance `(r, g, b)`"
             } else {
                 "a reflectance `(r, g, b)`"
             };
@@ -675,17 +686,30 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
             {
                 return format!("{field}: {m}; or give a texture");
             }
-            // A tuple is meant as a reflectance: its own error says what is wrong with it.
+            // A tuple is meant as a colour (an emitter's radiance, else a reflectance): its own
+            // error says what is wrong with it.
+            let radiance = field_name == Some("radiance");
+            let tuple_error = |tuple: &str| {
+                if radiance {
+                    ron::from_str::<super::values::Rgb>(tuple).err()
+                } else {
+                    ron::from_str::<super::values::Reflectance>(tuple).err()
+                }
+            };
             if name.is_empty()
                 && let Some(tuple) = bracketed(text, start)
-                && let Err(e) = ron::from_str::<super::values::Reflectance>(tuple)
+                && let Some(e) = tuple_error(tuple)
             {
+                let what = if radiance {
+                    "a radiance `(r, g, b)`, each channel at least 0"
+                } else {
+                    "a reflectance `(r, g, b)`, each channel from 0 to 1"
+                };
                 return match e.code {
                     Error::Message(m) => format!("{field}: {m}"),
-                    Error::ExpectedDifferentLength { found, .. } => format!(
-                        "expected 3 values, found {found}: {field} is a reflectance `(r, g, b)`, \
-                         each channel from 0 to 1, or a texture"
-                    ),
+                    Error::ExpectedDifferentLength { found, .. } => {
+                        format!("expected 3 values, found {found}: {field} is {what}, or a texture")
+                    }
                     other => format!("{field}: {other}"),
                 };
             }

@@ -438,3 +438,128 @@ fn a_one_colour_texture_renders_as_its_constant() {
         }
     }
 }
+
+/// Every image form the issue names decodes to its values: a 16-bit grey PNG (code over 65535,
+/// decoded from sRGB), an 8-bit RGBA PNG (alpha ignored), a flat grey JPEG (decoded from sRGB;
+/// JPEG keeps a flat block exact) and a 1x1 and an 8192x1 image (repeat wraps them).
+#[test]
+fn image_forms_decode() {
+    let dir = std::env::temp_dir().join(format!("rtis-forms-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let srgb = rtis::raster::srgb_to_linear;
+    let p16 = dir.join("grey16.png");
+    image::ImageBuffer::<image::Luma<u16>, _>::from_fn(2, 2, |_, _| image::Luma([40000u16]))
+        .save(&p16)
+        .unwrap();
+    let rgba = dir.join("rgba.png");
+    image::RgbaImage::from_fn(2, 2, |_, _| image::Rgba([200, 100, 50, 7]))
+        .save(&rgba)
+        .unwrap();
+    let jpeg = dir.join("flat.jpg");
+    image::GrayImage::from_fn(16, 16, |_, _| image::Luma([120]))
+        .save(&jpeg)
+        .unwrap();
+    let one = dir.join("one.png");
+    image::GrayImage::from_fn(1, 1, |_, _| image::Luma([77]))
+        .save(&one)
+        .unwrap();
+    let wide = dir.join("wide.png");
+    image::GrayImage::from_fn(8192, 1, |x, _| image::Luma([(x % 256) as u8]))
+        .save(&wide)
+        .unwrap();
+    for (path, want) in [
+        (&p16, [srgb(40000.0 / 65535.0); 3]),
+        (
+            &rgba,
+            [srgb(200.0 / 255.0), srgb(100.0 / 255.0), srgb(50.0 / 255.0)],
+        ),
+        (&jpeg, [srgb(120.0 / 255.0); 3]),
+        (&one, [srgb(77.0 / 255.0); 3]),
+    ] {
+        let img = floor_kd(&rectangle(&format!(
+            "Image(path: {path:?}, filter: Nearest)"
+        )));
+        for row in 0..8 {
+            for col in 0..8 {
+                let got = img.get(col, row);
+                let d = (got - glam::Vec3A::from_array(want)).abs().max_element();
+                assert!(d < 1e-5, "{path:?} ({col}, {row}): {got} vs {want:?}");
+            }
+        }
+    }
+    // 8192 texels across 8 pixels: pixel `col`'s centre is texel 1024 col + 512.
+    let img = floor_kd(&rectangle(&format!(
+        "Image(path: {wide:?}, filter: Nearest)"
+    )));
+    for col in 0..8u32 {
+        let want = srgb(((1024 * col + 512) % 256) as f32 / 255.0);
+        let got = img.get(col, 3).x;
+        assert!(
+            (got - want).abs() < 1e-5,
+            "wide, column {col}: {got} vs {want}"
+        );
+    }
+}
+
+/// Bad texture input, each located: an image of an unknown format, one above the size limit
+/// (refused before it is decoded, saying how much memory it needs), a roughness texture's
+/// constant out of range, a normal map around a `Named` material, and a texture where a
+/// parameter takes none. A mesh without texture coordinates under a texture is a warning.
+#[test]
+fn more_texture_errors_are_located() {
+    let dir = std::env::temp_dir().join(format!("rtis-bad-tex-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = dir.join("notes.png");
+    std::fs::write(&text, "not an image").unwrap();
+    let huge = dir.join("huge.png");
+    image::GrayImage::new(65537, 1).save(&huge).unwrap();
+    let load = |material: &str| {
+        let text = format!(
+            "Scene(model: Physical, shader: Path(), entities: [(shape: Sphere(center: (0, 0, 3), radius: 1),\n  material: {material})])"
+        );
+        rtis::scene::load_str(&text, "t.ron", None)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    let e = load(&format!("Phong(kd: Image(path: {text:?}))"));
+    assert!(e.contains("t.ron:2:") && e.contains("notes.png"), "{e}");
+    let e = load(&format!("Phong(kd: Image(path: {huge:?}))"));
+    assert!(
+        e.contains("t.ron:2:") && e.contains("65537x1") && e.contains("MiB"),
+        "{e}"
+    );
+    let e = load("RoughConductor(alpha: 2)");
+    assert!(
+        e.contains("t.ron:2:") && e.contains("from 1e-4 to 1"),
+        "{e}"
+    );
+    let e = load("RoughConductor(alpha: Image(path: \"r.png\", wrap: Repet))");
+    assert!(e.contains("`Repeat`, `Clamp`, or `Mirror`"), "{e}");
+    let e =
+        load("NormalMap(normal_map: Checkerboard(color0: (0.5, 0.5, 1)), material: Named(\"x\"))");
+    assert!(
+        e.contains("t.ron:2:") && e.contains("written inline"),
+        "{e}"
+    );
+    let e = load("Conductor(eta: Image(path: \"e.png\"), k: (1, 1, 1))");
+    assert!(
+        e.contains("t.ron:2:") && e.contains("`eta` takes no texture"),
+        "{e}"
+    );
+    // A mesh without `vt` under a texture: rendered, with a warning.
+    let obj = dir.join("tri.obj");
+    std::fs::write(&obj, "v -1 -1 3\nv 1 -1 3\nv 0 1 3\nf 1 2 3\n").unwrap();
+    let s = crate::common::scene(&format!(
+        "Scene(entities: [(shape: Mesh(path: {obj:?}), material: Phong(kd: Checkerboard(color0: (1, 1, 1)))),
+                          (light: Point(position: (0, 0, 0), intensity: (1, 1, 1)))])"
+    ));
+    let r = rtis::extract(&s);
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w.contains("without texture coordinates")),
+        "{:?}",
+        r.warnings
+    );
+}
