@@ -120,7 +120,10 @@ impl Emitters {
     /// The same area and environment lights, chosen with the point lights of powers `points`
     /// (none: among themselves).
     pub fn rechosen(&self, points: &[f32]) -> Self {
-        Self::with_points(self.lights.clone(), self.environment.clone(), points)
+        Emitters {
+            textures: self.textures.clone(),
+            ..Self::with_points(self.lights.clone(), self.environment.clone(), points)
+        }
     }
 
     /// Probability that the environment light is chosen (0 without one).

@@ -675,6 +675,7 @@ fn a_textured_emitter_lights_as_its_texture() {
         "Path(max_depth: 1, lights: Light)",
         "Path(max_depth: 1, lights: Brdf)",
         "Path(max_depth: 1, lights: Mis)",
+        "Path(max_depth: 1, lights: Mis, lights_per_vertex: One)",
     ] {
         let (want, se_want) = mean_and_se(&below_square(left, shader));
         let (got, se) = mean_and_se(&below_square(&half, shader));

@@ -177,6 +177,19 @@ mod random_scenes {
         ]
     }
 
+    /// A checkerboard at extreme scales, and images of 1x1 and 8192x1 texels (each filter and
+    /// wrap, transforms up to 1e9 and down to 1e-9).
+    fn texture() -> impl Strategy<Value = String> {
+        prop_oneof![
+            Just("Checkerboard(color0: (1, 1, 1), color1: (0, 0, 0), uv_transform: (scale: (1e6, 1e-6), rotate: 33))".to_string()),
+            Just(format!("Image(path: {:?}, filter: Nearest, wrap: Mirror)", texture_file(1))),
+            Just(format!("Image(path: {:?}, wrap: Clamp, raw: true)", texture_file(8192))),
+            Just(format!("Image(path: {:?}, filter: Nearest, wrap: Repeat, uv_transform: (scale: (1e9, -1e9)))", texture_file(8192))),
+            Just(format!("Image(path: {:?}, filter: Trilinear, uv_transform: (scale: (1e-9, 3), rotate: 45))", texture_file(8192))),
+            Just(format!("Image(path: {:?}, filter: Trilinear, wrap: Mirror)", texture_file(1))),
+        ]
+    }
+
     /// Every material, with extreme but valid parameters.
     fn material() -> impl Strategy<Value = String> {
         prop_oneof![
@@ -190,25 +203,28 @@ mod random_scenes {
                     num(s)
                 )),
             rgb01().prop_map(|c| format!("Mirror(color: {c})")),
-            // Textures: a checkerboard at extreme scales, and images of 1x1 and 8192x1 texels
-            // (each filter and wrap, transforms up to 1e9 and down to 1e-9), on Phong, a mirror
-            // and glass.
-            (
-                prop_oneof![
-                    Just("Checkerboard(color0: (1, 1, 1), color1: (0, 0, 0), uv_transform: (scale: (1e6, 1e-6), rotate: 33))".to_string()),
-                    Just(format!("Image(path: {:?}, filter: Nearest, wrap: Mirror)", texture_file(1))),
-                    Just(format!("Image(path: {:?}, wrap: Clamp, raw: true)", texture_file(8192))),
-                    Just(format!("Image(path: {:?}, filter: Nearest, wrap: Repeat, uv_transform: (scale: (1e9, -1e9)))", texture_file(8192))),
-                    Just(format!("Image(path: {:?}, filter: Trilinear, uv_transform: (scale: (1e-9, 3), rotate: 45))", texture_file(8192))),
-                    Just(format!("Image(path: {:?}, filter: Trilinear, wrap: Mirror)", texture_file(1))),
-                ],
-                0u8..3,
-            )
-                .prop_map(|(t, m)| match m {
-                    0 => format!("Phong(kd: {t}, ks: {t}, shininess: 10)"),
-                    1 => format!("Mirror(color: {t})"),
-                    _ => format!("Transmissive(ior: 1.5, color: {t})"),
-                }),
+            // Textures on Phong, a mirror and glass.
+            (texture(), 0u8..3).prop_map(|(t, m)| match m {
+                0 => format!("Phong(kd: {t}, ks: {t}, shininess: 10)"),
+                1 => format!("Mirror(color: {t})"),
+                _ => format!("Transmissive(ior: 1.5, color: {t})"),
+            }),
+            // Textures on the rough materials' colours and roughness (a texture's values of 0
+            // and 1 clamp to alpha 1e-4 and 1), and normal maps of every texture (normals
+            // leaning to and below the horizon) around Phong, a mirror and a rough metal.
+            (texture(), 0u8..6).prop_map(|(t, m)| match m {
+                0 => format!("RoughConductor(alpha: {t}, specular_reflectance: {t})"),
+                1 => format!(
+                    "RoughDielectric(alpha_u: {t}, alpha_v: 0.3, specular_reflectance: {t}, \
+                     specular_transmittance: {t})"
+                ),
+                2 => format!("RoughPlastic(diffuse_reflectance: {t}, specular_reflectance: {t})"),
+                3 => format!(
+                    "NormalMap(normal_map: {t}, material: Phong(kd: {t}, ks: (0.5, 0.5, 0.5)))"
+                ),
+                4 => format!("NormalMap(normal_map: {t}, material: Mirror())"),
+                _ => format!("NormalMap(normal_map: {t}, material: RoughConductor(alpha: {t}))"),
+            }),
             // Metals: three named ones (a mirror among them), and eta and k at the ends of
             // their range, 0 to 1000 (eta 0 with k 0 reflects everything at every angle).
             (
@@ -421,6 +437,12 @@ mod random_scenes {
             let things: String = shapes
                 .iter()
                 .map(|(sh, m, e)| match e {
+                    // A two-sided emitter of radiance 1 has the 8192x1 image's radiance.
+                    Some((l, true)) if *l == 1.0 && !sh.starts_with("InfinitePlane") => format!(
+                        "(shape: {sh}, material: {m}, emitter: Emitter(radiance: Image(path: {:?}, \
+                         filter: Trilinear), two_sided: true)),",
+                        texture_file(8192)
+                    ),
                     Some((l, two)) if !sh.starts_with("InfinitePlane") => format!(
                         "(shape: {sh}, material: {m}, emitter: Emitter(radiance: ({l}, {l}, {l}), \
                          two_sided: {two})),",
