@@ -142,8 +142,11 @@ impl<'a> Interaction<'a> {
 
 /// The shading normal on the viewer's side that a normal map gives (Mitsuba 3's `normalmap`):
 /// the map's `local` normal in the frame of the outward shading normal (`n` turned to the side
-/// of the geometric normal `n_out`) and the tangent `dp_du` made orthogonal to it, turned back to
-/// the viewer's side (`ng`, towards `wo`), then bent by [`valid_normal`].
+/// of the geometric normal `n_out`) and the tangent `dp_du` made orthogonal to it, then bent by
+/// [`valid_normal`]. Seen from the back, the map's normal is mirrored through the surface (its
+/// tangential part kept, its normal part turned to the viewer, `ng` towards `wo`), as rtis's
+/// two-sided materials and Mitsuba's `twosided` mirror every direction there: the back shows
+/// the front's bumps.
 #[inline]
 fn normal_mapped(
     local: Vec3A,
@@ -164,8 +167,8 @@ fn normal_mapped(
         None => Frame::from_normal(ns),
     };
     // Unit to rounding: the frame is orthonormal, `local` unit.
-    let mapped = frame.to_world(local);
-    valid_normal(if outward { -mapped } else { mapped }, ng, wo)
+    let mapped = local.x * frame.s + local.y * frame.t + local.z * n;
+    valid_normal(mapped, ng, wo)
 }
 
 /// The shading normal `n` bent, where needed, so that the viewer `wo` is above it and its

@@ -250,3 +250,27 @@ fn leaning_normals_leave_no_black_or_non_finite_pixel() {
         }
     }
 }
+
+/// Side by side with Mitsuba 3 (bench/mitsuba_texture_reference.py --scene rough): a plastic
+/// on a checkerboard, a rough gold sphere with a roughness map and a tint image, a panel
+/// bent by a normal map (Mitsuba's `normalmap`), and a rectangle light whose radiance is an
+/// OpenEXR image. Two renders of 64 spp agree with Mitsuba's on 4x4 blocks within what noise
+/// explains, and in the mean within 1%.
+#[test]
+fn textured_materials_and_lights_match_mitsuba() {
+    let (mse, explained, m) = crate::common::against_mitsuba(
+        "texture_rough.ron",
+        "mitsuba_texture_rough_160x120_spp4096.exr",
+        0.005479,
+    );
+    eprintln!("block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}; mean {m}");
+    assert!(
+        mse < 1.5 * explained,
+        "block MSE {mse:.3e} vs {explained:.3e}"
+    );
+    let mean = glam::Vec3A::new(0.42344, 0.4383, 0.4199);
+    assert!(
+        ((m - mean) / mean).abs().max_element() < 0.01,
+        "mean {m} vs {mean}"
+    );
+}
