@@ -1,7 +1,7 @@
-//! Images read as linear RGB: the environment light's map.
+//! Images read as linear RGB: the environment light's map and textures.
 //!
 //! OpenEXR files hold linear values and are read as they are. PNG files (8 or 16 bits, grey or
-//! colour, with or without alpha) hold sRGB-encoded values and are decoded with the sRGB
+//! colour, with or without alpha) and JPEG files hold sRGB-encoded values and are decoded with the sRGB
 //! transfer function (IEC 61966-2-1), as Mitsuba 3 and pbrt-v4 decode them. Alpha is ignored.
 //! A raster holds 12 bytes per texel (three `f32`); reading one needs about twice that at its
 //! peak, plus the file's own decoded form.
@@ -90,13 +90,13 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
-/// Read the image at `path` (OpenEXR, or PNG decoded from sRGB): the message names the reason
+/// Read the image at `path` (OpenEXR, or PNG or JPEG decoded from sRGB): the message names the reason
 /// it cannot be read, without the path (the caller places it).
 pub fn load(path: &Path) -> Result<Raster, String> {
     load_with(path, false)
 }
 
-/// [`load`]; with `raw`, PNG values are taken as they are stored (scaled to [0, 1]), not
+/// [`load`]; with `raw`, PNG and JPEG values are taken as they are stored (scaled to [0, 1]), not
 /// decoded from sRGB: for data such as roughness or normal maps.
 pub fn load_with(path: &Path, raw: bool) -> Result<Raster, String> {
     use image::{DynamicImage, ImageReader, Limits};
