@@ -29,14 +29,11 @@ pub struct Interaction<'a> {
     /// The surface's material as the render's table holds it (an interaction does not copy
     /// it); [`Interaction::material`] is what shades, its textures looked up.
     pub material: &'a Material,
-    /// The material with its textured parameters looked up here, when it has textures (boxed:
-    /// an untextured hit carries one empty pointer).
-    pub textured: Option<Box<Material>>,
-    /// The direction of `dp/du` at a textured hit (the tangent of its shading frame, as
-    /// Mitsuba 3's), else `None` (the shape's own tangent).
-    pub tangent: Option<Vec3A>,
-    /// True if a normal map bent `n`: directions whose side of the shading normal differs
-    /// from their side of the geometric surface then carry no light ([`Interaction::leaks`]).
+    /// What the hit's textures give, when its material has any (boxed: an untextured hit
+    /// carries one empty pointer).
+    pub textured: Option<Box<TexturedHit>>,
+    /// True if a normal map gave `n`: directions whose side of the shading normal differs from
+    /// their side of the geometric surface then carry no light ([`Interaction::leaks`]).
     pub bent: bool,
     /// Where rays leaving the hit start.
     pub origins: Origins,
@@ -56,21 +53,21 @@ impl<'a> Interaction<'a> {
         // The shading normal stays on the viewer's side of the surface.
         let ns = tr.geometry.shading_normal(&prim, hit.p, ng);
         let mut n = if ns.dot(ng) < 0.0 { -ns } else { ns };
-        let (mut textured, mut tangent, mut bent) = (None, None, false);
+        let (mut textured, mut bent) = (None, false);
         if let Some(t) = tr.textures.get(i).filter(|t| !t.is_empty()) {
             let uv = tr.geometry.uv(&prim, hit.p);
             // The footprint of the sample here, in texture coordinates.
             let width = tr.footprint.width(hit.p, hit.n) * tr.geometry.uv_rate(&prim, hit.p);
-            let dp_du = tr.geometry.dp_du(&prim, hit.p);
-            tangent = Some(dp_du);
-            if t.has_parameters() {
-                let physical = tr.model == Model::Physical;
-                textured = Some(Box::new(t.apply(&materials[i], uv, width, physical)));
-            }
+            let tangent = tr.geometry.dp_du(&prim, hit.p);
+            let physical = tr.model == Model::Physical;
+            let material = t
+                .has_parameters()
+                .then(|| t.apply(&materials[i], uv, width, physical));
             if let Some(local) = t.normal(uv, width) {
-                n = normal_mapped(local, n, ng, hit.n, wo, dp_du);
+                n = normal_mapped(local, n, ng, hit.n, wo, tangent);
                 bent = true;
             }
+            textured = Some(Box::new(TexturedHit { material, tangent }));
         }
         Interaction {
             hit,
@@ -78,7 +75,6 @@ impl<'a> Interaction<'a> {
             n,
             material: &materials[i],
             textured,
-            tangent,
             bent,
             origins: Origins::new(&hit),
             light: prim.light,
@@ -90,11 +86,15 @@ impl<'a> Interaction<'a> {
     /// hit such a direction carries nothing, so that no light leaks through the surface and
     /// no ray goes on from the wrong side (pbrt-v3's rule for shading normals, Veach 1997
     /// 5.3). Never at other hits, whose images stay as they were.
-    #[inline]
+    #[inline(always)]
     pub fn leaks(&self, wi: Vec3A) -> bool {
-        if !self.bent {
-            return false;
-        }
+        self.bent && self.crosses(wi)
+    }
+
+    /// [`Interaction::leaks`] at a normal-mapped hit.
+    #[cold]
+    #[inline(never)]
+    fn crosses(&self, wi: Vec3A) -> bool {
         let ng = if self.hit.n.dot(self.wo) < 0.0 {
             -self.hit.n
         } else {
@@ -106,7 +106,12 @@ impl<'a> Interaction<'a> {
     /// The material that shades here: the table's, its textured parameters looked up.
     #[inline]
     pub fn material(&self) -> &Material {
-        self.textured.as_deref().unwrap_or(self.material)
+        match self.textured.as_deref() {
+            Some(TexturedHit {
+                material: Some(m), ..
+            }) => m,
+            _ => self.material,
+        }
     }
 
     /// A ray leaving the surface in unit direction `w`, started off the surface on `w`'s side.
@@ -124,9 +129,10 @@ impl<'a> Interaction<'a> {
         } else {
             self.n
         };
-        let tangent = self
-            .tangent
-            .unwrap_or_else(|| tr.geometry.prim(self.hit.prim).shape.tangent(self.hit.p));
+        let tangent = match &self.textured {
+            Some(t) => t.tangent,
+            None => tr.geometry.prim(self.hit.prim).shape.tangent(self.hit.p),
+        };
         let s = tangent - n * n.dot(tangent);
         let frame = match s.try_normalize() {
             Some(s) => Frame {
@@ -192,6 +198,17 @@ pub fn valid_normal(n: Vec3A, ng: Vec3A, wo: Vec3A) -> Vec3A {
         .unwrap_or_else(|| ng.any_orthonormal_vector());
     let lifted = along * (1.0 - height * height).max(0.0).sqrt() + ng * height;
     (wo + lifted).normalize_or(ng)
+}
+
+/// What a hit's textures give: its material with the textured parameters looked up (`None`
+/// when only the normal is textured: the table's then shades), and the direction of `dp/du`
+/// (the tangent of its shading frame, as Mitsuba 3's).
+#[derive(Clone, Debug)]
+pub struct TexturedHit {
+    /// The material, its textured parameters looked up.
+    pub material: Option<Material>,
+    /// `dp/du` at the hit.
+    pub tangent: Vec3A,
 }
 
 /// A BSDF at a hit, with the local frame it is evaluated in.
@@ -283,10 +300,16 @@ pub fn emitted(tr: &Tracer, si: &Interaction) -> Vec3A {
     }
     let light = &tr.emitters.lights[si.light as usize];
     let le = light.emitted(si.hit.n, si.wo);
-    if light.texture.is_none() {
-        return le;
+    match light.texture {
+        None => le,
+        Some(_) => textured_emission(tr, si, light, le),
     }
-    // A textured light's radiance at the hit, filtered by the sample's footprint there.
+}
+
+/// A textured light's radiance `le` times its texture at the hit of `si`, filtered by the
+/// sample's footprint there (out of line: the untextured path stays small).
+#[inline(never)]
+fn textured_emission(tr: &Tracer, si: &Interaction, light: &AreaLight, le: Vec3A) -> Vec3A {
     let prim = tr.geometry.prim(si.hit.prim);
     let uv = tr.geometry.uv(&prim, si.hit.p);
     let width = tr.footprint.width(si.hit.p, si.hit.n) * tr.geometry.uv_rate(&prim, si.hit.p);
@@ -330,16 +353,36 @@ pub fn point_lights<L: Lobe>(tr: &mut Tracer, si: &Interaction, lobe: &L) -> Vec
         return Vec3A::ZERO;
     }
     let lights = tr.lights;
-    lights
-        .iter()
-        .map(|light| point_light(tr, si, lobe, light))
-        .sum()
+    // The loop is compiled twice: with the normal map's leak test, and (every other hit)
+    // without it.
+    if si.bent {
+        let each = |light| point_light_by::<L, true>(tr, si, lobe, light);
+        lights.iter().map(each).sum()
+    } else {
+        let each = |light| point_light_by::<L, false>(tr, si, lobe, light);
+        lights.iter().map(each).sum()
+    }
 }
 
 /// One point light's term of Eq. 3: `L_i r(wi, wo) V`.
 #[inline]
 fn point_light<L: Lobe>(tr: &mut Tracer, si: &Interaction, lobe: &L, light: &Light) -> Vec3A {
-    let Some((inc, shadow)) = point_light_ray(si, light, lobe.transmits()) else {
+    if si.bent {
+        point_light_by::<L, true>(tr, si, lobe, light)
+    } else {
+        point_light_by::<L, false>(tr, si, lobe, light)
+    }
+}
+
+/// [`point_light`] at a hit whose normal a normal map gave (`BENT`) or not.
+#[inline]
+fn point_light_by<L: Lobe, const BENT: bool>(
+    tr: &mut Tracer,
+    si: &Interaction,
+    lobe: &L,
+    light: &Light,
+) -> Vec3A {
+    let Some((inc, shadow)) = point_light_ray::<BENT>(si, light, lobe.transmits()) else {
         return Vec3A::ZERO;
     };
     let visible = !tr.effects.shadows
@@ -356,11 +399,16 @@ fn point_light<L: Lobe>(tr: &mut Tracer, si: &Interaction, lobe: &L, light: &Lig
 ///
 /// The shadow ray stops just short of the light, so that a surface the light sits on does not
 /// block it. No plane can block it when the light is in the planes' room
-/// ([`Light::in_room`]).
+/// ([`Light::in_room`]). At a normal-mapped hit (`BENT`) a light on one side of the shading
+/// normal and the other of the surface adds nothing ([`Interaction::leaks`]).
 #[inline]
-fn point_light_ray(si: &Interaction, light: &Light, transmits: bool) -> Option<(Incident, Ray)> {
+fn point_light_ray<const BENT: bool>(
+    si: &Interaction,
+    light: &Light,
+    transmits: bool,
+) -> Option<(Incident, Ray)> {
     let inc = light.incident(si.hit.p)?;
-    if (!transmits && inc.wi.dot(si.n) <= 0.0) || si.leaks(inc.wi) {
+    if (!transmits && inc.wi.dot(si.n) <= 0.0) || (BENT && si.leaks(inc.wi)) {
         return None;
     }
     let shadow = si.origins.ray(inc.wi, inc.dist * SHADOW_END);

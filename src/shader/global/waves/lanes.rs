@@ -407,7 +407,6 @@ unsafe fn chunk<L: Floats>(
                 material: &materials[e.material as usize],
                 // The waves do not run where materials have textures.
                 textured: None,
-                tangent: None,
                 bent: false,
                 origins: Origins {
                     front: vec3(&v, FRONT, i),
