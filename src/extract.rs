@@ -217,8 +217,7 @@ pub fn extract(scene: &Scene) -> RenderScene {
         .iter()
         .next()
         .map(|env| env.extract(scene_radius));
-    let mut emitters = Emitters::with_points(area_lights, environment, &[]);
-    emitters.textures = emission_textures;
+    let emitters = Emitters::with_points(area_lights, emission_textures, environment, &[]);
 
     // The effects, derived once from the parts, before the render scene is assembled.
     let derived = effects::derive(

@@ -577,18 +577,27 @@ impl Geometry {
 impl Geometry {
     /// The direction in which `u` grows along the surface of `prim` at `p`, `dp/du` (not
     /// unit; Mitsuba 3's `dp_du`), for textured surfaces' shading frames: a triangle's from
-    /// its corners' texture coordinates (pbrt-v4's `Triangle::InteractionFromIntersection`),
-    /// the shape's tangent ([`Shape::tangent`]) for a triangle without them or whose
-    /// coordinates do not span the plane; a sphere's azimuth; a plane's `u` axis
+    /// its corners' texture coordinates (pbrt-v4's `Triangle::InteractionFromIntersection`);
+    /// the shape's tangent ([`Shape::tangent`], Mitsuba's frame for a mesh without
+    /// coordinates) for a triangle without them (none kept, or the barycentric defaults a
+    /// triangle without coordinates is given, in either order: whatever else the scene holds)
+    /// or whose coordinates do not span the plane; a sphere's azimuth; a plane's `u` axis
     /// ([`Geometry::uv`]).
     #[inline]
     pub fn dp_du(&self, prim: &Prim, p: glam::Vec3A) -> glam::Vec3A {
+        use glam::Vec2;
         match prim.shape {
             Shape::Triangle(t) => {
                 let uvs = match self.uvs.get(prim.smooth as usize) {
                     Some(&c) if prim.smooth != FLAT => c,
                     _ => return prim.shape.tangent(p),
                 };
+                let barycentric = uvs[0] == Vec2::ZERO
+                    && ((uvs[1], uvs[2]) == (Vec2::X, Vec2::Y)
+                        || (uvs[1], uvs[2]) == (Vec2::Y, Vec2::X));
+                if barycentric {
+                    return prim.shape.tangent(p);
+                }
                 let (d02, d12) = (uvs[0] - uvs[2], uvs[1] - uvs[2]);
                 let (p02, p12) = (t.v[0] - t.v[2], t.v[1] - t.v[2]);
                 let det = d02.x * d12.y - d02.y * d12.x;

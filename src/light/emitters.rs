@@ -45,13 +45,15 @@ impl Emitters {
     /// The set of `lights`, each chosen with probability proportional to its power (uniformly
     /// if none has any).
     pub fn new(lights: Vec<AreaLight>) -> Self {
-        Self::with_points(lights, None, &[])
+        Self::with_points(lights, Vec::new(), None, &[])
     }
 
-    /// The area `lights`, the `environment` light and point lights of powers `points`, each
-    /// chosen in proportion to its power.
+    /// The area `lights` (with the `textures` their [`AreaLight::texture`]s name), the
+    /// `environment` light and point lights of powers `points`, each chosen in proportion to
+    /// its power.
     pub fn with_points(
         lights: Vec<AreaLight>,
+        textures: Vec<Texture>,
         environment: Option<EnvironmentLight>,
         points: &[f32],
     ) -> Self {
@@ -81,7 +83,7 @@ impl Emitters {
         Emitters {
             lights,
             environment,
-            textures: Vec::new(),
+            textures,
             cdf,
             pmf,
         }
@@ -120,10 +122,12 @@ impl Emitters {
     /// The same area and environment lights, chosen with the point lights of powers `points`
     /// (none: among themselves).
     pub fn rechosen(&self, points: &[f32]) -> Self {
-        Emitters {
-            textures: self.textures.clone(),
-            ..Self::with_points(self.lights.clone(), self.environment.clone(), points)
-        }
+        Self::with_points(
+            self.lights.clone(),
+            self.textures.clone(),
+            self.environment.clone(),
+            points,
+        )
     }
 
     /// Probability that the environment light is chosen (0 without one).

@@ -38,7 +38,8 @@ impl std::fmt::Write for Fnv {
 }
 
 /// A hash of everything that decides a render's samples: camera, geometry (primitives and
-/// smooth normals), materials, lights, the environment light (its map by a hash), background, shader, model, effects and film size.
+/// smooth normals), materials, lights, emitters, the environment light (its map by a hash),
+/// background, shader, model, effects and film size.
 /// Passes of one render share it. Streamed, so a mesh of a million triangles costs a pass over
 /// it, not a string of its size.
 pub fn fingerprint(scene: &RenderScene) -> u64 {
@@ -68,14 +69,18 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
     if !scene.textures.is_empty() {
         let _ = write!(h, "|{:?}|{:?}", scene.textures, scene.geometry.uvs);
     }
+    // Each area light's emission (radiance, sides, texture), run-length: the primitives of one
+    // emitter come together. (Before textured emitters the fingerprint left emission out:
+    // passes of those versions are refused, never mixed.)
+    let mut last = None;
+    for l in &scene.emitters.lights {
+        if last != Some((l.emitter, l.texture)) {
+            let _ = write!(h, "|{:?}{:?}", l.emitter, l.texture);
+            last = Some((l.emitter, l.texture));
+        }
+    }
     if !scene.emitters.textures.is_empty() {
-        let textured = scene.emitters.lights.iter().map(|l| l.texture);
-        let _ = write!(
-            h,
-            "|{:?}|{:?}",
-            scene.emitters.textures,
-            textured.collect::<Vec<_>>()
-        );
+        let _ = write!(h, "|{:?}", scene.emitters.textures);
     }
     if let Some(env) = &scene.emitters.environment {
         let _ = write!(h, "|{env:?}");

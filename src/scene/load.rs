@@ -549,6 +549,24 @@ impl Resolved {
                     .texture(&mut |path, raw| load_image(&mut images, &mut files, dir, path, raw))
                     .map_err(|why| src.error(place("emitter", Some("radiance")), why))?;
                 if let Some(t) = texture {
+                    // An image's brightest texel is the light's brightest radiance.
+                    if let crate::texture::TextureKind::Image(i) = &t.0.kind {
+                        let peak = i
+                            .raster
+                            .texels
+                            .iter()
+                            .flatten()
+                            .fold(0.0f32, |m, &c| m.max(c));
+                        if f64::from(peak) > MAX_RADIANCE {
+                            return Err(src.error(
+                                place("emitter", Some("radiance")),
+                                format!(
+                                    "this image's brightest texel is {peak:e}, above the limit \
+                                     of 1e30 for a radiance"
+                                ),
+                            ));
+                        }
+                    }
                     b.add(t);
                 }
             }

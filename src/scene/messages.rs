@@ -173,7 +173,8 @@ fn field_form(name: &str) -> Option<&'static str> {
             "`Named(\"name\")` for a material of the table, or one written inline: \
              `Phong(kd: (0.8, 0.8, 0.8))`, `Mirror()`, `Conductor(material: \"Au\")`, \
              `RoughConductor(alpha: 0.1, material: \"Au\")`, `RoughDielectric(alpha: 0.1, \
-             int_ior: 1.5)`, `RoughPlastic(alpha: 0.1)`, `Plastic()` or `Transmissive(ior: 1.5)`"
+             int_ior: 1.5)`, `RoughPlastic(alpha: 0.1)`, `Plastic()`, `Transmissive(ior: 1.5)` \
+             or `NormalMap(normal_map: Image(path: \"bumps.png\"), material: ...)`"
         }
         "shape" => {
             "one of `Sphere(...)`, `InfinitePlane(...)`, `Triangle(...)`, \
@@ -288,6 +289,16 @@ fn field_of(text: &str, off: usize) -> Option<&str> {
     let &(_, at) = open_brackets(text, off).last()?;
     let name_start = ident_before(text, at).map_or(at, |n| at - n.len());
     field_at(text, name_start)
+}
+
+/// Why field `f` refuses a texture, and which fields take one.
+fn no_texture(f: &str) -> String {
+    format!(
+        "`{f}` takes no texture: only colours and roughnesses do (`kd`, `ks`, `color`, the \
+         `*_reflectance` and `specular_transmittance` fields, a rough conductor's or \
+         dielectric's `alpha`, `alpha_u` and `alpha_v` (not `RoughPlastic`'s), an emitter's \
+         `radiance`)"
+    )
 }
 
 /// How field `field` is written, as a sentence to append.
@@ -461,12 +472,7 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
             let field = field_at(text, start);
             // A texture where the field takes none.
             if let (Some(f), Some("Image" | "Checkerboard")) = (field, found.as_deref()) {
-                return format!(
-                    "`{f}` takes no texture: only colours and roughnesses do (`kd`, `ks`, \
-                     `color`, the `*_reflectance` and `specular_transmittance` fields, `alpha`, \
-                     an emitter's `radiance`){}",
-                    hint(field)
-                );
+                return format!("{}{}", no_texture(f), hint(field));
             }
             format!("expected `(` here, found {found_q}{}", hint(field))
         }
@@ -486,6 +492,12 @@ pub fn explain(code: &Error, text: &str, start: usize, end: usize) -> String {
                 Error::ExpectedBoolean => "`true` or `false`",
                 _ => "a value",
             };
+            // A texture where the field takes none.
+            if let (Some(f), Some("Image" | "Checkerboard")) =
+                (field_at(text, start), found.as_deref())
+            {
+                return no_texture(f);
+            }
             // Inside `Named(` the field is the material, but the value is the name.
             let in_named = open_brackets(text, start)
                 .last()

@@ -306,14 +306,14 @@ pub fn emitted(tr: &Tracer, si: &Interaction) -> Vec3A {
     }
 }
 
-/// A textured light's radiance `le` times its texture at the hit of `si`, filtered by the
-/// sample's footprint there (out of line: the untextured path stays small).
+/// A textured light's radiance `le` times its texture at the hit of `si`, read at its finest
+/// texels as a light sample reads it (so that the two strategies MIS weighs estimate the same
+/// integrand; out of line: the untextured path stays small).
 #[inline(never)]
 fn textured_emission(tr: &Tracer, si: &Interaction, light: &AreaLight, le: Vec3A) -> Vec3A {
     let prim = tr.geometry.prim(si.hit.prim);
     let uv = tr.geometry.uv(&prim, si.hit.p);
-    let width = tr.footprint.width(si.hit.p, si.hit.n) * tr.geometry.uv_rate(&prim, si.hit.p);
-    tr.emitters.textured(light, le, uv, width)
+    tr.emitters.textured(light, le, uv, 0.0)
 }
 
 /// Radiance that a ray of unit direction `d` leaving the scene brings back: the background; or,

@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Run the binary; one that runs past 300 s is killed and fails the test.
@@ -130,7 +130,8 @@ fn check_prints_the_scene_in_its_own_terms() {
 }
 
 /// What `check` prints is a scene file: checked again, it prints the same scene, for every
-/// scene in `scenes/` (extends resolved, meshes inline, transforms kept).
+/// scene in `scenes/` (extends resolved, meshes inline, transforms kept) and the textured
+/// scenes of `tests/data` (textured roughness, normal maps, a textured emitter).
 #[test]
 fn check_output_reads_back_as_the_same_scene() {
     let d = tmp("roundtrip");
@@ -141,8 +142,11 @@ fn check_output_reads_back_as_the_same_scene() {
             .collect::<Vec<_>>()
             .join("\n")
     };
-    for entry in std::fs::read_dir("scenes").unwrap() {
-        let path = entry.unwrap().path();
+    let scenes = std::fs::read_dir("scenes")
+        .unwrap()
+        .map(|e| e.unwrap().path());
+    let textured = ["texture.ron", "texture_rough.ron"].map(|f| Path::new("tests/data").join(f));
+    for path in scenes.chain(textured) {
         if path.extension().is_none_or(|e| e != "ron") {
             continue;
         }

@@ -547,6 +547,22 @@ fn more_texture_errors_are_located() {
         e.contains("t.ron:2:") && e.contains("`eta` takes no texture"),
         "{e}"
     );
+    // An emitter's image brighter than a radiance may be.
+    let bright = dir.join("bright.exr");
+    image::Rgb32FImage::from_fn(2, 1, |x, _| image::Rgb([1e35 * x as f32, 1.0, 1.0]))
+        .save(&bright)
+        .unwrap();
+    let text = format!(
+        "Scene(entities: [(shape: Sphere(center: (0, 0, 3), radius: 1),\n  emitter: (radiance: Image(path: {bright:?})))])"
+    );
+    let e = rtis::scene::load_str(&text, "t.ron", None)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("t.ron:2:") && e.contains("above the limit of 1e30"),
+        "{e}"
+    );
     // A mesh without `vt` under a texture: rendered, with a warning.
     let obj = dir.join("tri.obj");
     std::fs::write(&obj, "v -1 -1 3\nv 1 -1 3\nv 0 1 3\nf 1 2 3\n").unwrap();
