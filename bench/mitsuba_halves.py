@@ -43,6 +43,23 @@ def sensor(mi, kind, eye, target, up, fov, width, height, spp, seed, **extra):
     }
 
 
+def rtis_head(comment, width, height, spp, eye, target, up, fov, film_extra="", extra=()):
+    """The opening lines of an rtis scene written beside a Mitsuba reference: the `comment`
+    lines, the film, a perspective camera, Path with Russian roulette from depth 5, the
+    Physical model, any `extra` top-level lines, and `entities: [`."""
+    return [
+        *comment,
+        "Scene(",
+        f"    film: (width: {width}, height: {height}, spp: {spp}{film_extra}),",
+        f"    camera: Perspective(position: {tup(eye)}, look_at: {tup(target)}, up: {tup(up)}, "
+        f"fov: {num(fov)}),",
+        "    shader: Path(rr_depth: 5),",
+        "    model: Physical,",
+        *extra,
+        "    entities: [",
+    ]
+
+
 def render_halves(mi, make_dict, spp, width, height):
     """Mitsuba's image of `make_dict(spp // 2, seed)` for seeds 0 and 1, averaged, rendered in
     chunks of at most 256 spp: (image, RMSE between the halves, seconds)."""

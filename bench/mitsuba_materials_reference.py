@@ -34,7 +34,7 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import load_mitsuba, num, render_halves, sensor, tup, write_reference
+from mitsuba_halves import load_mitsuba, num, render_halves, rtis_head, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WIDTH, HEIGHT = 192, 128
@@ -146,18 +146,12 @@ def rtis_material(m):
 
 def rtis_scene(variant, spp):
     lines = [
-        f"// Written by bench/mitsuba_materials_reference.py ({variant}); Mitsuba 3's image of the",
-        "// same scene is in tests/data (tests/integration/bsdfs.rs compares them). Rows, front to back: rough",
-        "// gold, frosted glass and blue rough plastic; roughness 0.03, 0.15 and 0.5 from left to",
-        "// right in rtis's image (Mitsuba's is mirrored left-right). The floor is a smooth plastic.",
-        "Scene(",
-        f"    film: (width: {WIDTH}, height: {HEIGHT}, spp: {spp}),",
-        f"    camera: Perspective(position: {tup(EYE)}, look_at: {tup(TARGET)}, up: {tup(UP)}, "
-        f"fov: {num(FOV)}),",
-        "    shader: Path(rr_depth: 5),",
-        "    model: Physical,",
-        f"    background: {tup(SKY)},",
-        "    entities: [",
+        *rtis_head([
+            f"// Written by bench/mitsuba_materials_reference.py ({variant}); Mitsuba 3's image of the",
+            "// same scene is in tests/data (tests/integration/bsdfs.rs compares them). Rows, front to back: rough",
+            "// gold, frosted glass and blue rough plastic; roughness 0.03, 0.15 and 0.5 from left to",
+            "// right in rtis's image (Mitsuba's is mirrored left-right). The floor is a smooth plastic.",
+        ], WIDTH, HEIGHT, spp, EYE, TARGET, UP, FOV, extra=[f"    background: {tup(SKY)},"]),
         f'        (name: "floor", shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)), '
         f"material: {rtis_material(floor_material())}),",
         f'        (name: "light", shape: Rectangle(corner: {tup(LIGHT["corner"])}, u: {tup(LIGHT["u"])}, '

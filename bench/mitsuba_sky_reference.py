@@ -29,7 +29,7 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import load_mitsuba, num, render_halves, sensor, tup, write_reference
+from mitsuba_halves import load_mitsuba, num, render_halves, rtis_head, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SKY = os.path.join(ROOT, "scenes/assets/sky.exr")
@@ -89,16 +89,11 @@ def mitsuba_dict(mi, spp, seed=0):
 
 def rtis_scene(spp):
     return "\n".join([
-        "// Written by bench/mitsuba_sky_reference.py; Mitsuba 3's image of the same scene is",
-        "// beside it (tests/integration/environment.rs compares them). A floor and three spheres",
-        "// (diffuse, rough gold, glass) under the generated sky of scenes/assets/sky.exr.",
-        "Scene(",
-        f"    film: (width: {WIDTH}, height: {HEIGHT}, spp: {spp}),",
-        f"    camera: Perspective(position: {tup(EYE)}, look_at: {tup(TARGET)}, up: {tup(UP)}, "
-        f"fov: {num(FOV)}),",
-        "    shader: Path(rr_depth: 5),",
-        "    model: Physical,",
-        "    entities: [",
+        *rtis_head([
+            "// Written by bench/mitsuba_sky_reference.py; Mitsuba 3's image of the same scene is",
+            "// beside it (tests/integration/environment.rs compares them). A floor and three spheres",
+            "// (diffuse, rough gold, glass) under the generated sky of scenes/assets/sky.exr.",
+        ], WIDTH, HEIGHT, spp, EYE, TARGET, UP, FOV),
         f"        (light: Environment(image: \"../../scenes/assets/sky.exr\", "
         f"rotate: (0, {num(ROTATE_Y)}, 0))),",
         f"        (shape: InfinitePlane(point: (0, 0, 0), normal: (0, 1, 0)), "

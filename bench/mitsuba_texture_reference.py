@@ -40,7 +40,7 @@ import os
 
 import numpy as np
 
-from mitsuba_halves import load_mitsuba, num, render_halves, sensor, tup, write_reference
+from mitsuba_halves import load_mitsuba, num, render_halves, rtis_head, sensor, tup, write_reference
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TEXTURE = os.path.join(ROOT, "tests/data/texture.png")
@@ -124,19 +124,29 @@ def rect_to_world(mi, corner, u, v):
     return mi.ScalarTransform4f(m.tolist())
 
 
-def mitsuba_dict(mi, spp, seed=0, gaussian=False):
-    rgb = lambda c: {"type": "rgb", "value": c}
+def rgb(c):
+    return {"type": "rgb", "value": c}
+
+
+def lit(mi, spp, seed, gaussian=False):
+    """What both scenes share: the integrator, the camera, the sky and the sun."""
     camera = sensor(mi, "perspective", EYE, TARGET, UP, FOV, WIDTH, HEIGHT, spp, seed)
     if gaussian:
         camera["film"]["rfilter"] = {"type": "gaussian", "stddev": 0.5}
-    bitmap = {"type": "bitmap", "filename": TEXTURE, "filter_type": "bilinear", "wrap_mode": "repeat"}
-    c0, c1, scale = CHECKS
     return {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
         "sensor": camera,
         "sky": {"type": "constant", "radiance": rgb(SKY)},
         "sun": {"type": "directional", "direction": SUN[0], "irradiance": rgb(SUN[1])},
+    }
+
+
+def mitsuba_dict(mi, spp, seed=0, gaussian=False):
+    bitmap = {"type": "bitmap", "filename": TEXTURE, "filter_type": "bilinear", "wrap_mode": "repeat"}
+    c0, c1, scale = CHECKS
+    return {
+        **lit(mi, spp, seed, gaussian),
         "floor": {"type": "rectangle", "to_world": rect_to_world(mi, *FLOOR),
                   "bsdf": {"type": "diffuse", "reflectance": {
                       "type": "checkerboard", "color0": rgb(c0), "color1": rgb(c1),
@@ -149,17 +159,11 @@ def mitsuba_dict(mi, spp, seed=0, gaussian=False):
 
 
 def mitsuba_rough_dict(mi, spp, seed=0):
-    rgb = lambda c: {"type": "rgb", "value": c}
-    camera = sensor(mi, "perspective", EYE, TARGET, UP, FOV, WIDTH, HEIGHT, spp, seed)
     bitmap = lambda f, raw=False: {"type": "bitmap", "filename": f, "filter_type": "bilinear",
                                    "wrap_mode": "repeat", "raw": raw}
     c0, c1, scale = CHECKS
     return {
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
-        "sensor": camera,
-        "sky": {"type": "constant", "radiance": rgb(SKY)},
-        "sun": {"type": "directional", "direction": SUN[0], "irradiance": rgb(SUN[1])},
+        **lit(mi, spp, seed),
         "floor": {"type": "rectangle", "to_world": rect_to_world(mi, *FLOOR),
                   "bsdf": {"type": "plastic",
                            "diffuse_reflectance": {
@@ -183,17 +187,12 @@ def rtis_rough_scene(spp):
     c0, c1, scale = CHECKS
     image = 'Image(path: "texture.png")'
     return "\n".join([
-        "// Written by bench/mitsuba_texture_reference.py --scene rough; Mitsuba 3's image of the",
-        "// same scene is beside it (tests/integration/material_textures.rs compares them). A",
-        "// plastic floor on a checkerboard, a rough gold sphere with a roughness map and a tint",
-        "// image, a panel bent by a normal map, and a light whose radiance is an image.",
-        "Scene(",
-        f"    film: (width: {WIDTH}, height: {HEIGHT}, spp: {spp}),",
-        f"    camera: Perspective(position: {tup(EYE)}, look_at: {tup(TARGET)}, up: {tup(UP)}, "
-        f"fov: {num(FOV)}),",
-        "    shader: Path(rr_depth: 5),",
-        "    model: Physical,",
-        "    entities: [",
+        *rtis_head([
+            "// Written by bench/mitsuba_texture_reference.py --scene rough; Mitsuba 3's image of the",
+            "// same scene is beside it (tests/integration/material_textures.rs compares them). A",
+            "// plastic floor on a checkerboard, a rough gold sphere with a roughness map and a tint",
+            "// image, a panel bent by a normal map, and a light whose radiance is an image.",
+        ], WIDTH, HEIGHT, spp, EYE, TARGET, UP, FOV),
         f"        (light: Environment(radiance: {tup(SKY)})),",
         f"        (light: Directional(direction: {tup(SUN[0])}, irradiance: {tup(SUN[1])})),",
         f"        (shape: Rectangle(corner: {tup(FLOOR[0])}, u: {tup(FLOOR[1])}, v: {tup(FLOOR[2])}), "
@@ -217,16 +216,11 @@ def rtis_scene(spp, gaussian=False):
     pixel_filter = ", filter: Gaussian(stddev: 0.5)" if gaussian else ""
     image = 'Image(path: "texture.png")'
     return "\n".join([
-        "// Written by bench/mitsuba_texture_reference.py; Mitsuba 3's image of the same scene is",
-        "// beside it (tests/integration/textures.rs compares them). A checkerboard floor, and a",
-        "// sphere and a panel wearing tests/data/texture.png, under a constant sky and a sun.",
-        "Scene(",
-        f"    film: (width: {WIDTH}, height: {HEIGHT}, spp: {spp}{pixel_filter}),",
-        f"    camera: Perspective(position: {tup(EYE)}, look_at: {tup(TARGET)}, up: {tup(UP)}, "
-        f"fov: {num(FOV)}),",
-        "    shader: Path(rr_depth: 5),",
-        "    model: Physical,",
-        "    entities: [",
+        *rtis_head([
+            "// Written by bench/mitsuba_texture_reference.py; Mitsuba 3's image of the same scene is",
+            "// beside it (tests/integration/textures.rs compares them). A checkerboard floor, and a",
+            "// sphere and a panel wearing tests/data/texture.png, under a constant sky and a sun.",
+        ], WIDTH, HEIGHT, spp, EYE, TARGET, UP, FOV, film_extra=pixel_filter),
         f"        (light: Environment(radiance: {tup(SKY)})),",
         f"        (light: Directional(direction: {tup(SUN[0])}, irradiance: {tup(SUN[1])})),",
         f"        (shape: Rectangle(corner: {tup(FLOOR[0])}, u: {tup(FLOOR[1])}, v: {tup(FLOOR[2])}), "

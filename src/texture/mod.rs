@@ -247,6 +247,13 @@ impl MaterialTextures {
                 m.alpha_y = a;
             }
         };
+        // A plastic's coating over its textured base, its own reflection textured.
+        let retint = |c: &crate::material::Coating| {
+            c.retinted(
+                at(&self.reflectance).unwrap_or(c.diffuse_reflectance),
+                at(&self.specular).unwrap_or(c.specular_reflectance),
+            )
+        };
         let mut m = *material;
         match &mut m {
             Material::Phong(p) => {
@@ -268,22 +275,8 @@ impl MaterialTextures {
                 set(&mut b.specular_transmittance, &self.transmittance);
                 rough(&mut b.microfacet);
             }
-            Material::Bsdf(Bsdf::RoughPlastic(b)) => {
-                let c = &b.coating;
-                let (kd, ks) = (
-                    at(&self.reflectance).unwrap_or(c.diffuse_reflectance),
-                    at(&self.specular).unwrap_or(c.specular_reflectance),
-                );
-                b.coating = c.retinted(kd, ks);
-            }
-            Material::Bsdf(Bsdf::Plastic(b)) => {
-                let c = &b.coating;
-                let (kd, ks) = (
-                    at(&self.reflectance).unwrap_or(c.diffuse_reflectance),
-                    at(&self.specular).unwrap_or(c.specular_reflectance),
-                );
-                b.coating = c.retinted(kd, ks);
-            }
+            Material::Bsdf(Bsdf::RoughPlastic(b)) => b.coating = retint(&b.coating),
+            Material::Bsdf(Bsdf::Plastic(b)) => b.coating = retint(&b.coating),
         }
         m
     }
