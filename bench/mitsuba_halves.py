@@ -60,12 +60,16 @@ def rtis_head(comment, width, height, spp, eye, target, up, fov, film_extra="", 
     ]
 
 
-def render_halves(mi, make_dict, spp, width, height):
-    """Mitsuba's image of `make_dict(spp // 2, seed)` for seeds 0 and 1, averaged, rendered in
-    chunks of at most 256 spp: (image, RMSE between the halves, seconds)."""
+def render_halves(mi, make_dict, spp, width, height, load=None):
+    """Mitsuba's image of `make_dict(spp // 2, seed)` (or of the scene `load(spp // 2, seed)`
+    returns) for seeds 0 and 1, averaged, rendered in chunks of at most 256 spp: (image, RMSE
+    between the halves, seconds)."""
     halves, t = [], time.perf_counter()
     for seed in (0, 1):
-        scene = mi.load_dict(make_dict(spp // 2, seed))
+        if load is not None:
+            scene = load(spp // 2, seed)
+        else:
+            scene = mi.load_dict(make_dict(spp // 2, seed))
         acc = np.zeros((height, width, 3))
         chunk = min(256, spp // 2)
         for k in range(spp // 2 // chunk):

@@ -22,6 +22,7 @@ pub mod converge;
 pub mod effects;
 pub mod extract;
 pub mod geometry;
+pub mod import;
 pub mod light;
 pub mod material;
 pub mod mesh;

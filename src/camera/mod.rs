@@ -1,7 +1,8 @@
 //! Cameras. Follow the course's convention: camera space has +x right, +y up and looks down +z;
 //! pixel `(col, row)` has row 0 at the top; image coordinates `(u, v)` in `[0, 1]^2` run right and
 //! down; the vertical extent is set by the field of view and the horizontal one by the aspect
-//! ratio `width / height`. Looking down +z with +y up, world -x is on the image's left.
+//! ratio `width / height`. Looking down +z with +y up, world -x is on the image's left (unless
+//! the camera is [`Handedness::Right`], Mitsuba 3's convention, whose images are the mirror).
 
 mod orthographic;
 mod perspective;
@@ -11,6 +12,19 @@ pub use perspective::{Perspective, ThinLens};
 
 use crate::geometry::Ray;
 use glam::{DVec3, Vec3A};
+
+/// Which way the image's right runs in the camera's frame (looking along `forward` with `up`
+/// up). The two conventions give mirror images of each other.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+pub enum Handedness {
+    /// The course's: the image's right is `up x forward` (looking down +z with +y up, world +x
+    /// is on the right).
+    #[default]
+    Left,
+    /// Mitsuba 3's: the image's right is `forward x up` (world +x on the left in that view),
+    /// so that a scene imported from Mitsuba renders as Mitsuba's image, not its mirror.
+    Right,
+}
 
 /// How a camera projects: the part of a [`WorldCamera`] that is not its frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,16 +65,21 @@ pub struct WorldCamera {
     pub look_at: DVec3,
     /// Up hint, not parallel to `look_at - position`.
     pub up: DVec3,
+    /// Which way the image's right runs.
+    pub handedness: Handedness,
 }
 
 impl WorldCamera {
     /// The camera of a render whose origin is this camera's position, for a film of
     /// `aspect = width / height`.
     pub fn extract(&self, aspect: f32) -> Camera {
-        let basis = Basis::look(
+        let mut basis = Basis::look(
             (self.look_at - self.position).as_vec3a(),
             self.up.as_vec3a(),
         );
+        if self.handedness == Handedness::Right {
+            basis.right = -basis.right;
+        }
         match self.projection {
             Projection::Perspective { fov, lens } => Camera::Perspective(Perspective {
                 origin: Vec3A::ZERO,

@@ -149,7 +149,7 @@ fn effects_section(
     };
     paths.sort();
     for path in paths {
-        let mut scene = rtis::scene::load_path(&path)?;
+        let mut scene = rtis::import::load_scene(&path)?;
         let f = &mut scene.settings.film;
         f.height = ((width as f64 * f.height as f64 / f.width as f64).round() as u32).max(1);
         f.width = width;

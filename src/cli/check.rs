@@ -7,12 +7,13 @@
 
 use super::CliError;
 use glam::{DVec3, Vec3A};
+use rtis::camera::Handedness;
 use rtis::light::Sky;
 use rtis::material::microfacet::Microfacet;
 use rtis::material::{Bsdf, Coating};
 use rtis::render::estimate::{self, human_seconds};
 use rtis::sampling::PixelFilter;
-use rtis::scene::{self, Scene};
+use rtis::scene::Scene;
 use rtis::shader::Shader;
 use rtis::texture::{MaterialTextures, Texture, TextureKind};
 use rtis::world::{
@@ -273,9 +274,13 @@ pub fn to_ron(scene: &Scene) -> String {
         ),
         Projection::Orthographic { height } => ("Orthographic", format!("height: {}", num(height))),
     };
+    let hand = match c.handedness {
+        Handedness::Left => "",
+        Handedness::Right => ", handedness: Right",
+    };
     let _ = writeln!(
         out,
-        "    camera: {kind}(position: {}, look_at: {}, up: {}, {extent}),",
+        "    camera: {kind}(position: {}, look_at: {}, up: {}, {extent}{hand}),",
         v3(c.position),
         v3(c.look_at),
         v3(c.up)
@@ -425,7 +430,7 @@ pub fn to_ron(scene: &Scene) -> String {
 
 /// Validate the scene and print it, its effects and its cost.
 pub fn run(path: &Path) -> Result<(), CliError> {
-    let scene = scene::load_path(path)?;
+    let scene = rtis::import::load_scene(path)?;
     println!(
         "// {}: valid. As loaded: extends resolved, defaults written out.",
         scene.origin

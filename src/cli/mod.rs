@@ -5,6 +5,7 @@ mod bench;
 mod check;
 mod converge;
 mod diff;
+mod import;
 pub mod interrupt;
 mod merge;
 mod render;
@@ -31,9 +32,11 @@ enum Command {
     Watch(watch::WatchArgs),
     /// Validate a scene and print what it contains.
     Check {
-        /// The scene file (RON).
+        /// The scene file (RON, or a Mitsuba 3 scene `.xml`, converted).
         scene: PathBuf,
     },
+    /// Convert a Mitsuba 3 scene (XML) into an rtis scene file.
+    Import(import::ImportArgs),
     /// Compare two images (PNG or EXR): RMSE, relMSE, largest error, FLIP, and a FLIP heatmap.
     Diff(diff::DiffArgs),
     /// Merge pass files (`render --pass I/N`) into the image, bit-identical to one render.
@@ -62,6 +65,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Render(args) => render::run(args),
         Command::Watch(args) => watch::run(args),
         Command::Check { scene } => check::run(&scene),
+        Command::Import(args) => import::run(args),
         Command::Converge(args) => converge::run(args),
         Command::Diff(args) => diff::run(args),
         Command::Merge(args) => merge::run(args),
@@ -81,7 +85,7 @@ pub fn runnable(isa: rtis::accel::Isa) -> Result<rtis::accel::Isa, CliError> {
 /// Load the scene at `path`, or the embedded Cornell box when there is none.
 pub fn load(path: Option<&Path>) -> Result<Scene, SceneError> {
     match path {
-        Some(p) => scene::load_path(p),
+        Some(p) => rtis::import::load_scene(p),
         None => Ok(scene::load_default()),
     }
 }

@@ -238,7 +238,7 @@ fn renderer(
             s.generation += 1;
             s.status = Status::Loading;
         }
-        match rtis::scene::load_path(scene_path) {
+        match rtis::import::load_scene(scene_path) {
             Err(e) => {
                 // Keep the last good image; follow the file the error is in as well, and
                 // reload on any change in the folders followed.

@@ -9,7 +9,7 @@ use super::values::{
     Aperture, Count, Direction, Fov, Ior, IorPart, MetalName, NonNegative, Point, Positive,
     Reflectance, Rgb, Roughness, Scale, SpotAngle, UpTo,
 };
-use crate::camera::{Projection, WorldCamera, WorldLens};
+use crate::camera::{Handedness, Projection, WorldCamera, WorldLens};
 use crate::effects::Switches;
 use crate::geometry::Transform;
 use crate::light::{Emitter, RadianceTexture, Sky, WorldEnvironment, WorldLight};
@@ -212,6 +212,10 @@ pub enum CameraFields {
         /// scene units (default: the distance to `look_at`). Used with `aperture_radius`.
         #[serde(default)]
         focus_distance: Option<Positive>,
+        /// `Left` (default, the course's: the image's right is `up x forward`) or `Right`
+        /// (Mitsuba 3's: `forward x up`, the mirror image).
+        #[serde(default, skip_serializing_if = "is_left")]
+        handedness: Handedness,
     },
     /// A parallel projection.
     Orthographic {
@@ -224,7 +228,14 @@ pub enum CameraFields {
         up: Direction,
         /// Vertical extent of the image rectangle in scene units, > 0.
         height: Positive,
+        /// As a perspective camera's.
+        #[serde(default, skip_serializing_if = "is_left")]
+        handedness: Handedness,
     },
+}
+
+fn is_left(h: &Handedness) -> bool {
+    *h == Handedness::Left
 }
 
 fn y_up() -> Direction {
@@ -235,6 +246,14 @@ fn fov60() -> Fov {
 }
 
 impl CameraFields {
+    /// Which way the image's right runs.
+    pub fn handedness(&self) -> Handedness {
+        match *self {
+            CameraFields::Perspective { handedness, .. }
+            | CameraFields::Orthographic { handedness, .. } => handedness,
+        }
+    }
+
     /// Position, look-at point and up hint.
     pub fn frame(&self) -> (glam::DVec3, glam::DVec3, glam::DVec3) {
         match *self {
@@ -326,6 +345,7 @@ impl CameraDesc {
             position,
             look_at,
             up,
+            handedness: self.0.handedness(),
         }
     }
 }
@@ -1240,6 +1260,10 @@ pub enum ShapeDesc {
     Mesh {
         /// Path of the .obj file.
         path: String,
+        /// Shade with each face's own normal, ignoring the file's vertex normals (default
+        /// false; Mitsuba 3's `face_normals`).
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        face_normals: bool,
     },
 }
 
@@ -1275,7 +1299,13 @@ impl ShapeDesc {
                 faces: faces.iter().map(|&(i, j, k)| [i, j, k]).collect(),
                 uvs: Vec::new(),
             })),
-            ShapeDesc::Mesh { path } => WorldShape::Mesh(Arc::new(load_mesh(path)?)),
+            ShapeDesc::Mesh { path, face_normals } => {
+                let mut mesh = load_mesh(path)?;
+                if *face_normals {
+                    mesh.normals.clear();
+                }
+                WorldShape::Mesh(Arc::new(mesh))
+            }
         })
     }
 }

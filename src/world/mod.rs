@@ -59,6 +59,7 @@ impl Default for Settings {
                 position: DVec3::ZERO,
                 look_at: DVec3::Z,
                 up: DVec3::Y,
+                handedness: crate::camera::Handedness::Left,
             },
             shader: Shader::Direct {
                 max_specular: 32,

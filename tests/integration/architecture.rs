@@ -23,6 +23,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("world", 5),
     ("extract", 6),
     ("scene", 7),
+    ("import", 7),
     ("converge", 7),
     ("cli", 8),
     ("lib", 9),

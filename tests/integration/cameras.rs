@@ -5,7 +5,7 @@
 
 use crate::common::{bits, render_str, scene};
 use glam::{DVec3, Vec3A};
-use rtis::camera::{Camera, Projection, WorldCamera, WorldLens};
+use rtis::camera::{Camera, Handedness, Projection, WorldCamera, WorldLens};
 use rtis::sampling::Sampler;
 
 fn camera(lens: Option<WorldLens>) -> Camera {
@@ -14,6 +14,7 @@ fn camera(lens: Option<WorldLens>) -> Camera {
         position: DVec3::ZERO,
         look_at: DVec3::new(0.3, -0.2, 1.0),
         up: DVec3::Y,
+        handedness: Handedness::Left,
     }
     .extract(1.5)
 }
@@ -252,4 +253,33 @@ fn a_gaussian_filter_blurs_an_edge_by_its_profile() {
         .unwrap()
         .to_string();
     assert!(e.contains("at most 8 pixels"), "{e}");
+}
+
+/// `handedness: Right` (Mitsuba's) renders the mirror image of the course's camera: a seen
+/// checkerboard emitter, every column of one the other's mirror, pixel for pixel.
+#[test]
+fn right_handedness_mirrors_the_image() {
+    let text = |hand: &str| {
+        format!(
+            "Scene(film: (width: 8, height: 6, spp: 1), shader: Path(max_depth: 1), model: Physical,
+                   camera: Orthographic(position: (0, 0, -5), look_at: (0, 0, 0), up: (0, 1, 0),
+                                        height: 2{hand}),
+                   entities: [
+                     (shape: Rectangle(corner: (-2, 1, 0), u: (4, 0, 0), v: (0, -2, 0)),
+                      emitter: (radiance: Checkerboard(color0: (0.9, 0.8, 0.7),
+                                                       color1: (0.1, 0.2, 0.3),
+                                                       uv_transform: (scale: (3, 2))),
+                                two_sided: true))])"
+        )
+    };
+    let left = render_str(&text("")).image;
+    let right = render_str(&text(", handedness: Right")).image;
+    let mut differs = false;
+    for row in 0..6 {
+        for col in 0..8 {
+            assert_eq!(left.get(col, row), right.get(7 - col, row), "({col}, {row})");
+            differs |= left.get(col, row) != right.get(col, row);
+        }
+    }
+    assert!(differs, "the image is its own mirror: the test sees nothing");
 }

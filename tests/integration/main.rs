@@ -23,6 +23,7 @@ mod global_waves;
 mod global_weights;
 mod golden;
 mod hard_cases;
+mod import;
 mod lights;
 mod material_textures;
 mod materials;

@@ -1,0 +1,42 @@
+//! `rtis import`: a Mitsuba 3 scene (XML) written as an rtis scene file that a person can read
+//! and edit, checked by loading it back.
+
+use super::CliError;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Arguments of `rtis import`.
+#[derive(Args, Debug)]
+pub struct ImportArgs {
+    /// The Mitsuba scene (`.xml`).
+    pub scene: PathBuf,
+    /// The rtis scene file to write (RON); printed when absent.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
+
+/// Convert, check that the result loads, and write it (whole, or not at all).
+pub fn run(args: ImportArgs) -> Result<(), CliError> {
+    let to = match &args.output {
+        Some(o) => o.parent().map(PathBuf::from).unwrap_or_default(),
+        None => args.scene.parent().map(PathBuf::from).unwrap_or_default(),
+    };
+    let converted = rtis::import::import(&args.scene, &to)?;
+    for w in &converted.warnings {
+        eprintln!("warning: {w}");
+    }
+    // What is written must load: the loader's own checks run on it now.
+    let name = format!("{} (as imported)", args.scene.display());
+    let scene = rtis::scene::load_str(&converted.text, &name, Some(&to))?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    match &args.output {
+        Some(path) => {
+            rtis::render::output::write_file(path, converted.text.as_bytes())?;
+            eprintln!("{} -> {}", args.scene.display(), path.display());
+        }
+        None => print!("{}", converted.text),
+    }
+    Ok(())
+}

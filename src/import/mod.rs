@@ -1,0 +1,38 @@
+//! Mitsuba 3 scenes imported: a front end beside [`crate::scene`] that reads Mitsuba's XML
+//! ([`xml`]) and writes the same scene as rtis scene text ([`convert`]), which the scene loader
+//! then reads as it reads any RON file, so that everything after it is shared. `rtis import`
+//! writes that text; `rtis render` and `rtis check` take a `.xml` file by the same conversion.
+//! docs/import.md lists the supported subset and the conventions.
+
+pub mod convert;
+pub mod spectrum;
+pub mod xml;
+
+use crate::scene::{Scene, SceneError};
+use std::path::Path;
+
+/// The rtis scene text of the Mitsuba scene at `path`, its files named relative to the folder
+/// `to` (where the text will be read from), and the conversion's warnings.
+pub fn import(path: &Path, to: &Path) -> Result<convert::Converted, SceneError> {
+    let doc = xml::read(path)?;
+    convert::convert(&doc, &path.display().to_string(), to)
+}
+
+/// True if `path` names a Mitsuba scene (`.xml`).
+pub fn is_mitsuba(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
+/// The scene at `path`: a Mitsuba scene converted ([`import`]), or an rtis scene file.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    if !is_mitsuba(path) {
+        return crate::scene::load_path(path);
+    }
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let converted = import(path, dir)?;
+    let name = format!("{} (as imported)", path.display());
+    let mut scene = crate::scene::load_str(&converted.text, &name, Some(dir))?;
+    scene.warnings.extend(converted.warnings);
+    Ok(scene)
+}
