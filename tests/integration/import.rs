@@ -241,3 +241,45 @@ fn imported_cornell_box_matches_mitsuba() {
         "mean {m} vs {want}"
     );
 }
+
+mod fuzz {
+    use crate::scene_fuzz::{Mutation, apply, cases, mutation};
+    use proptest::prelude::*;
+    use std::panic::{AssertUnwindSafe, catch_unwind};
+    use std::path::Path;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(cases(600)))]
+
+        /// Mutated Mitsuba scenes (bytes flipped, cut short, numbers swapped or replaced by
+        /// extreme ones, brackets deleted, lines duplicated or deleted, punctuation inserted)
+        /// import to a scene or fail with a located message, and never panic.
+        #[test]
+        fn mutated_xml_imports_or_fails_located(
+            mutations in proptest::collection::vec(mutation(), 1..4),
+        ) {
+            let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/import/cbox.xml");
+            let mut bytes = std::fs::read(&source).unwrap();
+            for m in &mutations {
+                apply(&mut bytes, m);
+            }
+            let d = super::dir(&format!("fuzz-{:?}", std::thread::current().id()).replace(|c: char| !c.is_ascii_alphanumeric(), ""));
+            let path = d.join("cbox.xml");
+            std::fs::write(&path, &bytes).unwrap();
+            let shown = String::from_utf8_lossy(&bytes).into_owned();
+            let result = catch_unwind(AssertUnwindSafe(|| rtis::import::load_scene(&path)));
+            let result = result.map_err(|p| {
+                let why = p
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                    .unwrap_or_default();
+                TestCaseError::fail(format!("import panicked ({why}) after {mutations:?}:\n{shown}"))
+            })?;
+            if let Err(e) = result {
+                let located = e.at.is_some() || e.message.starts_with("cannot read");
+                prop_assert!(located, "not located: {e} after {:?}", mutations as Vec<Mutation>);
+            }
+        }
+    }
+}

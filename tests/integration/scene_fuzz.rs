@@ -11,7 +11,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 
 /// Proptest cases: `PROPTEST_CASES` when set (for long runs), else `default` (seconds in CI).
-fn cases(default: u32) -> u32 {
+pub(crate) fn cases(default: u32) -> u32 {
     std::env::var("PROPTEST_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -41,7 +41,7 @@ fn scenes() -> Vec<(String, String)> {
 
 /// One change to a file's bytes; every index is taken modulo what it indexes.
 #[derive(Clone, Debug)]
-enum Mutation {
+pub(crate) enum Mutation {
     /// Flip bit `bit` of byte `at`.
     FlipBit { at: usize, bit: u8 },
     /// Cut the file at `at`.
@@ -106,7 +106,7 @@ const INSERTS: &[&str] = &[
     "\0",
 ];
 
-fn mutation() -> impl Strategy<Value = Mutation> {
+pub(crate) fn mutation() -> impl Strategy<Value = Mutation> {
     let any = any::<usize>();
     prop_oneof![
         (any, 0u8..8).prop_map(|(at, bit)| Mutation::FlipBit { at, bit }),
@@ -149,7 +149,7 @@ fn numbers(b: &[u8]) -> Vec<(usize, usize)> {
     out
 }
 
-fn apply(b: &mut Vec<u8>, m: &Mutation) {
+pub(crate) fn apply(b: &mut Vec<u8>, m: &Mutation) {
     let len = b.len().max(1);
     let lines = |b: &[u8]| -> Vec<(usize, usize)> {
         let mut v = Vec::new();
