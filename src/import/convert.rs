@@ -934,10 +934,11 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
                 faces.join(", ")
             )
         }
-        "obj" => {
-            let (file, _) = p
-                .string("filename")?
-                .ok_or_else(|| o.pos.error("an `obj` shape needs a `filename`"))?;
+        "obj" | "ply" => {
+            let (file, _) = p.string("filename")?.ok_or_else(|| {
+                o.pos
+                    .error(format!("a `{}` shape needs a `filename`", o.kind))
+            })?;
             let face_normals = p.boolean("face_normals", false)?;
             if flip {
                 return Err(o
@@ -953,14 +954,14 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
             if !t.is_empty() {
                 transform = format!(", transform: {t}");
             }
-            let fn_text = if face_normals {
-                ", face_normals: true"
-            } else {
-                ""
-            };
-            format!("Mesh(path: {}{fn_text})", string(&paths.path(&file)))
+            // Mitsuba computes smooth normals for a mesh without them, unless face_normals.
+            let normals = if face_normals { "Faces" } else { "Smooth" };
+            format!(
+                "Mesh(path: {}, normals: {normals})",
+                string(&paths.path(&file))
+            )
         }
-        _ => return Err(unsupported(o, "shapes: sphere, rectangle, cube, obj")),
+        _ => return Err(unsupported(o, "shapes: sphere, rectangle, cube, obj, ply")),
     };
     p.done()?;
     let material = shape_material(o, &out.paths)?;

@@ -67,6 +67,28 @@ pub fn vertex_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DVec3> {
     n.into_iter().map(DVec3::normalize_or_zero).collect()
 }
 
+/// Angle-weighted vertex normals (Thurmer and Wuthrich, "Computing vertex normals from
+/// polygonal facets", JGT 1998; Mitsuba 3's for meshes without normals): each face adds its unit
+/// normal to each of its corners, weighted by its interior angle there, and the sums are
+/// normalised (zero where nothing adds up).
+pub fn angle_weighted_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut n = vec![DVec3::ZERO; positions.len()];
+    for f in faces {
+        let p = f.map(|i| positions[i as usize]);
+        let Some(face) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else {
+            continue;
+        };
+        for k in 0..3 {
+            let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+            let angle = a.angle_between(b);
+            if angle.is_finite() {
+                n[f[k] as usize] += face * angle;
+            }
+        }
+    }
+    n.into_iter().map(DVec3::normalize_or_zero).collect()
+}
+
 /// Write a mesh as Wavefront OBJ (positions, normals if any, 1-based faces).
 pub fn write_obj(mesh: &MeshData, path: &Path) -> std::io::Result<()> {
     let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);

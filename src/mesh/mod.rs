@@ -1,10 +1,21 @@
-//! Triangle meshes: Wavefront OBJ loading and a procedural generator for tests and benchmarks.
+//! Triangle meshes: Wavefront OBJ and Stanford PLY loading, and a procedural generator for
+//! tests and benchmarks.
 
 mod generate;
 mod obj;
+mod ply;
 
-pub use generate::{displaced_sphere, vertex_normals, write_obj};
+pub use generate::{angle_weighted_normals, displaced_sphere, vertex_normals, write_obj};
 pub use obj::load_obj;
+pub use ply::load_ply;
+
+/// Read the mesh at `path`: a PLY file (`.ply`), else a Wavefront OBJ file.
+pub fn load(path: &std::path::Path) -> Result<MeshData, String> {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case("ply") => load_ply(path),
+        _ => load_obj(path),
+    }
+}
 
 use glam::DVec3;
 

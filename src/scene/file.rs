@@ -1260,11 +1260,31 @@ pub enum ShapeDesc {
     Mesh {
         /// Path of the .obj file.
         path: String,
-        /// Shade with each face's own normal, ignoring the file's vertex normals (default
-        /// false; Mitsuba 3's `face_normals`).
-        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-        face_normals: bool,
+        /// Which normals shade it: `File` (default: the file's vertex normals, each face's
+        /// own without them), `Faces` (each face's own, always; Mitsuba 3's `face_normals`) or
+        /// `Smooth` (the file's, else computed from the faces around each vertex weighted by
+        /// their angles there, as Mitsuba 3 computes them by default).
+        #[serde(default, skip_serializing_if = "MeshNormals::is_file")]
+        normals: MeshNormals,
     },
+}
+
+/// Which normals shade a mesh read from a file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+pub enum MeshNormals {
+    /// The file's vertex normals; flat faces without them.
+    #[default]
+    File,
+    /// Flat faces, whatever the file holds.
+    Faces,
+    /// The file's vertex normals, else angle-weighted ones computed from the faces.
+    Smooth,
+}
+
+impl MeshNormals {
+    fn is_file(&self) -> bool {
+        *self == MeshNormals::File
+    }
 }
 
 impl ShapeDesc {
@@ -1299,10 +1319,16 @@ impl ShapeDesc {
                 faces: faces.iter().map(|&(i, j, k)| [i, j, k]).collect(),
                 uvs: Vec::new(),
             })),
-            ShapeDesc::Mesh { path, face_normals } => {
+            ShapeDesc::Mesh { path, normals } => {
                 let mut mesh = load_mesh(path)?;
-                if *face_normals {
-                    mesh.normals.clear();
+                match normals {
+                    MeshNormals::File => {}
+                    MeshNormals::Faces => mesh.normals.clear(),
+                    MeshNormals::Smooth if mesh.normals.is_empty() => {
+                        mesh.normals =
+                            crate::mesh::angle_weighted_normals(&mesh.positions, &mesh.faces);
+                    }
+                    MeshNormals::Smooth => {}
                 }
                 WorldShape::Mesh(Arc::new(mesh))
             }

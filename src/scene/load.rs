@@ -474,7 +474,7 @@ impl Resolved {
                     .to_world(|path| {
                         let file = src.dir.clone().unwrap_or_default().join(path);
                         files.push(file.clone());
-                        crate::mesh::load_obj(&file)
+                        crate::mesh::load(&file)
                     })
                     .map_err(|m| src.error(place("shape", Some("path")), m))?;
                 b.add(shape);

@@ -277,9 +277,16 @@ fn right_handedness_mirrors_the_image() {
     let mut differs = false;
     for row in 0..6 {
         for col in 0..8 {
-            assert_eq!(left.get(col, row), right.get(7 - col, row), "({col}, {row})");
+            assert_eq!(
+                left.get(col, row),
+                right.get(7 - col, row),
+                "({col}, {row})"
+            );
             differs |= left.get(col, row) != right.get(col, row);
         }
     }
-    assert!(differs, "the image is its own mirror: the test sees nothing");
+    assert!(
+        differs,
+        "the image is its own mirror: the test sees nothing"
+    );
 }

@@ -210,35 +210,56 @@ fn bad_input_is_located() {
     assert!(e.contains("b.xml:2:") && e.contains("include cycle"), "{e}");
 }
 
-/// Side by side with Mitsuba 3 (bench/mitsuba_import_reference.py): a Cornell box written in
-/// Mitsuba's XML (rectangles placed by transforms, a cube, a glass sphere, a rectangle light),
-/// rendered by Mitsuba from the file and by rtis from its import, in Mitsuba's orientation. Two
-/// renders of 64 spp agree with Mitsuba's 4096 spp on 4x4 blocks within what noise explains,
-/// and in the mean within 1%.
-#[test]
-fn imported_cornell_box_matches_mitsuba() {
-    let xml = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/import/cbox.xml");
-    let mut s = rtis::import::load_scene(&xml).unwrap_or_else(|e| panic!("{e}"));
+/// Two renders of 64 spp of the imported Mitsuba scene `xml` (in tests/data/import) against
+/// Mitsuba's image `reference` of noise `noise` (bench/mitsuba_import_reference.py, Mitsuba's
+/// orientation): block MSE within 1.5 times what noise explains, and the mean within 1% of
+/// Mitsuba's `mean`.
+fn matches_mitsuba(xml: &str, reference: &str, noise: f64, mean: [f32; 3]) {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let mut s =
+        rtis::import::load_scene(&data.join("import").join(xml)).unwrap_or_else(|e| panic!("{e}"));
     s.settings.film.spp = 64;
     let a = common::render_scene(&s);
     s.settings.seed = 4321;
     let b = common::render_scene(&s);
-    let r = rtis::render::output::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/mitsuba_import_cbox_96x96_spp4096.exr"),
-    )
-    .unwrap();
-    let (mse, explained) = common::block_mse(&a.image, &b.image, &r, 0.008883, &|_, _| false);
+    let r = rtis::render::output::load(&data.join(reference)).unwrap();
+    let (mse, explained) = common::block_mse(&a.image, &b.image, &r, noise, &|_, _| false);
     let m = (a.image.mean() + b.image.mean()) * 0.5;
-    eprintln!("block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}; mean {m}");
+    eprintln!("{xml}: block MSE vs Mitsuba {mse:.3e}; noise explains {explained:.3e}; mean {m}");
     assert!(
         mse < 1.5 * explained,
-        "block MSE {mse:.3e} vs {explained:.3e}"
+        "{xml}: block MSE {mse:.3e} vs {explained:.3e}"
     );
-    let want = glam::Vec3A::new(0.298009, 0.245842, 0.137712);
+    let want = glam::Vec3A::from_array(mean);
     assert!(
         ((m - want) / want).abs().max_element() < 0.01,
-        "mean {m} vs {want}"
+        "{xml}: mean {m} vs {want}"
+    );
+}
+
+/// A Cornell box written in Mitsuba's XML (rectangles placed by transforms, a cube, a glass
+/// sphere, a rectangle light, declared BSDFs, defaults), rendered by Mitsuba from the file and
+/// by rtis from its import: the same image.
+#[test]
+fn imported_cornell_box_matches_mitsuba() {
+    matches_mitsuba(
+        "cbox.xml",
+        "mitsuba_import_cbox_96x96_spp4096.exr",
+        0.008883,
+        [0.298009, 0.245842, 0.137712],
+    );
+}
+
+/// Meshes: a binary little-endian PLY torus with normals and texture coordinates (a
+/// checkerboard), a big-endian PLY strip without normals (smooth normals computed as
+/// Mitsuba's), a transformed OBJ pyramid, under a sky and a sun: the same image.
+#[test]
+fn imported_meshes_match_mitsuba() {
+    matches_mitsuba(
+        "meshes.xml",
+        "mitsuba_import_meshes_128x96_spp4096.exr",
+        0.002767,
+        [0.411715, 0.401771, 0.4053],
     );
 }
 
