@@ -5,8 +5,9 @@ Not run in CI. Mitsuba loads the XML file itself (`mi.load_file`); rtis imports 
 (`rtis import`, or `rtis render FILE.xml`). tests/integration/import.rs compares the two.
 
 It writes tests/data/mitsuba_import_<NAME>_<W>x<H>_spp<N>.exr (linear float32 RGB, Mitsuba's
-own orientation: an imported scene renders as Mitsuba's image, not its mirror) and a .json
-beside it with the version, variant, spp, seconds, the image mean and `noise_rmse`.
+own orientation: an imported scene renders as Mitsuba's image, not its mirror), a .json
+beside it with the version, variant, spp, seconds, the image mean and `noise_rmse`, and
+docs/images/mitsuba-import-<NAME>.png (sRGB) for the README.
 
 Setup: pip install mitsuba numpy; apt-get install libllvm19 (else --variant scalar_rgb).
 
@@ -39,6 +40,10 @@ def main():
     name = os.path.splitext(os.path.basename(args.scene))[0]
     stem = os.path.join(ROOT, "tests/data", f"mitsuba_import_{name}_{width}x{height}_spp{args.spp}")
     meta = write_reference(mi, stem, img, half_rmse, seconds, args.variant, args.spp)
+    # Mitsuba's image for the README (sRGB PNG, its own orientation).
+    png = os.path.join(ROOT, "docs/images", f"mitsuba-import-{name}.png")
+    bitmap = mi.Bitmap(img.astype(np.float32), pixel_format=mi.Bitmap.PixelFormat.RGB)
+    bitmap.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, srgb_gamma=True).write(png)
     print(json.dumps(meta))
 
 

@@ -59,8 +59,8 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 README = os.path.join(ROOT, "README.md")
 RTIS = os.path.join(ROOT, "target", "release", "rtis")
-BLOCKS = ["build", "hero", "cornell", "commits", "effects", "meshes", "converge", "area", "materials", "lens", "sky", "textures", "obvhs", "embree",
-          "mitsuba"]
+BLOCKS = ["build", "hero", "cornell", "commits", "effects", "meshes", "converge", "area", "materials", "lens", "sky", "textures", "import",
+          "obvhs", "embree", "mitsuba"]
 # The commit the `commits` block compares with: the last before the Global shader's waves.
 COMPARE_BASE = "e3269bf"
 # The commit the `build` block compares with: the last with one test binary per file.
@@ -234,6 +234,46 @@ def textures(_runs):
         *table,
         "",
         stamp("`rtis render --stats` and `rtis converge scenes/checkerboard.ron --runs 1 --seeds 2`"),
+    ])
+
+
+def diff_rmse(a, b):
+    """`rtis diff A B`: the RMSE it prints."""
+    out = run(["diff", a, b])
+    return float(re.search(r"RMSE\s+([0-9.eE+-]+)", out).group(1))
+
+
+def import_block(_runs):
+    """tests/data/import/cbox.xml rendered by rtis from its import, beside Mitsuba's image of the
+    file (bench/mitsuba_import_reference.py), with the RMSE between them and what noise explains
+    of it: rtis's own noise (from two seeds) and the reference's."""
+    scene = "tests/data/import/cbox.xml"
+    ref = "tests/data/mitsuba_import_cbox_96x96_spp4096.exr"
+    with open(os.path.join(ROOT, ref.replace(".exr", ".json"))) as f:
+        meta = json.load(f)
+    spp = 1024
+    with tempfile.TemporaryDirectory() as d:
+        a, b = os.path.join(d, "a.exr"), os.path.join(d, "b.exr")
+        stats = os.path.join(d, "stats.json")
+        run(["render", scene, "--spp", str(spp), "-o", a, "--stats", stats])
+        run(["render", scene, "--spp", str(spp), "-o", b, "--seed", "1"])
+        run(["render", scene, "--spp", str(spp), "-o", os.path.join(ROOT, "docs/images/rtis-import-cbox.png")])
+        with open(stats) as f:
+            s = json.load(f)
+        rmse = diff_rmse(a, os.path.join(ROOT, ref))
+        # Each render's noise: the RMSE between two seeds over sqrt(2).
+        own = diff_rmse(a, b) / 2 ** 0.5
+    noise = (own ** 2 + meta["noise_rmse"] ** 2) ** 0.5
+    return "\n".join([
+        "| Mitsuba 3 (`mi.load_file`) | rtis (`rtis render cbox.xml`) |",
+        "|---|---|",
+        "| ![Mitsuba's image](docs/images/mitsuba-import-cbox.png) | ![rtis's image](docs/images/rtis-import-cbox.png) |",
+        "",
+        f"*`{scene}`, 96x96: Mitsuba {meta['mitsuba']} ({meta['variant']}) at {meta['spp']} spp; rtis at {spp} spp "
+        f"in {s['seconds']:.2f} s. RMSE between the two {rmse:.4f}, where their noise alone gives {noise:.4f} "
+        f"(rtis {own:.4f}, Mitsuba {meta['noise_rmse']:.4f}).*",
+        "",
+        stamp("`rtis render` and `rtis diff` against the stored Mitsuba image"),
     ])
 
 
@@ -491,7 +531,7 @@ def main():
     makers = {"build": build, "hero": hero, "cornell": cornell, "commits": commits, "effects": effects, "meshes": meshes,
               "converge": converge,
               "obvhs": obvhs,
-              "area": area, "materials": materials, "lens": lens, "sky": sky, "textures": textures, "embree": embree, "mitsuba": mitsuba}
+              "area": area, "materials": materials, "lens": lens, "sky": sky, "textures": textures, "import": import_block, "embree": embree, "mitsuba": mitsuba}
     for name in a.only.split(","):
         if name not in makers:
             print(f"unknown block {name}: use {', '.join(BLOCKS)}", file=sys.stderr)
