@@ -4,6 +4,7 @@
 //! writes that text; `rtis render` and `rtis check` take a `.xml` file by the same conversion.
 //! docs/import.md lists the supported subset and the conventions.
 
+mod cie;
 pub mod convert;
 pub mod spectrum;
 pub mod xml;

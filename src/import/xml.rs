@@ -261,7 +261,7 @@ impl Reader {
                     self.chain.pop();
                 }
                 _ => {
-                    let object = self.object(&cx, node)?;
+                    let object = self.object(&cx, node, "scene")?;
                     match object {
                         Item::Object(o) => objects.push(o),
                         Item::Property(name, p) => {
@@ -327,7 +327,7 @@ impl Reader {
     }
 
     /// An object element or a property element.
-    fn object(&mut self, cx: &Cx, node: roxmltree::Node) -> Result<Item, SceneError> {
+    fn object(&mut self, cx: &Cx, node: roxmltree::Node, parent: &str) -> Result<Item, SceneError> {
         let tag = node.tag_name().name();
         let pos = (cx.at)(node);
         let name = self.attr(cx, node, "name")?;
@@ -371,7 +371,15 @@ impl Reader {
                     c.map(|x| crate::raster::srgb_to_linear(x as f32) as f64),
                 ))
             }
-            "spectrum" => named(Value::Color(super::spectrum::to_rgb(&value(self)?, &pos)?)),
+            "spectrum" => {
+                use super::spectrum::{Role, to_rgb};
+                let role = match (parent, name.as_deref()) {
+                    ("emitter", _) => Role::Emitter,
+                    (_, Some("eta" | "k" | "int_ior" | "ext_ior")) => Role::Unbounded,
+                    _ => Role::Bounded,
+                };
+                named(Value::Color(to_rgb(&value(self)?, role, &pos)?))
+            }
             "point" | "vector" => named(Value::Vector(self.vector(cx, node, 0.0)?)),
             "transform" => named(Value::Transform(self.transform(cx, node)?)),
             "ref" => {
@@ -411,7 +419,7 @@ impl Reader {
                     pos: pos.clone(),
                 };
                 for child in node.children().filter(roxmltree::Node::is_element) {
-                    match self.object(cx, child)? {
+                    match self.object(cx, child, tag)? {
                         Item::Property(n, p) => {
                             if let Some(first) = object.props.get(&n) {
                                 return Err(p.pos.error(format!(
