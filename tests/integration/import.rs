@@ -263,6 +263,20 @@ fn imported_meshes_match_mitsuba() {
     );
 }
 
+/// One of each remaining kind: a thin lens (in an included file), an envmap turned by its
+/// to_world, a point light given as a spectrum, a spot light, a conductor, a rough dielectric,
+/// a plastic, a rough plastic on a bitmap, and a normal-mapped panel seen from its back: the
+/// same image.
+#[test]
+fn imported_kinds_match_mitsuba() {
+    matches_mitsuba(
+        "kinds.xml",
+        "mitsuba_import_kinds_128x96_spp4096.exr",
+        0.006118,
+        [0.195765, 0.20019, 0.213298],
+    );
+}
+
 mod fuzz {
     use crate::scene_fuzz::{Mutation, apply, cases, mutation};
     use proptest::prelude::*;
@@ -304,3 +318,4 @@ mod fuzz {
         }
     }
 }
+
