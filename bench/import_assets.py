@@ -73,3 +73,37 @@ def main():
 
 if __name__ == "__main__":
     main()
+
+
+def write_serialized(path, meshes):
+    """A Mitsuba serialized file (version 4, single precision) of `meshes`, each (name,
+    vertices [(x, y, z)], triangles [(i, j, k)], uvs or None), with its dictionary."""
+    import zlib
+    out, offsets = b"", []
+    for name, verts, tris, uvs in meshes:
+        offsets.append(len(out))
+        raw = struct.pack("<I", 0x1000 | (0x0002 if uvs else 0)) + name.encode() + b"\0"
+        raw += struct.pack("<QQ", len(verts), len(tris))
+        raw += b"".join(struct.pack("<3f", *v) for v in verts)
+        if uvs:
+            raw += b"".join(struct.pack("<2f", *t) for t in uvs)
+        raw += b"".join(struct.pack("<3I", *t) for t in tris)
+        out += struct.pack("<HH", 0x041C, 4) + zlib.compress(raw)
+    out += b"".join(struct.pack("<Q", o) for o in offsets) + struct.pack("<I", len(offsets))
+    with open(path, "wb") as f:
+        f.write(out)
+
+
+def serialized_assets():
+    """tests/data/import/shapes.serialized: a tetrahedron (mesh 0) and the torus without its
+    normals (mesh 1, with texture coordinates)."""
+    tet = [(0, 0, 0), (1, 0, 0), (0.5, 0, 0.9), (0.5, 0.8, 0.3)]
+    tet_faces = [(0, 2, 1), (0, 1, 3), (1, 2, 3), (2, 0, 3)]
+    verts, faces = torus()
+    write_serialized(os.path.join(OUT, "shapes.serialized"), [
+        ("tetrahedron", tet, tet_faces, None),
+        ("torus", [v[:3] for v in verts], faces, [v[6:] for v in verts]),
+    ])
+
+
+serialized_assets()

@@ -934,11 +934,26 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
                 faces.join(", ")
             )
         }
-        "obj" | "ply" => {
+        "obj" | "ply" | "serialized" => {
             let (file, _) = p.string("filename")?.ok_or_else(|| {
                 o.pos
                     .error(format!("a `{}` shape needs a `filename`", o.kind))
             })?;
+            let index = if o.kind == "serialized" {
+                p.integer("shape_index", 0)?
+            } else {
+                0
+            };
+            if !(0..=u32::MAX as i64).contains(&index) {
+                return Err(o
+                    .pos
+                    .error(format!("`shape_index` {index} is not a mesh index")));
+            }
+            let index_text = if index > 0 {
+                format!(", shape_index: {index}")
+            } else {
+                String::new()
+            };
             let face_normals = p.boolean("face_normals", false)?;
             if flip {
                 return Err(o
@@ -957,11 +972,16 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
             // Mitsuba computes smooth normals for a mesh without them, unless face_normals.
             let normals = if face_normals { "Faces" } else { "Smooth" };
             format!(
-                "Mesh(path: {}, normals: {normals})",
+                "Mesh(path: {}, normals: {normals}{index_text})",
                 string(&paths.path(&file))
             )
         }
-        _ => return Err(unsupported(o, "shapes: sphere, rectangle, cube, obj, ply")),
+        _ => {
+            return Err(unsupported(
+                o,
+                "shapes: sphere, rectangle, cube, obj, ply, serialized",
+            ));
+        }
     };
     p.done()?;
     let material = shape_material(o, &out.paths)?;

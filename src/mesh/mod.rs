@@ -1,19 +1,32 @@
-//! Triangle meshes: Wavefront OBJ and Stanford PLY loading, and a procedural generator for
+//! Triangle meshes: Wavefront OBJ, Stanford PLY and Mitsuba serialized loading, and a procedural generator for
 //! tests and benchmarks.
 
 mod generate;
 mod obj;
 mod ply;
+mod serialized;
 
 pub use generate::{angle_weighted_normals, displaced_sphere, vertex_normals, write_obj};
 pub use obj::load_obj;
 pub use ply::load_ply;
+pub use serialized::load_serialized;
 
-/// Read the mesh at `path`: a PLY file (`.ply`), else a Wavefront OBJ file.
-pub fn load(path: &std::path::Path) -> Result<MeshData, String> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some(e) if e.eq_ignore_ascii_case("ply") => load_ply(path),
-        _ => load_obj(path),
+/// Read the mesh at `path`: a PLY file (`.ply`), mesh `index` of a Mitsuba serialized file
+/// (`.serialized`), else a Wavefront OBJ file. `index` is for serialized files only.
+pub fn load(path: &std::path::Path, index: u32) -> Result<MeshData, String> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ext.eq_ignore_ascii_case("serialized") {
+        return load_serialized(path, index);
+    }
+    if index != 0 {
+        return Err(format!(
+            "shape_index {index}: only a .serialized file holds several meshes"
+        ));
+    }
+    if ext.eq_ignore_ascii_case("ply") {
+        load_ply(path)
+    } else {
+        load_obj(path)
     }
 }
 

@@ -1258,7 +1258,8 @@ pub enum ShapeDesc {
     /// A Wavefront OBJ file, relative to the scene file's folder: positions, faces
     /// (triangulated), and vertex normals for smooth shading when the file has them.
     Mesh {
-        /// Path of the .obj file.
+        /// Path of the mesh file: Wavefront OBJ, Stanford PLY (`.ply`) or Mitsuba serialized
+        /// (`.serialized`).
         path: String,
         /// Which normals shade it: `File` (default: the file's vertex normals, each face's
         /// own without them), `Faces` (each face's own, always; Mitsuba 3's `face_normals`) or
@@ -1266,7 +1267,14 @@ pub enum ShapeDesc {
         /// their angles there, as Mitsuba 3 computes them by default).
         #[serde(default, skip_serializing_if = "MeshNormals::is_file")]
         normals: MeshNormals,
+        /// Which mesh of a Mitsuba `.serialized` file (default 0, the first).
+        #[serde(default, skip_serializing_if = "is_zero")]
+        shape_index: u32,
     },
+}
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
 }
 
 /// Which normals shade a mesh read from a file.
@@ -1292,7 +1300,7 @@ impl ShapeDesc {
     /// file) and says why it cannot.
     pub fn to_world(
         &self,
-        load_mesh: impl FnOnce(&str) -> Result<MeshData, String>,
+        load_mesh: impl FnOnce(&str, u32) -> Result<MeshData, String>,
     ) -> Result<WorldShape, String> {
         Ok(match self {
             ShapeDesc::Sphere { center, radius } => WorldShape::Sphere {
@@ -1319,8 +1327,12 @@ impl ShapeDesc {
                 faces: faces.iter().map(|&(i, j, k)| [i, j, k]).collect(),
                 uvs: Vec::new(),
             })),
-            ShapeDesc::Mesh { path, normals } => {
-                let mut mesh = load_mesh(path)?;
+            ShapeDesc::Mesh {
+                path,
+                normals,
+                shape_index,
+            } => {
+                let mut mesh = load_mesh(path, *shape_index)?;
                 match normals {
                     MeshNormals::File => {}
                     MeshNormals::Faces => mesh.normals.clear(),

@@ -471,10 +471,10 @@ impl Resolved {
             }
             if let Some(shape) = &e.shape {
                 let shape = shape
-                    .to_world(|path| {
+                    .to_world(|path, index| {
                         let file = src.dir.clone().unwrap_or_default().join(path);
                         files.push(file.clone());
-                        crate::mesh::load(&file)
+                        crate::mesh::load(&file, index)
                     })
                     .map_err(|m| src.error(place("shape", Some("path")), m))?;
                 b.add(shape);
