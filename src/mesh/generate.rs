@@ -70,7 +70,8 @@ pub fn vertex_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DVec3> {
 /// Angle-weighted vertex normals (Thurmer and Wuthrich, "Computing vertex normals from
 /// polygonal facets", JGT 1998; Mitsuba 3's for meshes without normals): each face adds its unit
 /// normal to each of its corners, weighted by its interior angle there, and the sums are
-/// normalised (zero where nothing adds up).
+/// normalised; a vertex that no face of area uses gets `(1, 0, 0)`, as Mitsuba's (it shades
+/// nothing, and a normal is a direction).
 pub fn angle_weighted_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DVec3> {
     let mut n = vec![DVec3::ZERO; positions.len()];
     for f in faces {
@@ -86,7 +87,7 @@ pub fn angle_weighted_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DV
             }
         }
     }
-    n.into_iter().map(DVec3::normalize_or_zero).collect()
+    n.into_iter().map(|v| v.normalize_or(DVec3::X)).collect()
 }
 
 /// Write a mesh as Wavefront OBJ (positions, normals if any, 1-based faces).
