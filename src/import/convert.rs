@@ -934,6 +934,32 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
                 faces.join(", ")
             )
         }
+        "disk" => {
+            // Mitsuba's disk: radius 1 at z = 0, facing +z, as a fan of DISK_SEGMENTS
+            // triangles around its centre (its area short by 1e-4).
+            let centre = apply(&m, DVec3::ZERO);
+            let mut verts = vec![vec3(centre)];
+            for k in 0..DISK_SEGMENTS {
+                let phi = std::f64::consts::TAU * k as f64 / DISK_SEGMENTS as f64;
+                verts.push(vec3(apply(&m, DVec3::new(phi.cos(), phi.sin(), 0.0))));
+            }
+            let mirrored = (m.determinant() < 0.0) != flip;
+            let faces: Vec<String> = (0..DISK_SEGMENTS)
+                .map(|k| {
+                    let (a, b) = (1 + k, 1 + (k + 1) % DISK_SEGMENTS);
+                    if mirrored {
+                        format!("(0, {b}, {a})")
+                    } else {
+                        format!("(0, {a}, {b})")
+                    }
+                })
+                .collect();
+            format!(
+                "TriangleMesh(vertices: [{}], faces: [{}])",
+                verts.join(", "),
+                faces.join(", ")
+            )
+        }
         "obj" | "ply" | "serialized" => {
             let (file, _) = p.string("filename")?.ok_or_else(|| {
                 o.pos
@@ -979,7 +1005,7 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
         _ => {
             return Err(unsupported(
                 o,
-                "shapes: sphere, rectangle, cube, obj, ply, serialized",
+                "shapes: sphere, rectangle, cube, disk, obj, ply, serialized",
             ));
         }
     };
@@ -1015,6 +1041,10 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
     ));
     Ok(())
 }
+
+/// Triangles of an imported disk: its area is `(n / 2 pi) sin(2 pi / n)` of the circle's,
+/// 1e-4 short at 256.
+const DISK_SEGMENTS: usize = 256;
 
 /// A transform as rtis's scale, rotation (degrees about x, then y, then z) and translation,
 /// `(scale: ..., rotate: ..., translate: ...)`, or nothing for the identity; `None` when it
