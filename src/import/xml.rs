@@ -214,14 +214,17 @@ impl Reader {
             }
             None => (3, 0, 0),
         };
-        if top && !(v.0 == 2 || v.0 == 3) {
+        if v.0 > 3 {
             return Err(at(root).error(format!(
-                "version {}.{}.{}: rtis reads Mitsuba 3 scenes (versions 2.x and 3.x); 0.x \
-                 scenes are not upgraded yet",
+                "version {}.{}.{}: rtis reads Mitsuba scenes up to version 3.x",
                 v.0, v.1, v.2
             )));
         }
-        let cx = Cx { at: &at };
+        // A scene older than 2.0 is upgraded as Mitsuba 3 upgrades it.
+        let cx = Cx {
+            at: &at,
+            upgrade: v.0 < 2,
+        };
         for node in root.children().filter(roxmltree::Node::is_element) {
             match node.tag_name().name() {
                 "default" => {
@@ -330,7 +333,9 @@ impl Reader {
     fn object(&mut self, cx: &Cx, node: roxmltree::Node, parent: &str) -> Result<Item, SceneError> {
         let tag = node.tag_name().name();
         let pos = (cx.at)(node);
-        let name = self.attr(cx, node, "name")?;
+        let name = self
+            .attr(cx, node, "name")?
+            .map(|n| if cx.upgrade { snake_case(&n) } else { n });
         let named = |value: Value| -> Result<Item, SceneError> {
             let name = name
                 .clone()
@@ -432,6 +437,9 @@ impl Reader {
                         Item::Object(o) => object.children.push(o),
                     }
                 }
+                if cx.upgrade {
+                    upgrade(&mut object);
+                }
                 let object = Rc::new(object);
                 if let Some(id) = id {
                     self.ids.insert(id, object.clone());
@@ -521,7 +529,7 @@ impl Reader {
                         }
                     }
                 }
-                "lookat" => {
+                "lookat" | "lookAt" => {
                     let o = triple(&self.need(cx, step, "origin")?, &pos)?;
                     let t = triple(&self.need(cx, step, "target")?, &pos)?;
                     let up = match self.attr(cx, step, "up")? {
@@ -557,9 +565,76 @@ enum Item {
     Object(Rc<Object>),
 }
 
-/// Per-file context: the position of a node.
+/// Per-file context: the position of a node, and whether the file is older than 2.0 (its
+/// properties upgraded as Mitsuba 3's parser upgrades them: `camelCase` names become
+/// `snake_case`, a `diffuse` BSDF's `diffuse_reflectance` its `reflectance`, `uoffset`,
+/// `voffset`, `uscale` and `vscale` a `to_uv` transform, and `<lookAt>` is `<lookat>`).
 struct Cx<'a> {
     at: &'a dyn Fn(roxmltree::Node) -> Pos,
+    upgrade: bool,
+}
+
+/// Mitsuba's `camel_to_underscore_case`: `intIOR` is `int_ior`, `sampleCount` `sample_count`.
+fn snake_case(name: &str) -> String {
+    let c: Vec<char> = name.chars().collect();
+    let mut out = String::new();
+    let mut i = 0;
+    while i < c.len() {
+        if i > 0 && c[i - 1].is_lowercase() && c[i].is_uppercase() {
+            out.push('_');
+            out.extend(c[i].to_lowercase());
+            while i + 1 < c.len() && c[i + 1].is_uppercase() {
+                i += 1;
+                out.extend(c[i].to_lowercase());
+            }
+        } else {
+            out.push(c[i]);
+        }
+        i += 1;
+    }
+    out
+}
+
+/// A 0.x object's properties upgraded (see [`Cx`]).
+fn upgrade(object: &mut Object) {
+    if object.kind == "diffuse"
+        && let Some(p) = object.props.remove("diffuse_reflectance")
+    {
+        object.props.insert("reflectance".into(), p);
+    }
+    let mut offset = DVec3::ZERO;
+    let mut scale = DVec3::ONE;
+    let mut pos = None;
+    for (name, axis, is_scale) in [
+        ("uoffset", 0, false),
+        ("voffset", 1, false),
+        ("uscale", 0, true),
+        ("vscale", 1, true),
+    ] {
+        if let Some(p) = object.props.remove(name) {
+            let v = match p.value {
+                Value::Float(x) => x,
+                Value::Integer(i) => i as f64,
+                _ => continue,
+            };
+            if is_scale {
+                scale[axis] = v;
+            } else {
+                offset[axis] = v;
+            }
+            pos = Some(p.pos);
+        }
+    }
+    if let Some(pos) = pos {
+        let m = DMat4::from_scale(scale) * DMat4::from_translation(offset);
+        object.props.insert(
+            "to_uv".into(),
+            Property {
+                value: Value::Transform(m),
+                pos,
+            },
+        );
+    }
 }
 
 /// Mitsuba's `look_at`: camera space to world, its `x` axis `up x dir` (the image's left),
