@@ -13,6 +13,10 @@ pub struct ImportArgs {
     /// The rtis scene file to write (RON); printed when absent.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Skip what rtis cannot render (plugins, properties), with a warning for each, instead
+    /// of stopping at the first.
+    #[arg(long)]
+    pub lenient: bool,
 }
 
 /// Convert, check that the result loads, and write it (whole, or not at all).
@@ -21,7 +25,7 @@ pub fn run(args: ImportArgs) -> Result<(), CliError> {
         Some(o) => o.parent().map(PathBuf::from).unwrap_or_default(),
         None => args.scene.parent().map(PathBuf::from).unwrap_or_default(),
     };
-    let converted = rtis::import::import(&args.scene, &to)?;
+    let converted = rtis::import::import_with(&args.scene, &to, args.lenient)?;
     for w in &converted.warnings {
         eprintln!("warning: {w}");
     }

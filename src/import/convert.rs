@@ -196,15 +196,24 @@ impl<'a> Props<'a> {
     fn done(self) -> Result<(), SceneError> {
         for (name, p) in &self.object.props {
             if !self.read.contains(name.as_str()) {
-                return Err(p.pos.error(format!(
+                let e = p.pos.error(format!(
                     "`{name}` of `<{} type=\"{}\">` is not supported by rtis's import \
                      (docs/import.md lists what is)",
                     self.object.tag, self.object.kind
-                )));
+                ));
+                match &self.paths.skipped {
+                    Some(skipped) => skipped.borrow_mut().push(format!("skipped: {}", head(&e))),
+                    None => return Err(e),
+                }
             }
         }
         Ok(())
     }
+}
+
+/// The first line of an error: `file:line:col: message`.
+fn head(e: &SceneError) -> String {
+    e.to_string().lines().next().unwrap_or_default().to_string()
 }
 
 /// Refuse `object` as a plugin rtis does not render.
@@ -555,6 +564,8 @@ struct Out {
 struct Paths {
     from: std::path::PathBuf,
     to: std::path::PathBuf,
+    /// Under `--lenient`, what was skipped (shared by every clone); `None` when strict.
+    skipped: Option<Rc<std::cell::RefCell<Vec<String>>>>,
 }
 
 impl Paths {
@@ -571,7 +582,17 @@ impl Paths {
 
 /// The scene `doc` as rtis text, its files named relative to `to` (the folder the text will be
 /// read from).
-pub fn convert(doc: &Document, source: &str, to: &Path) -> Result<Converted, SceneError> {
+///
+/// With `lenient`, a top-level object that cannot be converted is skipped (a declared BSDF
+/// becomes Mitsuba's default, a 0.5 diffuse, so that the shapes that name it stay), and so is a
+/// property rtis does not read, each with a warning; otherwise the first is an error.
+pub fn convert(
+    doc: &Document,
+    source: &str,
+    to: &Path,
+    lenient: bool,
+) -> Result<Converted, SceneError> {
+    let skipped = lenient.then(|| Rc::new(std::cell::RefCell::new(Vec::new())));
     let mut out = Out {
         materials: Vec::new(),
         entities: Vec::new(),
@@ -579,7 +600,19 @@ pub fn convert(doc: &Document, source: &str, to: &Path) -> Result<Converted, Sce
         paths: Paths {
             from: doc.dir.clone(),
             to: to.to_path_buf(),
+            skipped: skipped.clone(),
         },
+    };
+    // Under `lenient`, an object's error becomes a warning (`Ok(false)`).
+    let tolerate = |r: Result<(), SceneError>| -> Result<bool, SceneError> {
+        match (r, &skipped) {
+            (Ok(()), _) => Ok(true),
+            (Err(e), Some(s)) => {
+                s.borrow_mut().push(format!("skipped: {}", head(&e)));
+                Ok(false)
+            }
+            (Err(e), None) => Err(e),
+        }
     };
     let mut film = String::from("(width: 768, height: 576, spp: 4, filter: Gaussian(stddev: 0.5))");
     let mut camera = None;
@@ -595,17 +628,23 @@ pub fn convert(doc: &Document, source: &str, to: &Path) -> Result<Converted, Sce
                          Mitsuba too; remove the others)",
                     ));
                 }
-                let (f, c) = sensor(o, &out.paths)?;
-                film = f;
-                camera = Some(c);
+                let mut got = None;
+                tolerate(sensor(o, &out.paths).map(|fc| got = Some(fc)))?;
+                if let Some((f, c)) = got {
+                    film = f;
+                    camera = Some(c);
+                }
             }
-            "integrator" => shader = integrator(o, &out.paths)?,
+            "integrator" => {
+                tolerate(integrator(o, &out.paths).map(|i| shader = i))?;
+            }
             "bsdf" => {
                 let id = o.id.clone().ok_or_else(|| {
                     o.pos
                         .error("a top-level `<bsdf>` needs an `id` for shapes to refer to")
                 })?;
-                let m = material(o, &out.paths)?;
+                let mut m = "Phong(kd: (0.5, 0.5, 0.5), ks: (0, 0, 0))".to_string();
+                tolerate(material(o, &out.paths).map(|t| m = t))?;
                 out.materials.push(format!("        {}: {m},", string(&id)));
             }
             "texture" => {
@@ -614,17 +653,23 @@ pub fn convert(doc: &Document, source: &str, to: &Path) -> Result<Converted, Sce
                     return Err(o.pos.error("a top-level `<texture>` needs an `id`"));
                 }
             }
-            "shape" => shape(o, &mut out)?,
+            "shape" => {
+                let r = shape(o, &mut out);
+                tolerate(r)?;
+            }
             "emitter" => {
-                let light = emitter(o, &out)?;
-                out.entities.push(format!("        (light: {light}),"));
+                let mut light = None;
+                tolerate(emitter(o, &out).map(|l| light = Some(l)))?;
+                if let Some(light) = light {
+                    out.entities.push(format!("        (light: {light}),"));
+                }
             }
             _ => {
-                return Err(o.pos.error(format!(
+                tolerate(Err(o.pos.error(format!(
                     "`<{}>` at the top level: rtis imports sensors, integrators, shapes, \
                      BSDFs, textures and emitters",
                     o.tag
-                )));
+                ))))?;
             }
         }
     }
@@ -657,10 +702,11 @@ pub fn convert(doc: &Document, source: &str, to: &Path) -> Result<Converted, Sce
     }
     let _ = writeln!(text, "    ],");
     let _ = writeln!(text, ")");
-    Ok(Converted {
-        text,
-        warnings: out.warnings,
-    })
+    let mut warnings = out.warnings;
+    if let Some(s) = skipped {
+        warnings.extend(s.borrow().iter().cloned());
+    }
+    Ok(Converted { text, warnings })
 }
 
 /// A sensor: the film's text and the camera's.

@@ -15,8 +15,18 @@ use std::path::Path;
 /// The rtis scene text of the Mitsuba scene at `path`, its files named relative to the folder
 /// `to` (where the text will be read from), and the conversion's warnings.
 pub fn import(path: &Path, to: &Path) -> Result<convert::Converted, SceneError> {
+    import_with(path, to, false)
+}
+
+/// [`import`]; with `lenient`, what cannot be converted is skipped with a warning for each
+/// ([`convert::convert`]).
+pub fn import_with(
+    path: &Path,
+    to: &Path,
+    lenient: bool,
+) -> Result<convert::Converted, SceneError> {
     let doc = xml::read(path)?;
-    convert::convert(&doc, &path.display().to_string(), to)
+    convert::convert(&doc, &path.display().to_string(), to, lenient)
 }
 
 /// True if `path` names a Mitsuba scene (`.xml`).

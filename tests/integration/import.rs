@@ -480,3 +480,38 @@ fn version_0_6_is_upgraded() {
     assert!(a.contains("uv_transform: (scale: (4.0, 1.0)"), "{a}");
     assert_eq!(body(a), body(b));
 }
+
+/// `--lenient` skips what rtis cannot render, with a warning naming each place: an unknown
+/// shape, an unknown property, a BSDF rtis lacks (declared: its shapes keep Mitsuba's default
+/// diffuse); strict import stops at the first.
+#[test]
+fn lenient_import_skips_with_warnings() {
+    let xml = scene(
+        r#"<bsdf type="hair" id="h"/>
+           <shape type="teapot"/>
+           <shape type="sphere"><float name="wobble" value="1"/><ref id="h"/></shape>"#,
+    );
+    let d = dir("lenient");
+    let path = d.join("lenient.xml");
+    std::fs::write(&path, &xml).unwrap();
+    assert!(rtis::import::import(&path, &d).is_err());
+    let c = rtis::import::import_with(&path, &d, true).unwrap();
+    let w = c.warnings.join("\n");
+    for want in [
+        "lenient.xml:2:",
+        "hair",
+        "lenient.xml:3:",
+        "teapot",
+        "lenient.xml:4:",
+        "wobble",
+    ] {
+        assert!(w.contains(want), "{want} not in\n{w}");
+    }
+    assert!(
+        c.text.contains(r#""h": Phong(kd: (0.5, 0.5, 0.5)"#),
+        "{}",
+        c.text
+    );
+    assert!(c.text.contains(r#"material: Named("h")"#), "{}", c.text);
+    rtis::scene::load_str(&c.text, "lenient.ron", Some(&d)).unwrap_or_else(|e| panic!("{e}"));
+}
