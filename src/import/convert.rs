@@ -1027,11 +1027,6 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
                 String::new()
             };
             let face_normals = p.boolean("face_normals", false)?;
-            if flip {
-                return Err(o
-                    .pos
-                    .error("`flip_normals` on an `obj` is not supported yet"));
-            }
             let t = srt(&m).ok_or_else(|| {
                 o.pos.error(
                     "this `to_world` shears the mesh: rtis's transforms are a scale, a \
@@ -1043,8 +1038,9 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
             }
             // Mitsuba computes smooth normals for a mesh without them, unless face_normals.
             let normals = if face_normals { "Faces" } else { "Smooth" };
+            let flip_text = if flip { ", flip_normals: true" } else { "" };
             format!(
-                "Mesh(path: {}, normals: {normals}{index_text})",
+                "Mesh(path: {}, normals: {normals}{index_text}{flip_text})",
                 string(&paths.path(&file))
             )
         }

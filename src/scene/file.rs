@@ -1270,6 +1270,10 @@ pub enum ShapeDesc {
         /// Which mesh of a Mitsuba `.serialized` file (default 0, the first).
         #[serde(default, skip_serializing_if = "is_zero")]
         shape_index: u32,
+        /// Turn every face and normal around (default false; Mitsuba 3's `flip_normals`): an
+        /// emitting mesh then emits from its other side, and glass has its inside outside.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        flip_normals: bool,
     },
 }
 
@@ -1331,8 +1335,17 @@ impl ShapeDesc {
                 path,
                 normals,
                 shape_index,
+                flip_normals,
             } => {
                 let mut mesh = load_mesh(path, *shape_index)?;
+                if *flip_normals {
+                    for f in &mut mesh.faces {
+                        f.swap(1, 2);
+                    }
+                    for n in &mut mesh.normals {
+                        *n = -*n;
+                    }
+                }
                 match normals {
                     MeshNormals::File => {}
                     MeshNormals::Faces => mesh.normals.clear(),

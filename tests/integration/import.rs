@@ -396,8 +396,8 @@ fn import_writes_a_scene_that_reads_back() {
     }
 }
 
-/// A mesh file that is missing, or a PLY face beyond its vertices, is an error located at the
-/// converted scene's mesh path that names the file's problem.
+/// A mesh file that is missing, cut short, or whose face refers beyond its vertices, is an
+/// error located at the converted scene's mesh path that names the file's problem.
 #[test]
 fn bad_meshes_are_located() {
     let d = dir("badmesh");
@@ -406,7 +406,16 @@ fn bad_meshes_are_located() {
         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n",
     )
     .unwrap();
-    for (file, why) in [("missing.obj", "cannot read"), ("bad.ply", "vertex 7")] {
+    std::fs::write(
+        d.join("cut.ply"),
+        b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\0\0\0\0",
+    )
+    .unwrap();
+    for (file, why) in [
+        ("missing.obj", "cannot read"),
+        ("bad.ply", "vertex 7"),
+        ("cut.ply", "truncated"),
+    ] {
         let xml = d.join(format!("{file}.xml"));
         std::fs::write(
             &xml,
@@ -532,4 +541,106 @@ fn lenient_import_skips_with_warnings() {
     );
     assert!(c.text.contains(r#"material: Named("h")"#), "{}", c.text);
     rtis::scene::load_str(&c.text, "lenient.ron", Some(&d)).unwrap_or_else(|e| panic!("{e}"));
+}
+
+/// Shapes and textures field by field: a rectangle by a composed transform (scale, then
+/// rotate, then translate, Mitsuba's order), a `matrix` step, a sphere's uniform scale, a
+/// mesh's transform as rtis's scale, rotation and translation with `flip_normals` and
+/// `face_normals`, a bitmap's filter, wrap, raw and `to_uv`; and what rtis refuses in them
+/// (a sphere scaled unevenly, a sheared mesh, a mirrored `to_uv`).
+#[test]
+fn shapes_and_textures_convert_field_by_field() {
+    let text = import(
+        "shapes",
+        &scene(
+            r#"<shape type="rectangle" id="r">
+                 <transform name="to_world"><scale x="2" y="3"/><rotate z="1" angle="90"/><translate x="1"/></transform>
+               </shape>
+               <shape type="sphere" id="s">
+                 <transform name="to_world"><matrix value="2 0 0 1  0 2 0 2  0 0 2 3  0 0 0 1"/></transform>
+               </shape>
+               <shape type="obj" id="m">
+                 <string name="filename" value="m.obj"/>
+                 <boolean name="flip_normals" value="true"/>
+                 <boolean name="face_normals" value="true"/>
+                 <transform name="to_world"><scale value="2"/><rotate y="1" angle="30"/><translate z="4"/></transform>
+                 <bsdf type="diffuse">
+                   <texture type="bitmap" name="reflectance">
+                     <string name="filename" value="wood.png"/>
+                     <string name="filter_type" value="nearest"/>
+                     <string name="wrap_mode" value="mirror"/>
+                     <boolean name="raw" value="true"/>
+                     <transform name="to_uv"><scale x="2" y="4"/><translate x="0.5"/></transform>
+                   </texture>
+                 </bsdf>
+               </shape>"#,
+        ),
+    )
+    .unwrap();
+    for want in [
+        // Corner (-1, -1) scaled to (-2, -3), turned to (3, -2), moved to (4, -2).
+        r#"(name: "r", shape: Rectangle(corner: (4.0, -2.0, 0.0), u: (0.0, 4.0, 0.0), v: (-6.0, 0.0, 0.0))"#,
+        r#"(name: "s", shape: Sphere(center: (1.0, 2.0, 3.0), radius: 2.0)"#,
+        r#"(name: "m", shape: Mesh(path: "m.obj", normals: Faces, flip_normals: true), transform: (scale: (2.0, 2.0, 2.0), rotate: (0.0, 30.0, 0.0), translate: (0.0, 0.0, 4.0))"#,
+        r#"Image(path: "wood.png", filter: Nearest, wrap: Mirror, raw: true, uv_transform: (scale: (2.0, 4.0), rotate: 0.0, offset: (0.5, 0.0)))"#,
+    ] {
+        assert!(text.contains(want), "{want}\nnot in\n{text}");
+    }
+    for (body, why) in [
+        (
+            r#"<shape type="sphere"><transform name="to_world"><scale x="1" y="2"/></transform></shape>"#,
+            "rtis's spheres are round",
+        ),
+        (
+            r#"<shape type="obj"><string name="filename" value="m.obj"/><transform name="to_world"><matrix value="1 1 0 0  0 1 0 0  0 0 1 0  0 0 0 1"/></transform></shape>"#,
+            "shears the mesh",
+        ),
+        (
+            r#"<shape type="sphere"><bsdf type="diffuse"><texture type="checkerboard" name="reflectance"><transform name="to_uv"><scale x="-1"/></transform></texture></bsdf></shape>"#,
+            "shears or mirrors",
+        ),
+    ] {
+        let e = import("refused", &scene(body)).unwrap_err();
+        assert!(e.contains("refused.xml:2:") && e.contains(why), "{e}");
+    }
+}
+
+/// `flip_normals` on a mesh emitter turns the side it emits from: a one-sided square light
+/// facing up lights nothing below it until flipped.
+#[test]
+fn a_flipped_mesh_light_emits_from_its_other_side() {
+    let d = dir("flip");
+    std::fs::write(
+        d.join("quad.obj"),
+        "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 1 4 3 2\n",
+    )
+    .unwrap();
+    let lit = |flip: bool| {
+        let xml = d.join(format!("flip{flip}.xml"));
+        std::fs::write(
+            &xml,
+            scene(&format!(
+                r#"<integrator type="direct"/>
+                   <sensor type="perspective">
+                     <float name="fov" value="0.01"/>
+                     <transform name="to_world"><lookat origin="0, 0.5, 0" target="0, 0, 0" up="0, 0, 1"/></transform>
+                     <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
+                     <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film>
+                   </sensor>
+                   <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform></shape>
+                   <shape type="obj">
+                     <string name="filename" value="quad.obj"/>
+                     <boolean name="flip_normals" value="{flip}"/>
+                     <transform name="to_world"><translate y="1"/></transform>
+                     <emitter type="area"><rgb name="radiance" value="1"/></emitter>
+                   </shape>"#
+            )),
+        )
+        .unwrap();
+        let s = rtis::import::load_scene(&xml).unwrap_or_else(|e| panic!("{e}"));
+        common::mean_and_se(&common::render_scene(&s)).0
+    };
+    // The quad's faces (1, 4, 3, 2) wind to face +y: away from the floor.
+    assert_eq!(lit(false), 0.0);
+    assert!(lit(true) > 0.05, "{}", lit(true));
 }
