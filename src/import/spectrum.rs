@@ -11,8 +11,6 @@
 //!   a reflectance (not for an emitter's radiance or an index of refraction).
 
 use super::cie;
-use super::xml::{Pos, number};
-use crate::scene::SceneError;
 use glam::DVec3;
 
 /// What a spectrum describes, which decides its conversion.
@@ -43,10 +41,18 @@ fn at(table: &[f64], w: f64) -> f64 {
     table[i] * (1.0 - f) + table[i + 1] * f
 }
 
-/// The linear RGB of a `<spectrum value="...">` describing `role`.
-pub fn to_rgb(value: &str, role: Role, pos: &Pos) -> Result<DVec3, SceneError> {
+/// A finite number, or why `v` is not one.
+fn number(v: &str) -> Result<f64, String> {
+    match v.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        _ => Err(format!("`{v}` is not a finite number")),
+    }
+}
+
+/// The linear RGB of a `<spectrum value="...">` describing `role`, or why it has none.
+pub fn to_rgb(value: &str, role: Role) -> Result<DVec3, String> {
     if !value.contains(':') {
-        let v = number(value, pos)?;
+        let v = number(value)?;
         return Ok(match role {
             Role::Emitter => xyz_to_srgb(DVec3::ONE) * v,
             _ => DVec3::splat(v),
@@ -56,16 +62,15 @@ pub fn to_rgb(value: &str, role: Role, pos: &Pos) -> Result<DVec3, SceneError> {
     let mut pairs = Vec::new();
     for item in value.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (w, v) = item.split_once(':').ok_or_else(|| {
-            pos.error(format!(
-                "`{item}`: a spectrum's pairs are written `wavelength:value`"
-            ))
+            format!("`{item}`: a spectrum's pairs are written `wavelength:value`")
         })?;
-        pairs.push((number(w, pos)?, number(v, pos)?));
+        pairs.push((number(w)?, number(v)?));
     }
     if pairs.len() < 2 || pairs.windows(2).any(|p| p[1].0 <= p[0].0) {
-        return Err(pos.error(
-            "a spectrum needs two or more `wavelength:value` pairs, by increasing wavelength",
-        ));
+        return Err(
+            "a spectrum needs two or more `wavelength:value` pairs, by increasing wavelength"
+                .into(),
+        );
     }
     let (first, last) = (pairs[0].0, pairs[pairs.len() - 1].0);
     const STEPS: usize = 1000;
@@ -101,40 +106,28 @@ pub fn to_rgb(value: &str, role: Role, pos: &Pos) -> Result<DVec3, SceneError> {
 mod tests {
     use super::*;
 
-    fn pos() -> Pos {
-        Pos {
-            file: "t.xml".into(),
-            text: "".into(),
-            line: 1,
-            col: 1,
-        }
-    }
-
     /// Mitsuba 3.9.1's `spectrum_list_to_srgb` of two spectra (printed by its Python
     /// bindings): with D65 and clamping, and without.
     #[test]
     fn pairs_convert_as_mitsuba() {
         let s = "400:0.1, 500:0.5, 600:0.8, 700:0.3";
-        let bounded = to_rgb(s, Role::Bounded, &pos()).unwrap();
-        let emitter = to_rgb(s, Role::Emitter, &pos()).unwrap();
+        let bounded = to_rgb(s, Role::Bounded).unwrap();
+        let emitter = to_rgb(s, Role::Emitter).unwrap();
         for (got, want) in [
             (bounded, DVec3::new(0.752186, 0.64527, 0.271707)),
             (emitter, DVec3::new(0.883847, 0.618319, 0.236324)),
         ] {
             assert!((got - want).abs().max_element() < 2e-5, "{got} vs {want}");
         }
-        let e = to_rgb("400:1, 300:2", Role::Bounded, &pos()).unwrap_err();
-        assert!(e.to_string().contains("increasing"), "{e}");
+        let e = to_rgb("400:1, 300:2", Role::Bounded).unwrap_err();
+        assert!(e.contains("increasing"), "{e}");
     }
 
     /// A constant spectrum is grey, but on an emitter the sRGB of equal energy.
     #[test]
     fn constants() {
-        assert_eq!(
-            to_rgb("0.5", Role::Bounded, &pos()).unwrap(),
-            DVec3::splat(0.5)
-        );
-        let e = to_rgb("1", Role::Emitter, &pos()).unwrap();
+        assert_eq!(to_rgb("0.5", Role::Bounded).unwrap(), DVec3::splat(0.5));
+        let e = to_rgb("1", Role::Emitter).unwrap();
         assert!(
             (e - DVec3::new(1.20479, 0.948291, 0.908916))
                 .abs()

@@ -383,7 +383,8 @@ impl Reader {
                     (_, Some("eta" | "k" | "int_ior" | "ext_ior")) => Role::Unbounded,
                     _ => Role::Bounded,
                 };
-                named(Value::Color(to_rgb(&value(self)?, role, &pos)?))
+                let color = to_rgb(&value(self)?, role).map_err(|why| pos.error(why))?;
+                named(Value::Color(color))
             }
             "point" | "vector" => named(Value::Vector(self.vector(cx, node, 0.0)?)),
             "transform" => named(Value::Transform(self.transform(cx, node)?)),
@@ -400,16 +401,7 @@ impl Reader {
                         }
                     ))
                 })?;
-                Ok(match name {
-                    Some(n) => Item::Property(
-                        n,
-                        Property {
-                            value: Value::Object(object),
-                            pos,
-                        },
-                    ),
-                    None => Item::Object(object),
-                })
+                Ok(Item::of(name, object, pos))
             }
             "sensor" | "film" | "sampler" | "rfilter" | "integrator" | "shape" | "bsdf"
             | "emitter" | "texture" | "medium" | "phase" | "volume" => {
@@ -444,16 +436,7 @@ impl Reader {
                 if let Some(id) = id {
                     self.ids.insert(id, object.clone());
                 }
-                Ok(match name {
-                    Some(n) => Item::Property(
-                        n,
-                        Property {
-                            value: Value::Object(object),
-                            pos,
-                        },
-                    ),
-                    None => Item::Object(object),
-                })
+                Ok(Item::of(name, object, pos))
             }
             other => Err(pos.error(format!(
                 "`<{other}>` is not an element of Mitsuba's scene format (objects: sensor, film, \
@@ -563,6 +546,22 @@ impl Reader {
 enum Item {
     Property(String, Property),
     Object(Rc<Object>),
+}
+
+impl Item {
+    /// An object written at `pos`: a property if it has a `name`, else unnamed.
+    fn of(name: Option<String>, object: Rc<Object>, pos: Pos) -> Item {
+        match name {
+            Some(n) => Item::Property(
+                n,
+                Property {
+                    value: Value::Object(object),
+                    pos,
+                },
+            ),
+            None => Item::Object(object),
+        }
+    }
 }
 
 /// Per-file context: the position of a node, and whether the file is older than 2.0 (its
