@@ -121,6 +121,13 @@ impl<'a> Props<'a> {
         }
     }
 
+    /// A string naming one of a closed set, in lower case (Mitsuba's are case-insensitive).
+    fn keyword(&mut self, name: &'a str) -> Result<Option<(String, Pos)>, SceneError> {
+        Ok(self
+            .string(name)?
+            .map(|(s, pos)| (s.to_ascii_lowercase(), pos)))
+    }
+
     fn vector(&mut self, name: &'a str) -> Result<Option<DVec3>, SceneError> {
         match self.get(name) {
             None => Ok(None),
@@ -234,7 +241,7 @@ fn texture(t: &Object, paths: &Paths) -> Result<String, SceneError> {
             let (file, _) = p
                 .string("filename")?
                 .ok_or_else(|| t.pos.error("a `bitmap` needs a `filename`"))?;
-            let filter = match p.string("filter_type")? {
+            let filter = match p.keyword("filter_type")? {
                 None => "Bilinear",
                 Some((f, _)) if f == "bilinear" => "Bilinear",
                 Some((f, _)) if f == "nearest" => "Nearest",
@@ -244,7 +251,7 @@ fn texture(t: &Object, paths: &Paths) -> Result<String, SceneError> {
                     )));
                 }
             };
-            let wrap = match p.string("wrap_mode")? {
+            let wrap = match p.keyword("wrap_mode")? {
                 None => "Repeat",
                 Some((w, _)) if w == "repeat" => "Repeat",
                 Some((w, _)) if w == "mirror" => "Mirror",
@@ -315,7 +322,7 @@ fn uv_transform(p: &mut Props) -> Result<String, SceneError> {
 fn material(b: &Object, paths: &Paths) -> Result<String, SceneError> {
     let mut p = Props::new(b, paths);
     let distribution = |p: &mut Props| -> Result<&'static str, SceneError> {
-        Ok(match p.string("distribution")? {
+        Ok(match p.keyword("distribution")? {
             // Mitsuba's default is Beckmann.
             None => "Beckmann",
             Some((d, _)) if d == "beckmann" => "Beckmann",
@@ -344,7 +351,7 @@ fn material(b: &Object, paths: &Paths) -> Result<String, SceneError> {
             Some(Property {
                 value: Value::String(s),
                 pos,
-            }) => named_ior(s).ok_or_else(|| {
+            }) => named_ior(&s.to_ascii_lowercase()).ok_or_else(|| {
                 pos.error(format!("`{name}` \"{s}\" is not an index Mitsuba names"))
             }),
             Some(prop) => Err(prop.pos.error(format!("`{name}` takes a float or a name"))),
@@ -355,17 +362,36 @@ fn material(b: &Object, paths: &Paths) -> Result<String, SceneError> {
         let a = p.roughness("alpha")?;
         let (u, v) = (p.roughness("alpha_u")?, p.roughness("alpha_v")?);
         Ok(match (a, u, v) {
-            (_, Some(u), Some(v)) => format!("alpha_u: {u}, alpha_v: {v}"),
-            (Some(a), _, _) => format!("alpha: {a}"),
-            _ => "alpha: 0.1".to_string(),
+            (None, Some(u), Some(v)) => format!("alpha_u: {u}, alpha_v: {v}"),
+            (Some(a), None, None) => format!("alpha: {a}"),
+            (None, None, None) => "alpha: 0.1".to_string(),
+            (Some(_), ..) => {
+                return Err(b.pos.error("`alpha` or `alpha_u` and `alpha_v`, not both"));
+            }
+            _ => {
+                return Err(b
+                    .pos
+                    .error("`alpha_u` and `alpha_v` go together: give both"));
+            }
         })
     };
     let metal = |p: &mut Props| -> Result<String, SceneError> {
         let named = p.string("material")?;
         let (eta, k) = (p.color("eta", None, false)?, p.color("k", None, false)?);
         Ok(match (named, eta, k) {
-            (_, Some(eta), Some(k)) => format!("eta: {eta}, k: {k}"),
-            (Some((m, pos)), _, _) => {
+            (Some((_, pos)), Some(_), _) | (Some((_, pos)), _, Some(_)) => {
+                return Err(
+                    pos.error("a conductor takes a named `material` or `eta` and `k`, not both")
+                );
+            }
+            (None, Some(eta), Some(k)) => format!("eta: {eta}, k: {k}"),
+            (None, Some(_), None) | (None, None, Some(_)) => {
+                return Err(b.pos.error(
+                    "a conductor's `eta` and `k` go together here: give both (Mitsuba takes \
+                     `k` as 1 when only `eta` is given; write `<rgb name=\"k\" value=\"1\"/>`)",
+                ));
+            }
+            (Some((m, pos)), None, None) => {
                 let known = ["Au", "Ag", "Al", "Cu", "Cr", "none"];
                 if !known.contains(&m.as_str()) {
                     return Err(pos.error(format!(
@@ -376,12 +402,13 @@ fn material(b: &Object, paths: &Paths) -> Result<String, SceneError> {
                 format!("material: {}", string(&m))
             }
             // Mitsuba's default conductor is "none", a perfect mirror.
-            _ => "material: \"none\"".to_string(),
+            (None, None, None) => "material: \"none\"".to_string(),
         })
     };
     let text = match b.kind.as_str() {
         "twosided" => {
             // rtis's materials are all two-sided.
+            p.done()?;
             let inner = single_child(b, "bsdf")?;
             return material(&inner, paths);
         }
@@ -494,9 +521,33 @@ fn material(b: &Object, paths: &Paths) -> Result<String, SceneError> {
             ));
         }
     };
-    // An `id` is not a property; a nested BSDF (twosided's, normalmap's) is read above.
+    // An `id` is not a property; a nested BSDF (normalmap's) is read above, no other.
     p.done()?;
+    children(
+        b,
+        if b.kind == "normalmap" {
+            &["bsdf"]
+        } else {
+            &[]
+        },
+    )?;
     Ok(text)
+}
+
+/// Refuse a nested object of `o` that is not one of the `allowed` tags (it would be dropped).
+fn children(o: &Object, allowed: &[&str]) -> Result<(), SceneError> {
+    match o
+        .children
+        .iter()
+        .find(|c| !allowed.contains(&c.tag.as_str()))
+    {
+        Some(c) => Err(c.pos.error(format!(
+            "`<{} type=\"{}\">` inside `<{} type=\"{}\">` without a name: rtis does not \
+             read it there",
+            c.tag, c.kind, o.tag, o.kind
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// The one nested object of `parent` with tag `tag` (a `twosided`'s BSDF).
@@ -566,6 +617,8 @@ struct Paths {
     to: std::path::PathBuf,
     /// Under `--lenient`, what was skipped (shared by every clone); `None` when strict.
     skipped: Option<Rc<std::cell::RefCell<Vec<String>>>>,
+    /// The ids of the top-level BSDFs: the materials table's names.
+    table: BTreeSet<String>,
 }
 
 impl Paths {
@@ -601,6 +654,12 @@ pub fn convert(
             from: doc.dir.clone(),
             to: to.to_path_buf(),
             skipped: skipped.clone(),
+            table: doc
+                .objects
+                .iter()
+                .filter(|o| o.tag == "bsdf")
+                .filter_map(|o| o.id.clone())
+                .collect(),
         },
     };
     // Under `lenient`, an object's error becomes a warning (`Ok(false)`).
@@ -721,7 +780,8 @@ fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
         _ => return Err(unsupported(o, "sensors: perspective, thinlens")),
     };
     let fov = p.float("fov", 0.0)?;
-    let fov_axis = p.string("fov_axis")?;
+    let focal = p.string("focal_length")?;
+    let fov_axis = p.keyword("fov_axis")?;
     let m = p.transform("to_world")?;
     for near in ["near_clip", "far_clip"] {
         p.float(near, 0.0)?;
@@ -729,7 +789,12 @@ fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
     // The film and the sampler.
     let (mut width, mut height, mut filter) = (768i64, 576i64, "Gaussian(stddev: 0.5)".to_string());
     let mut spp = 4i64;
-    for child in &o.children {
+    for (k, child) in o.children.iter().enumerate() {
+        if o.children[..k].iter().any(|c| c.tag == child.tag) {
+            return Err(child
+                .pos
+                .error(format!("a second `<{}>` in this sensor", child.tag)));
+        }
         match child.tag.as_str() {
             "film" => {
                 if child.kind != "hdrfilm" {
@@ -771,17 +836,48 @@ fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
             }
         }
     }
-    if width < 1 || height < 1 || spp < 1 {
+    if !(1..=32768).contains(&width) || !(1..=32768).contains(&height) {
+        return Err(o.pos.error(format!(
+            "a film of {width}x{height}: rtis takes 1 to 32768 pixels a side"
+        )));
+    }
+    if !(1..=1 << 20).contains(&spp) {
         return Err(o
             .pos
-            .error("the film's width and height and the sample count must be positive"));
+            .error(format!("`sample_count` {spp}: rtis takes 1 to 1048576")));
     }
     // The field of view, made vertical as rtis's.
     let aspect = width as f64 / height as f64;
-    let fov = if fov > 0.0 { fov } else { 39.3077 };
+    // Without `fov`, Mitsuba's `focal_length` (default 50mm) on a 36 x 24 mm film gives the
+    // diagonal field of view (its `parse_fov`).
+    let (fov, axis) = match (fov, focal) {
+        (f, _) if f > 0.0 && f < 180.0 => (f, fov_axis.map_or("x".to_string(), |(a, _)| a)),
+        (f, _) if f != 0.0 => {
+            return Err(o
+                .pos
+                .error(format!("`fov` {f}: a field of view is in (0, 180) degrees")));
+        }
+        (_, focal) => {
+            let mm = match &focal {
+                None => 50.0,
+                Some((v, pos)) => v
+                    .trim()
+                    .strip_suffix("mm")
+                    .and_then(|n| n.trim().parse::<f64>().ok())
+                    .filter(|f| *f > 0.0 && f.is_finite())
+                    .ok_or_else(|| {
+                        pos.error(format!("`focal_length` \"{v}\" is not such as \"50mm\""))
+                    })?,
+            };
+            let diagonal = 2.0
+                * ((36f64 * 36.0 + 24.0 * 24.0).sqrt() / (2.0 * mm))
+                    .atan()
+                    .to_degrees();
+            (diagonal, "diagonal".to_string())
+        }
+    };
     let half = (fov.to_radians() / 2.0).tan();
-    let axis = fov_axis.map_or("x".to_string(), |(a, _)| a);
-    let vertical = match axis.as_str() {
+    let vertical = match axis.to_ascii_lowercase().as_str() {
         "x" => half / aspect,
         "y" => half,
         "diagonal" => half / (1.0 + aspect * aspect).sqrt(),
@@ -836,11 +932,22 @@ fn integrator(o: &Object, paths: &Paths) -> Result<String, SceneError> {
             if p.boolean("hide_emitters", false)? {
                 return Err(o.pos.error("`hide_emitters` is not supported by rtis"));
             }
+            if !(1..=1024).contains(&rr_depth) {
+                return Err(o
+                    .pos
+                    .error(format!("`rr_depth` {rr_depth}: rtis takes 1 to 1024")));
+            }
             // Mitsuba counts the camera ray's hit as depth 1: rtis's depth counts bounces.
             match max_depth {
-                -1 => format!("Path(rr_depth: {})", rr_depth.max(1)),
-                d if d >= 1 => format!("Path(max_depth: {}, rr_depth: {})", d - 1, rr_depth.max(1)),
-                _ => return Err(o.pos.error("`max_depth` is -1 (no limit) or at least 1")),
+                -1 => format!("Path(rr_depth: {rr_depth})"),
+                d if (1..=1025).contains(&d) => {
+                    format!("Path(max_depth: {}, rr_depth: {rr_depth})", d - 1)
+                }
+                _ => {
+                    return Err(o.pos.error(
+                        "`max_depth` is -1 (no limit) or from 1 to 1025 (rtis's 1024 bounces)",
+                    ));
+                }
             }
         }
         "direct" => {
@@ -857,6 +964,7 @@ fn integrator(o: &Object, paths: &Paths) -> Result<String, SceneError> {
         _ => return Err(unsupported(o, "integrators: path, direct")),
     };
     p.done()?;
+    children(o, &[])?;
     Ok(text)
 }
 
@@ -867,8 +975,9 @@ fn shape_material(o: &Object, paths: &Paths) -> Result<String, SceneError> {
     match (bsdfs.next(), bsdfs.next()) {
         (None, _) => Ok("Phong(kd: (0.5, 0.5, 0.5), ks: (0, 0, 0))".to_string()),
         (Some(b), None) => match &b.id {
-            Some(id) => Ok(format!("Named({})", string(id))),
-            None => material(b, paths),
+            // A declared (top-level) BSDF is an entry of the materials table.
+            Some(id) if paths.table.contains(id) => Ok(format!("Named({})", string(id))),
+            _ => material(b, paths),
         },
         (Some(_), Some(second)) => Err(second.pos.error("a shape takes one `<bsdf>`")),
     }
@@ -908,6 +1017,15 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
                     .pos
                     .error("`flip_normals` on a sphere: rtis's spheres face outward"));
             }
+            // A rotation turns Mitsuba's sphere's texture coordinates and frame, not rtis's.
+            if (axes[0] / s - DVec3::X).length() > 1e-9 || (axes[1] / s - DVec3::Y).length() > 1e-9
+            {
+                out.warnings.push(format!(
+                    "{}:{}: this sphere's `to_world` turns it: Mitsuba turns its texture \
+                     coordinates with it, rtis keeps its poles on z",
+                    o.pos.file, o.pos.line
+                ));
+            }
             format!(
                 "Sphere(center: {}, radius: {})",
                 vec3(apply(&m, c)),
@@ -923,6 +1041,11 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
             // Its normal is to_world's normal transform of +z; rtis's is u x v.
             let n = (m.inverse().transpose()).transform_vector3(DVec3::Z);
             let mut c = corner;
+            if u.cross(v).length_squared() == 0.0 || !u.cross(v).is_finite() {
+                return Err(o
+                    .pos
+                    .error("this rectangle's `to_world` flattens it to a line or a point"));
+            }
             if (u.cross(v).dot(n) < 0.0) != flip {
                 // The other side: start from the other corner along v's way back.
                 c = corner + v;
@@ -1007,10 +1130,14 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
             )
         }
         "obj" | "ply" | "serialized" => {
-            let (file, _) = p.string("filename")?.ok_or_else(|| {
+            let (file, at) = p.string("filename")?.ok_or_else(|| {
                 o.pos
                     .error(format!("a `{}` shape needs a `filename`", o.kind))
             })?;
+            // A missing file is named here, at its place in the XML.
+            if let Err(e) = std::fs::metadata(paths.from.join(&file)) {
+                return Err(at.error(format!("cannot read mesh file {file}: {e}")));
+            }
             let index = if o.kind == "serialized" {
                 p.integer("shape_index", 0)?
             } else {
@@ -1053,6 +1180,16 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
     };
     p.done()?;
     let material = shape_material(o, &out.paths)?;
+    let textured = ["Image(", "Checkerboard(", "NormalMap("]
+        .iter()
+        .any(|t| material.contains(t));
+    if textured && (o.kind == "cube" || o.kind == "disk") {
+        out.warnings.push(format!(
+            "{}:{}: a textured `{}`: rtis's mesh of it has no texture coordinates of its own \
+             (each face is mapped by its barycentric ones), unlike Mitsuba's",
+            o.pos.file, o.pos.line, o.kind
+        ));
+    }
     let mut emitters = o.children.iter().filter(|c| c.tag == "emitter");
     let emitter = match (emitters.next(), emitters.next()) {
         (None, _) => String::new(),
@@ -1066,6 +1203,7 @@ fn shape(o: &Object, out: &mut Out) -> Result<(), SceneError> {
             let mut ep = Props::new(e, &out.paths);
             let radiance = ep.color("radiance", Some(DVec3::ONE), true)?;
             ep.done()?;
+            children(e, &[])?;
             format!(", emitter: (radiance: {})", radiance.unwrap_or_default())
         }
         (Some(_), Some(second)) => return Err(second.pos.error("a shape takes one emitter")),
@@ -1136,8 +1274,17 @@ fn emitter(o: &Object, out: &Out) -> Result<String, SceneError> {
     let mut p = Props::new(o, paths);
     let text = match o.kind.as_str() {
         "point" => {
+            let has_frame = o.props.contains_key("to_world");
             let m = p.transform("to_world")?;
-            let position = p.vector("position")?.unwrap_or(apply(&m, DVec3::ZERO));
+            let position = match p.vector("position")? {
+                Some(_) if has_frame => {
+                    return Err(o
+                        .pos
+                        .error("a point light takes `position` or `to_world`, not both"));
+                }
+                Some(q) => q,
+                None => apply(&m, DVec3::ZERO),
+            };
             let i = p.color("intensity", Some(DVec3::ONE), false)?;
             format!(
                 "Point(position: {}, intensity: {})",
@@ -1211,5 +1358,6 @@ fn emitter(o: &Object, out: &Out) -> Result<String, SceneError> {
         }
     };
     p.done()?;
+    children(o, &[])?;
     Ok(text)
 }

@@ -108,13 +108,16 @@ pub struct Document {
 
 /// Most nested includes followed before giving up.
 const MAX_INCLUDE_DEPTH: usize = 32;
+/// Most nested elements read (objects within objects; a scene needs a handful).
+const MAX_NESTING: usize = 64;
 
 /// The reading state: defaults, declared objects by id, and the chain of files being read.
 struct Reader {
     defaults: BTreeMap<String, String>,
     ids: BTreeMap<String, Rc<Object>>,
     chain: Vec<PathBuf>,
-    dir: PathBuf,
+    /// The folder of the file being read (includes are relative to it).
+    here: PathBuf,
 }
 
 /// Read the Mitsuba scene at `path`.
@@ -127,7 +130,7 @@ pub fn read(path: &Path) -> Result<Document, SceneError> {
         defaults: BTreeMap::new(),
         ids: BTreeMap::new(),
         chain: path.canonicalize().into_iter().collect(),
-        dir: dir.clone(),
+        here: dir.clone(),
     };
     let mut objects = Vec::new();
     let version = reader.file(&name, &text, &mut objects, true)?;
@@ -144,7 +147,7 @@ pub fn read_str(text: &str, name: &str, dir: &Path) -> Result<Document, SceneErr
         defaults: BTreeMap::new(),
         ids: BTreeMap::new(),
         chain: Vec::new(),
-        dir: dir.to_path_buf(),
+        here: dir.to_path_buf(),
     };
     let mut objects = Vec::new();
     let version = reader.file(name, text, &mut objects, true)?;
@@ -239,7 +242,8 @@ impl Reader {
                     let f = self.attr(&cx, node, "filename")?.ok_or_else(|| {
                         at(node).error("`<include>` needs a `filename` attribute")
                     })?;
-                    let path = self.dir.join(&f);
+                    // Relative to the including file's folder, as Mitsuba 3 resolves it.
+                    let path = self.here.join(&f);
                     let canon = path.canonicalize().map_err(|e| {
                         at(node).error(format!("cannot read included file {f}: {e}"))
                     })?;
@@ -260,7 +264,13 @@ impl Reader {
                         at(node).error(format!("cannot read included file {f}: {e}"))
                     })?;
                     self.chain.push(canon);
-                    self.file(&path.display().to_string(), &inner, objects, false)?;
+                    let outer = std::mem::replace(
+                        &mut self.here,
+                        path.parent().map(Path::to_path_buf).unwrap_or_default(),
+                    );
+                    let read = self.file(&path.display().to_string(), &inner, objects, false);
+                    self.here = outer;
+                    read?;
                     self.chain.pop();
                 }
                 _ => {
@@ -333,6 +343,12 @@ impl Reader {
     fn object(&mut self, cx: &Cx, node: roxmltree::Node, parent: &str) -> Result<Item, SceneError> {
         let tag = node.tag_name().name();
         let pos = (cx.at)(node);
+        // Elements nested deeper than any scene needs (and than the stack allows) are refused.
+        if node.ancestors().count() > MAX_NESTING {
+            return Err(pos.error(format!(
+                "`<{tag}>` is nested more than {MAX_NESTING} elements deep"
+            )));
+        }
         let name = self
             .attr(cx, node, "name")?
             .map(|n| if cx.upgrade { snake_case(&n) } else { n });
@@ -361,7 +377,7 @@ impl Reader {
             }
             "boolean" => {
                 let v = value(self)?;
-                let b = match v.trim() {
+                let b = match v.trim().to_ascii_lowercase().as_str() {
                     "true" => true,
                     "false" => false,
                     _ => return Err(pos.error(format!("`value=\"{v}\"` is not `true` or `false`"))),
@@ -515,9 +531,16 @@ impl Reader {
                 "lookat" | "lookAt" => {
                     let o = triple(&self.need(cx, step, "origin")?, &pos)?;
                     let t = triple(&self.need(cx, step, "target")?, &pos)?;
+                    // Without `up` (or a zero one), Mitsuba's `coordinate_system` of the view:
+                    // Duff et al.'s first tangent.
                     let up = match self.attr(cx, step, "up")? {
                         Some(u) => triple(&u, &pos)?,
-                        None => DVec3::Y,
+                        None => DVec3::ZERO,
+                    };
+                    let up = if up == DVec3::ZERO {
+                        (t - o).normalize_or(DVec3::Z).any_orthonormal_pair().0
+                    } else {
+                        up
                     };
                     look_at(o, t, up).ok_or_else(|| {
                         pos.error(

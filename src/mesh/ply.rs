@@ -234,6 +234,10 @@ pub fn parse(bytes: &[u8]) -> Result<MeshData, String> {
         if is_face && faces.is_none() {
             return Err("the `face` element has no `vertex_indices` list".into());
         }
+        // An element of no properties holds no data, however many it counts.
+        if e.properties.is_empty() {
+            continue;
+        }
         let mut values = vec![0.0f64; e.properties.len()];
         let mut list: Vec<f64> = Vec::new();
         for _ in 0..e.count {

@@ -13,7 +13,6 @@ const FORMAT: u16 = 0x041C;
 const HAS_NORMALS: u32 = 0x0001;
 const HAS_TEXCOORDS: u32 = 0x0002;
 const HAS_COLORS: u32 = 0x0008;
-const FACE_NORMALS: u32 = 0x0010;
 const DOUBLE_PRECISION: u32 = 0x2000;
 /// Most vertices or triangles a mesh may declare (a larger count is a corrupt file).
 const MAX_COUNT: u64 = 1 << 31;
@@ -68,7 +67,9 @@ pub fn parse(bytes: &[u8], index: u32) -> Result<MeshData, String> {
                 .ok_or("the file's dictionary is cut short")?;
             u32::from_le_bytes(bytes[at..at + 4].try_into().map_err(|_| "truncated")?) as usize
         };
-        if offset + 4 > bytes.len() || u16_at(bytes, offset)? != FORMAT {
+        if offset.checked_add(4).is_none_or(|end| end > bytes.len())
+            || u16_at(bytes, offset)? != FORMAT
+        {
             return Err(format!(
                 "mesh {index}'s offset {offset} does not start a mesh"
             ));
@@ -76,10 +77,16 @@ pub fn parse(bytes: &[u8], index: u32) -> Result<MeshData, String> {
         offset
     };
     let mut z = flate2::read::ZlibDecoder::new(&bytes[start + 4..]);
+    // Read as the data comes: a header's counts never decide an allocation on their own.
     let mut read = |n: usize| -> Result<Vec<u8>, String> {
-        let mut buf = vec![0u8; n];
-        z.read_exact(&mut buf)
-            .map_err(|e| format!("the compressed mesh data is cut short or corrupt ({e})"))?;
+        let mut buf = Vec::new();
+        (&mut z)
+            .take(n as u64)
+            .read_to_end(&mut buf)
+            .map_err(|e| format!("the compressed mesh data is corrupt ({e})"))?;
+        if buf.len() < n {
+            return Err("the compressed mesh data is cut short (truncated)".into());
+        }
         Ok(buf)
     };
     let u32_of = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
@@ -127,16 +134,16 @@ pub fn parse(bytes: &[u8], index: u32) -> Result<MeshData, String> {
     if let Some(bad) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(format!("vertex {bad} is not finite"));
     }
+    // The file's face-normals flag is ignored, as Mitsuba 3 ignores it (a shape's
+    // `face_normals` says it).
     if flags & HAS_NORMALS != 0 {
         let n = floats(3 * nv)?;
-        if flags & FACE_NORMALS == 0 {
-            mesh.normals = n
-                .chunks_exact(3)
-                .map(|c| DVec3::new(c[0], c[1], c[2]).normalize_or_zero())
-                .collect();
-            if mesh.normals.contains(&DVec3::ZERO) {
-                mesh.normals.clear();
-            }
+        mesh.normals = n
+            .chunks_exact(3)
+            .map(|c| DVec3::new(c[0], c[1], c[2]).normalize_or_zero())
+            .collect();
+        if mesh.normals.contains(&DVec3::ZERO) {
+            mesh.normals.clear();
         }
     }
     if flags & HAS_TEXCOORDS != 0 {
@@ -234,6 +241,18 @@ mod tests {
         let e = parse(&b, 2).unwrap_err();
         assert!(e.contains("holds 2 mesh"), "{e}");
         let e = parse(&b[..40], 0).unwrap_err();
+        assert!(e.contains("cut short") || e.contains("corrupt"), "{e}");
+        // A header that declares 2^31 vertices in a few bytes is refused without allocating.
+        let mut big = Vec::new();
+        big.extend(FORMAT.to_le_bytes());
+        big.extend(3u16.to_le_bytes());
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        let mut raw = 0x1000u32.to_le_bytes().to_vec();
+        raw.extend((1u64 << 31).to_le_bytes());
+        raw.extend(1u64.to_le_bytes());
+        z.write_all(&raw).unwrap();
+        big.extend(z.finish().unwrap());
+        let e = parse(&big, 0).unwrap_err();
         assert!(e.contains("cut short"), "{e}");
     }
 }

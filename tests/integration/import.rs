@@ -550,6 +550,9 @@ fn lenient_import_skips_with_warnings() {
 /// (a sphere scaled unevenly, a sheared mesh, a mirrored `to_uv`).
 #[test]
 fn shapes_and_textures_convert_field_by_field() {
+    for d in ["shapes", "refused"] {
+        std::fs::write(dir(d).join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    }
     let text = import(
         "shapes",
         &scene(
@@ -643,4 +646,87 @@ fn a_flipped_mesh_light_emits_from_its_other_side() {
     // The quad's faces (1, 4, 3, 2) wind to face +y: away from the floor.
     assert_eq!(lit(false), 0.0);
     assert!(lit(true) > 0.05, "{}", lit(true));
+}
+
+/// What a review found: deep nesting is a located error (not a stack overflow); an inline BSDF
+/// with an id converts inline; an unnamed texture in a BSDF, a BSDF in a point light and a
+/// twosided's own property are refused, not dropped; a conductor's `eta` needs its `k`;
+/// includes resolve from the including file's folder; without `fov` the field of view is
+/// Mitsuba's 50 mm lens (46.8 degrees across the diagonal: 29.1 vertically at 4:3).
+#[test]
+fn review_cases() {
+    let deep = format!(
+        "{}{}{}",
+        "<bsdf type=\"twosided\">".repeat(100),
+        "<bsdf type=\"diffuse\"/>",
+        "</bsdf>".repeat(100)
+    );
+    let e = import(
+        "deep",
+        &scene(&format!("<shape type=\"sphere\">{deep}</shape>")),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("deep.xml:") && e.contains("nested more than"),
+        "{e}"
+    );
+    let text = import(
+        "inline",
+        &scene(r#"<shape type="sphere"><bsdf type="diffuse" id="red"><rgb name="reflectance" value="0.7, 0.1, 0.1"/></bsdf></shape>"#),
+    )
+    .unwrap();
+    assert!(
+        text.contains("material: Phong(kd: (0.7, 0.1, 0.1)"),
+        "{text}"
+    );
+    for (body, why) in [
+        (
+            r#"<shape type="sphere"><bsdf type="diffuse"><texture type="checkerboard"/></bsdf></shape>"#,
+            "without a name",
+        ),
+        (
+            r#"<emitter type="point"><bsdf type="diffuse"/></emitter>"#,
+            "without a name",
+        ),
+        (
+            r#"<shape type="sphere"><bsdf type="twosided"><rgb name="reflectance" value="1"/><bsdf type="diffuse"/></bsdf></shape>"#,
+            "`reflectance`",
+        ),
+        (
+            r#"<shape type="sphere"><bsdf type="conductor"><rgb name="eta" value="1"/></bsdf></shape>"#,
+            "go together",
+        ),
+    ] {
+        let e = import("refused2", &scene(body)).unwrap_err();
+        assert!(
+            e.contains("refused2.xml:2:") && e.contains(why),
+            "{why}: {e}"
+        );
+    }
+    let d = dir("nested-include");
+    std::fs::create_dir_all(d.join("sub")).unwrap();
+    std::fs::write(
+        d.join("top.xml"),
+        scene(r#"<include filename="sub/a.xml"/>"#),
+    )
+    .unwrap();
+    std::fs::write(d.join("sub/a.xml"), scene(r#"<include filename="b.xml"/>"#)).unwrap();
+    std::fs::write(d.join("sub/b.xml"), scene(r#"<emitter type="constant"/>"#)).unwrap();
+    let c = rtis::import::import(&d.join("top.xml"), &d).unwrap_or_else(|e| panic!("{e}"));
+    assert!(c.text.contains("Environment(radiance"), "{}", c.text);
+    let text = import(
+        "lens",
+        &scene(r#"<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="400"/><integer name="height" value="300"/></film></sensor>"#),
+    )
+    .unwrap();
+    let diag = (43.266615305567875f64 / 100.0).atan();
+    let want = 2.0
+        * (diag.tan() / (1.0f64 + (4.0f64 / 3.0).powi(2)).sqrt())
+            .atan()
+            .to_degrees();
+    assert!(
+        text.contains(&format!("fov: {}", num(want))),
+        "{want} in {text}"
+    );
+    assert!((want - 29.11).abs() < 0.01, "{want}");
 }
