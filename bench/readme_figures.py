@@ -265,7 +265,7 @@ def import_block(_runs):
         own = diff_rmse(a, b) / 2 ** 0.5
     noise = (own ** 2 + meta["noise_rmse"] ** 2) ** 0.5
     return "\n".join([
-        "| Mitsuba 3 (`mi.load_file`) | rtis (`rtis render cbox.xml`) |",
+        f"| Mitsuba 3 (`mi.load_file`) | rtis (`rtis render cbox.xml --spp {spp}`) |",
         "|---|---|",
         "| ![Mitsuba's image](docs/images/mitsuba-import-cbox.png) | ![rtis's image](docs/images/rtis-import-cbox.png) |",
         "",

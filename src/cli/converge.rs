@@ -12,7 +12,7 @@ use std::sync::atomic::Ordering;
 /// Arguments of `rtis converge`.
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
-    /// The scene file (RON); the embedded Cornell box without one.
+    /// The scene file (RON, or a Mitsuba `.xml`); the embedded Cornell box without one.
     scene: Option<PathBuf>,
     /// A reference image (linear EXR of the same size) instead of rendering one.
     #[arg(long, conflicts_with = "reference_spp")]

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 pub struct ImportArgs {
     /// The Mitsuba scene (`.xml`).
     pub scene: PathBuf,
-    /// The rtis scene file to write (RON); printed when absent.
+    /// The rtis scene file to write (RON); printed when absent (with file names absolute, or
+    /// relative to the current folder when it is the scene's).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Skip what rtis cannot render (plugins, properties), with a warning for each, instead
@@ -21,9 +22,12 @@ pub struct ImportArgs {
 
 /// Convert, check that the result loads, and write it (whole, or not at all).
 pub fn run(args: ImportArgs) -> Result<(), CliError> {
+    // The folder the text will be read from: the output's; printed, the current folder (where
+    // a redirected copy most likely lands), so that file names are absolute unless it is the
+    // scene's own folder.
     let to = match &args.output {
         Some(o) => o.parent().map(PathBuf::from).unwrap_or_default(),
-        None => args.scene.parent().map(PathBuf::from).unwrap_or_default(),
+        None => PathBuf::from("."),
     };
     let converted = rtis::import::import_with(&args.scene, &to, args.lenient)?;
     for w in &converted.warnings {

@@ -19,7 +19,7 @@ use std::time::Duration;
 /// Arguments of `rtis render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The scene file (RON). Without one, the embedded Cornell box of the course is rendered.
+    /// The scene file (RON, or a Mitsuba 3 scene `.xml`, converted). Without one, the embedded Cornell box of the course is rendered.
     scene: Option<PathBuf>,
     /// Output image: .png (8-bit) or .exr (linear float). Default: the scene's name with .png.
     #[arg(short, long)]

@@ -38,7 +38,7 @@ const SETTLE: Duration = Duration::from_millis(40);
 /// Arguments of `rtis watch`.
 #[derive(Args, Debug)]
 pub struct WatchArgs {
-    /// The scene file (RON) to render and follow.
+    /// The scene file (RON, or a Mitsuba `.xml`) to render and follow.
     scene: PathBuf,
     /// The port to serve on (0: any free port; the URL printed says which).
     #[arg(long, default_value_t = 8137)]

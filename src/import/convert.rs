@@ -624,11 +624,30 @@ struct Paths {
 impl Paths {
     /// A file name of the Mitsuba scene as the rtis file must write it.
     fn path(&self, file: &str) -> String {
-        if self.from == self.to {
+        // The same folder however it is written (`a/../b`, `.`, an empty path).
+        let same = |a: &Path, b: &Path| {
+            let dir = |p: &Path| {
+                if p.as_os_str().is_empty() {
+                    Path::new(".")
+                } else {
+                    p
+                }
+                .to_path_buf()
+            };
+            match (dir(a).canonicalize(), dir(b).canonicalize()) {
+                (Ok(a), Ok(b)) => a == b,
+                _ => a == b,
+            }
+        };
+        if same(&self.from, &self.to) {
             file.to_string()
         } else {
             let p = self.from.join(file);
-            std::path::absolute(&p).unwrap_or(p).display().to_string()
+            p.canonicalize()
+                .or_else(|_| std::path::absolute(&p))
+                .unwrap_or(p)
+                .display()
+                .to_string()
         }
     }
 }
