@@ -43,7 +43,17 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let converted = import(path, dir)?;
     let name = format!("{} (as imported)", path.display());
-    let mut scene = crate::scene::load_str(&converted.text, &name, Some(dir))?;
+    // A check only the loader makes is placed in the converted text: say how to see it.
+    let mut scene =
+        crate::scene::load_str(&converted.text, &name, Some(dir)).map_err(|mut e| {
+            e.message = crate::scene::clip_message(&format!(
+                "{} (in the rtis scene converted from {}: `rtis import {}` prints it)",
+                e.message,
+                path.display(),
+                path.display()
+            ));
+            e
+        })?;
     scene.warnings.extend(converted.warnings);
     Ok(scene)
 }

@@ -39,6 +39,11 @@ pub fn clip(s: &str, max: usize) -> String {
     format!("{start}…{end}")
 }
 
+/// A message cut to [`MAX_MESSAGE`] characters, as every error's is.
+pub fn clip_message(message: &str) -> String {
+    clip(message, MAX_MESSAGE)
+}
+
 /// The window of `line` shown for 1-based column `col`, and the caret's index in it.
 fn excerpt(line: &str, col: usize) -> (String, usize) {
     let caret = col.saturating_sub(1);

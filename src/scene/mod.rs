@@ -13,7 +13,7 @@ mod spans;
 pub mod values;
 
 pub use crate::world::{Scene, Settings};
-pub use error::{EXCERPT_RADIUS, MAX_MESSAGE, SceneError};
+pub use error::{EXCERPT_RADIUS, MAX_MESSAGE, SceneError, clip_message};
 pub use file::{
     CameraDesc, FilmDesc, LightDesc, MaterialDesc, Model, ShaderDesc, ShapeDesc, TransformDesc,
 };
