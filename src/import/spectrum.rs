@@ -41,8 +41,8 @@ fn at(table: &[f64], w: f64) -> f64 {
     table[i] * (1.0 - f) + table[i + 1] * f
 }
 
-/// A finite number, or why `v` is not one.
-fn number(v: &str) -> Result<f64, String> {
+/// A finite number, or why `v` is not one (the XML reader's numbers too).
+pub fn number(v: &str) -> Result<f64, String> {
     match v.trim().parse::<f64>() {
         Ok(x) if x.is_finite() => Ok(x),
         _ => Err(format!("`{v}` is not a finite number")),

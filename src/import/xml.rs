@@ -675,10 +675,7 @@ pub fn look_at(origin: DVec3, target: DVec3, up: DVec3) -> Option<DMat4> {
 
 /// A number, finite.
 pub fn number(v: &str, pos: &Pos) -> Result<f64, SceneError> {
-    match v.trim().parse::<f64>() {
-        Ok(x) if x.is_finite() => Ok(x),
-        _ => Err(pos.error(format!("`{v}` is not a finite number"))),
-    }
+    super::spectrum::number(v).map_err(|why| pos.error(why))
 }
 
 /// Numbers separated by commas and/or spaces.

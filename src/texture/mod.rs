@@ -240,10 +240,17 @@ impl MaterialTextures {
                     y.clamp(MIN_ALPHA, 1.0)
                 })
             };
-            if let Some(a) = lum(&self.alpha_u) {
+            let u = lum(&self.alpha_u);
+            // An isotropic `alpha` is one texture on both axes: looked up once.
+            let v = if self.alpha_v == self.alpha_u {
+                u
+            } else {
+                lum(&self.alpha_v)
+            };
+            if let Some(a) = u {
                 m.alpha_x = a;
             }
-            if let Some(a) = lum(&self.alpha_v) {
+            if let Some(a) = v {
                 m.alpha_y = a;
             }
         };
