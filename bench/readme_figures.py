@@ -33,6 +33,9 @@ that this script rewrites from a run of `rtis render --stats`, `rtis bench --jso
     sky        docs/images/outdoor.png: scenes/outdoor.ron (an environment map with a sun) at its
                640 px and 64 spp, and `rtis converge scenes/outdoor.ron`: the sky sampled by
                importance, by the materials (cosine on the ground) and by both with MIS
+    inspect    the converge report's time and efficiency maps of the course's box (Path at 16 spp,
+               docs/images/inspect-*.png), the price of `render --aov --parts --fireflies`, and a
+               firefly found and replayed (`rtis replay`)
     build      bench/build_times.py: a newcomer's two first builds (render, then tests) of this
                commit against BUILD_BASE (one test binary per file), each from nothing (about
                12 minutes; run it with nothing else compiling)
@@ -60,7 +63,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 README = os.path.join(ROOT, "README.md")
 RTIS = os.path.join(ROOT, "target", "release", "rtis")
 BLOCKS = ["build", "hero", "cornell", "commits", "effects", "meshes", "converge", "area", "materials", "lens", "sky", "textures", "import",
-          "obvhs", "embree", "mitsuba"]
+          "inspect", "obvhs", "embree", "mitsuba"]
 # The commit the `commits` block compares with: the last before the Global shader's waves.
 COMPARE_BASE = "e3269bf"
 # The commit the `build` block compares with: the last with one test binary per file.
@@ -274,6 +277,80 @@ def import_block(_runs):
         f"(rtis {own:.4f}, Mitsuba {meta['noise_rmse']:.4f}).*",
         "",
         stamp("`rtis render` and `rtis diff` against the stored Mitsuba image"),
+    ])
+
+
+def report_rungs(html):
+    """The rungs' data embedded in a converge report.html."""
+    m = re.search(r'<script id="data" type="application/json">(.*?)</script>', html, re.S)
+    return json.loads(m.group(1).replace("<\\/", "</"))
+
+
+def save_data_uri(uri, path):
+    import base64
+    with open(os.path.join(ROOT, path), "wb") as f:
+        f.write(base64.b64decode(uri.split(",", 1)[1]))
+
+
+def inspect(_runs):
+    """Where the time and the error go in the course's box: the converge report's time and
+    efficiency maps of the Path 16-spp rung (docs/images/inspect-*.png), the price of an
+    inspected render (`--aov --parts --fireflies`) against a plain one, and the largest
+    firefly of a Path render found and replayed."""
+    scene, width = "scenes/cornell.ron", 180
+    with tempfile.TemporaryDirectory() as d:
+        run(["converge", scene, "--out", d, "--width", str(width), "--runs", "1", "--seeds", "2"],
+            stderr=subprocess.DEVNULL)
+        with open(os.path.join(d, "report.html")) as f:
+            rungs = report_rungs(f.read())
+        rung = next(r for r in rungs if r["family"] == "Path" and r["label"] == "spp=16")
+        save_data_uri(rung["image"], "docs/images/inspect-image.png")
+        save_data_uri(rung["timemap"], "docs/images/inspect-time.png")
+        save_data_uri(rung["productmap"], "docs/images/inspect-efficiency.png")
+        # The price of inspecting: the same Path render, plain and inspected, best of three.
+        box = "scenes/cornell-physical.ron"
+        args = [box, "--width", str(width), "--spp", "16"]
+        def seconds(extra):
+            best = None
+            for _ in range(3):
+                stats = os.path.join(d, "stats.json")
+                run(["render", *args, "-o", os.path.join(d, "box.exr"), "--stats", stats, *extra])
+                with open(stats) as f:
+                    t = json.load(f)["seconds"]
+                best = t if best is None else min(best, t)
+            return best
+        plain = seconds([])
+        inspected = seconds(["--aov", os.path.join(d, "aov.exr"), "--parts", os.path.join(d, "parts.exr"),
+                             "--fireflies", "5"])
+        with open(os.path.join(d, "box.fireflies.json")) as f:
+            top = json.load(f)["fireflies"][0]
+        x, y = top["pixel"]
+        replay = run(["replay", *args, "--pixel", f"{x},{y}", "--sample", str(top["sample"])])
+    lines = replay.strip().splitlines()
+    if len(lines) > 16:
+        lines = lines[:8] + ["..."] + lines[-7:]
+    return "\n".join([
+        "| the Path 16-spp rung | time per pixel | error &times; time |",
+        "|---|---|---|",
+        "| ![the rung](docs/images/inspect-image.png) | ![time per pixel](docs/images/inspect-time.png) "
+        "| ![error times time](docs/images/inspect-efficiency.png) |",
+        "",
+        f"*`rtis converge {scene}` at {width} px, the report's maps of its Path rung at 16 spp "
+        f"(`Path`, Course model): time per pixel on the rung's own scale, and squared error times time "
+        f"(the inverse efficiency). {rung['fireflies'][0]['path']} made its largest firefly.*",
+        "",
+        f"An inspected render (`--aov --parts --fireflies 5`) of `{box}` at {width} px and 16 spp took "
+        f"{inspected:.2f} s against {plain:.2f} s plain ({inspected / plain:.2f}x): the price of the "
+        f"counters, the clock, the split by technique and bounce and the first-hit layers. Its largest "
+        f"firefly, pixel {x},{y} sample {top['sample']} (luminance {top['luminance']:.3g}, "
+        f"{top['excess']:.3g} above its pixel), replayed:",
+        "",
+        "```",
+        f"$ rtis replay {' '.join(args)} --pixel {x},{y} --sample {top['sample']}",
+        *lines,
+        "```",
+        "",
+        stamp("`rtis converge`, `rtis render --aov --parts --fireflies` and `rtis replay`"),
     ])
 
 
@@ -531,7 +608,7 @@ def main():
     makers = {"build": build, "hero": hero, "cornell": cornell, "commits": commits, "effects": effects, "meshes": meshes,
               "converge": converge,
               "obvhs": obvhs,
-              "area": area, "materials": materials, "lens": lens, "sky": sky, "textures": textures, "import": import_block, "embree": embree, "mitsuba": mitsuba}
+              "area": area, "materials": materials, "lens": lens, "sky": sky, "textures": textures, "import": import_block, "inspect": inspect, "embree": embree, "mitsuba": mitsuba}
     for name in a.only.split(","):
         if name not in makers:
             print(f"unknown block {name}: use {', '.join(BLOCKS)}", file=sys.stderr)

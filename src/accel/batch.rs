@@ -17,9 +17,9 @@
 //! has it. Their copies are `#[target_feature]` functions around the generic code, which has
 //! no closures, so every lane operation inlines into them.
 
-use super::Geometry;
 use super::lanes::{RayLanes, SurfaceLanes, plane_surface, sphere_surface};
 use super::simd::{Floats, Isa, MAX_LANES};
+use super::{Geometry, Tally, Traversal};
 use crate::geometry::{Hit, Ray};
 use glam::Vec4;
 
@@ -63,6 +63,9 @@ unsafe fn chunk<L: Floats>(rays: &[Ray], k: usize) -> ([&Ray; MAX_LANES], L) {
     (lanes, unsafe { L::from_array(lanes.map(|r| r.t_max)) })
 }
 
+/// Segments in lanes: origins, unit directions, the origins' error bounds and the ends.
+pub type Segments<L> = ([L; 3], [L; 3], L, L);
+
 impl Geometry {
     /// True if the batched queries can put rays in the lanes: every primitive is packed.
     #[inline]
@@ -73,11 +76,27 @@ impl Geometry {
     /// The nearest hit of each ray of `rays`, as [`Geometry::intersect`] finds it, into `hits`
     /// (cleared first, then one entry per ray).
     pub fn intersect_batch(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+        self.intersect_batch_tallied(rays, hits, None);
+    }
+
+    /// [`Geometry::intersect_batch`], counting into `tally` if there is one (in lanes, every
+    /// ray tests every packed primitive).
+    pub fn intersect_batch_tallied(
+        &self,
+        rays: &[Ray],
+        hits: &mut Vec<Option<Hit>>,
+        tally: Option<&Traversal>,
+    ) {
         hits.clear();
         if !self.all_packed() {
-            hits.extend(rays.iter().map(|r| self.intersect(r)));
+            // Ray by ray, the BVH's loop compiled with the counters or without them.
+            match tally {
+                Some(t) => hits.extend(rays.iter().map(|r| self.intersect_tallied(r, t))),
+                None => hits.extend(rays.iter().map(|r| self.intersect(r))),
+            }
             return;
         }
+        tally.prims(rays.len() as u64 * self.lane_prims());
         match self.bvh.isa() {
             // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
             #[cfg(target_arch = "x86_64")]
@@ -94,24 +113,41 @@ impl Geometry {
     /// [`Geometry::occluded_in_room`] does if not `planes`, into `blocked` (cleared first,
     /// then one entry per ray).
     pub fn occluded_batch(&self, rays: &[Ray], planes: bool, blocked: &mut Vec<bool>) {
+        self.occluded_batch_tallied(rays, planes, blocked, None);
+    }
+
+    /// [`Geometry::occluded_batch`], counting into `tally` if there is one.
+    pub fn occluded_batch_tallied(
+        &self,
+        rays: &[Ray],
+        planes: bool,
+        blocked: &mut Vec<bool>,
+        tally: Option<&Traversal>,
+    ) {
         blocked.clear();
         if !self.all_packed() {
-            blocked.extend(rays.iter().map(|r| match planes {
-                true => self.occluded(r),
-                false => self.occluded_in_room(r),
-            }));
+            match tally {
+                Some(t) => blocked.extend(rays.iter().map(|r| self.occluded_tallied(r, planes, t))),
+                None => blocked.extend(rays.iter().map(|r| self.occluded_tallied(r, planes, &()))),
+            }
             return;
         }
         match self.bvh.isa() {
             // SAFETY: as in `intersect_batch`.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => unsafe { self.occluded_avx2(rays, planes, blocked) },
+            Isa::Avx2 => unsafe { self.occluded_avx2(rays, planes, blocked, &tally) },
             // SAFETY: as above.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => unsafe { self.occluded_avx512(rays, planes, blocked) },
+            Isa::Avx512 => unsafe { self.occluded_avx512(rays, planes, blocked, &tally) },
             // SAFETY: `Vec4` runs on every CPU.
-            _ => unsafe { self.occluded_in::<Vec4>(rays, planes, blocked) },
+            _ => unsafe { self.occluded_in::<Vec4>(rays, planes, blocked, &tally) },
         }
+    }
+
+    /// Primitives each ray in lanes tests for its nearest hit: every packed sphere and plane.
+    #[inline]
+    pub fn lane_prims(&self) -> u64 {
+        (self.sphere_each.len() + self.plane_each.len()) as u64
     }
 
     /// [`Geometry::intersect_batch`] in eight AVX2 lanes.
@@ -131,9 +167,15 @@ impl Geometry {
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn occluded_avx2(&self, rays: &[Ray], planes: bool, blocked: &mut Vec<bool>) {
+    unsafe fn occluded_avx2(
+        &self,
+        rays: &[Ray],
+        planes: bool,
+        blocked: &mut Vec<bool>,
+        tally: &impl Tally,
+    ) {
         // SAFETY: this function runs only where AVX2 was found.
-        unsafe { self.occluded_in::<super::simd::avx2::F8>(rays, planes, blocked) }
+        unsafe { self.occluded_in::<super::simd::avx2::F8>(rays, planes, blocked, tally) }
     }
 
     /// [`Geometry::intersect_batch`] in sixteen AVX-512 lanes.
@@ -153,24 +195,29 @@ impl Geometry {
     /// The CPU must have AVX-512F.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
-    unsafe fn occluded_avx512(&self, rays: &[Ray], planes: bool, blocked: &mut Vec<bool>) {
+    unsafe fn occluded_avx512(
+        &self,
+        rays: &[Ray],
+        planes: bool,
+        blocked: &mut Vec<bool>,
+        tally: &impl Tally,
+    ) {
         // SAFETY: this function runs only where AVX-512F was found.
-        unsafe { self.occluded_in::<super::simd::avx512::F16>(rays, planes, blocked) }
+        unsafe { self.occluded_in::<super::simd::avx512::F16>(rays, planes, blocked, tally) }
     }
 
     /// Which of the segments in the lanes are blocked, as [`Geometry::occluded`] answers each
     /// (or [`Geometry::occluded_in_room`] if not `planes`): from origins `o` (with errors
     /// `o_err`) along unit directions `d` to `t_max`. Only the lanes of `live` are asked; the
-    /// others answer false. For a shader that builds its rays in lanes (no gathering).
+    /// others answer false; `tally` is told the primitives they test. For a shader that builds
+    /// its rays in lanes (no gathering).
     #[inline(always)]
     pub fn occluded_lanes<L: Floats>(
         &self,
-        o: [L; 3],
-        d: [L; 3],
-        o_err: L,
-        t_max: L,
+        (o, d, o_err, t_max): Segments<L>,
         planes: bool,
         live: L::Mask,
+        tally: &impl Tally,
     ) -> L::Mask {
         if !self.all_packed() {
             // Ray by ray through the BVH.
@@ -192,11 +239,7 @@ impl Geometry {
                     t_max: v[7][i],
                     o_err: v[6][i],
                 };
-                let hit = if planes {
-                    self.occluded(&ray)
-                } else {
-                    self.occluded_in_room(&ray)
-                };
+                let hit = self.occluded_tallied(&ray, planes, tally);
                 *blocked = if hit { 1.0 } else { 0.0 };
             }
             // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
@@ -205,12 +248,15 @@ impl Geometry {
         let lanes = RayLanes::from_parts(o, d, o_err);
         // No lane blocked yet (nothing is below itself, NaN included).
         let mut hit = t_max.cmplt(t_max);
+        let asked = L::bitmask(live).count_ones() as u64;
+        tally.prims(asked * self.sphere_each.len() as u64);
         for (_, sphere) in &self.sphere_each {
             // SAFETY: as above.
             hit = hit | unsafe { sphere.splat::<L>() }.hit(&lanes, t_max).1;
         }
         // The planes only if asked, and while a live lane is not blocked yet.
         if planes && !L::all(hit | !live) {
+            tally.prims(asked * self.plane_each.len() as u64);
             for (_, plane) in &self.plane_each {
                 hit = hit | unsafe { plane.splat::<L>() }.hit(&lanes, t_max).1;
             }
@@ -351,7 +397,13 @@ impl Geometry {
     /// # Safety
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    unsafe fn occluded_in<L: Floats>(&self, rays: &[Ray], planes: bool, blocked: &mut Vec<bool>) {
+    unsafe fn occluded_in<L: Floats>(
+        &self,
+        rays: &[Ray],
+        planes: bool,
+        blocked: &mut Vec<bool>,
+        tally: &impl Tally,
+    ) {
         for k in (0..rays.len()).step_by(L::LANES) {
             // SAFETY: the caller vouches for the instruction set.
             let (four, t_max) = unsafe { chunk::<L>(rays, k) };
@@ -362,9 +414,13 @@ impl Geometry {
                     L::from_array(four.map(|r| r.o_err)),
                 )
             };
-            // Every lane asks (nothing is below itself: all clear, then all set).
-            let all = !t_max.cmplt(t_max);
-            let hit = self.occluded_lanes(o, d, o_err, t_max, planes, all);
+            // The lanes of the rays ask; the padding (the last ray again) does not.
+            let n = (rays.len() - k).min(L::LANES);
+            let real = unsafe {
+                L::from_array(std::array::from_fn::<f32, MAX_LANES, _>(|i| i as f32))
+                    .cmplt(L::splat(n as f32))
+            };
+            let hit = self.occluded_lanes((o, d, o_err, t_max), planes, real, tally);
             let mask = L::bitmask(hit);
             for i in 0..(rays.len() - k).min(L::LANES) {
                 blocked.push(mask & (1 << i) != 0);

@@ -443,16 +443,21 @@ impl<P> Lanes<P> {
         }
     }
 
-    /// True if any lane of any packet hits within `t_max`.
+    /// True if any lane of any packet hits within `t_max`; `tally` is told the shapes of the
+    /// packets tested.
     #[inline(always)]
     pub fn any(
         &self,
         r: &RayLanes,
         t_max: f32,
         hit: impl Fn(&P, &RayLanes, Vec4) -> (Vec4, BVec4A),
+        tally: &impl super::Tally,
     ) -> bool {
         let t_max = Vec4::splat(t_max);
-        self.packs.iter().any(|p| hit(p, r, t_max).1.any())
+        self.packs.iter().enumerate().any(|(k, p)| {
+            tally.prims((self.count - 4 * k).min(4) as u64);
+            hit(p, r, t_max).1.any()
+        })
     }
 }
 

@@ -7,8 +7,10 @@ mod bvh;
 pub mod lanes;
 mod prim;
 mod simd;
+pub mod tally;
 pub mod wide;
 
+pub use batch::Segments;
 pub use bvh::{Bvh, Node};
 pub use prim::{FLAT, Prim};
 #[cfg(target_arch = "x86_64")]
@@ -16,6 +18,7 @@ pub use simd::avx2::F8;
 #[cfg(target_arch = "x86_64")]
 pub use simd::avx512::F16;
 pub use simd::{Floats, Isa, MAX_LANES, require_all_isas};
+pub use tally::{Tally, Traversal};
 pub use wide::{WideBvh, WideNode};
 
 use crate::geometry::{BvhRay, Hit, Ray};
@@ -453,6 +456,12 @@ impl Geometry {
     /// The nearest hit along `ray` within `(0, ray.t_max]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_tallied(ray, &())
+    }
+
+    /// [`Geometry::intersect`], telling `tally` the nodes and primitives it tests.
+    #[inline]
+    pub fn intersect_tallied(&self, ray: &Ray, tally: &impl Tally) -> Option<Hit> {
         let mut t_max = ray.t_max;
         let mut best: Option<u32> = None;
         // The BVH's nearest hit, and its unit normal if a block's lane test found it.
@@ -460,6 +469,7 @@ impl Geometry {
         // The ray in lanes only for scenes with packets (a mesh scene has none).
         let lanes = self.has_packets().then(|| RayLanes::new(ray));
         if let Some(lanes) = &lanes {
+            tally.prims(self.spheres.count as u64);
             self.spheres
                 .closest(lanes, &mut t_max, &mut best, SphereLanes::hit);
         }
@@ -468,7 +478,9 @@ impl Geometry {
             let mut leaf_ray = LeafRay::default();
             let leaf = |b: u32, t_max: f32| {
                 let (r, br) = leaf_ray.get(&r, self.has_triangles);
-                let hit = self.blocks[b as usize].closest(&self.others, br, r, t_max);
+                let block = &self.blocks[b as usize];
+                tally.prims(block.count as u64);
+                let hit = block.closest(&self.others, br, r, t_max);
                 hit.map(|(lane, t, n)| {
                     // The last hit a leaf reports is the nearest: keep its normal.
                     lane_normal = n;
@@ -476,13 +488,14 @@ impl Geometry {
                 })
             };
             let touch = |b: u32| wide::prefetch(self.blocks.as_ptr().wrapping_add(b as usize));
-            if let Some((i, t)) = self.bvh.closest(&r, leaf, touch) {
+            if let Some((i, t)) = self.bvh.closest_tallied(&r, leaf, touch, tally) {
                 t_max = t;
                 best = Some(i);
                 bvh_best = best;
             }
         }
         if let Some(lanes) = &lanes {
+            tally.prims(self.planes.count as u64);
             self.planes
                 .closest(lanes, &mut t_max, &mut best, PlaneLanes::hit);
         }
@@ -509,31 +522,41 @@ impl Geometry {
     /// True if anything blocks `ray` within `(0, ray.t_max]` (any-hit query for shadow rays).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.occluded_by(ray, true)
+        self.occluded_by(ray, true, &())
     }
 
     /// [`Geometry::occluded`] for a segment that ends at a point [`Geometry::in_room`]: no
     /// plane can block it, so the planes are not tested.
     #[inline]
     pub fn occluded_in_room(&self, ray: &Ray) -> bool {
-        self.occluded_by(ray, false)
+        self.occluded_by(ray, false, &())
+    }
+
+    /// [`Geometry::occluded`] (all planes, or none if not `planes`), telling `tally` the nodes
+    /// and primitives it tests.
+    #[inline]
+    pub fn occluded_tallied(&self, ray: &Ray, planes: bool, tally: &impl Tally) -> bool {
+        self.occluded_by(ray, planes, tally)
     }
 
     /// The any-hit query, testing the planes if `planes`. Kept out of line: inlined into the
     /// shaders' light loops it measured slower.
     #[inline(never)]
-    fn occluded_by(&self, ray: &Ray, planes: bool) -> bool {
+    fn occluded_by(&self, ray: &Ray, planes: bool, tally: &impl Tally) -> bool {
         (self.has_packets() && {
             let lanes = RayLanes::new(ray);
-            self.spheres.any(&lanes, ray.t_max, SphereLanes::hit)
-                || (planes && self.planes.any(&lanes, ray.t_max, PlaneLanes::hit))
+            self.spheres.any(&lanes, ray.t_max, SphereLanes::hit, tally)
+                || (planes && self.planes.any(&lanes, ray.t_max, PlaneLanes::hit, tally))
         }) || (!self.bvh.is_empty() && {
             let r = ray.for_bvh(ray.t_max);
             let mut leaf_ray = LeafRay::default();
-            self.bvh.any(&r, |b, r| {
+            let leaf = |b: u32, r: &BvhRay| {
                 let (r, br) = leaf_ray.get(r, self.has_triangles);
-                self.blocks[b as usize].any(&self.others, br, r)
-            })
+                let block = &self.blocks[b as usize];
+                tally.prims(block.count as u64);
+                block.any(&self.others, br, r)
+            };
+            self.bvh.any_tallied(&r, leaf, tally)
         })
     }
 }

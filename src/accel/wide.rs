@@ -16,6 +16,7 @@
 //! [`Aabb::hit`](crate::geometry::Aabb::hit)'s, lane by lane (entry and exit sides chosen by the
 //! direction's sign), with the reciprocal direction kept finite.
 
+use super::Tally;
 use super::bvh::Node;
 use super::simd::{Isa, Lanes8, baseline::Halves};
 use crate::geometry::BvhRay;
@@ -566,14 +567,26 @@ impl WideBvh {
         test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
     ) -> Option<(u32, f32)> {
+        self.closest_tallied(ray, test, touch, &())
+    }
+
+    /// [`WideBvh::closest`], telling `tally` each node test.
+    #[inline]
+    pub fn closest_tallied(
+        &self,
+        ray: &BvhRay,
+        test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
+        touch: impl Fn(u32),
+        tally: &impl Tally,
+    ) -> Option<(u32, f32)> {
         debug_assert!(self.isa.available());
         match self.isa {
             // SAFETY: `isa` is private to this file and set only by `collapse` and `Default`
             // (both `Isa::detect`) and by `set_isa`, which checks: AVX2 (or AVX-512, whose
             // CPUs all have AVX2: its node test is AVX2's) only where the CPU has it.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 | Isa::Avx512 => unsafe { self.closest_avx2(ray, test, touch) },
-            _ => self.closest_baseline(ray, test, touch),
+            Isa::Avx2 | Isa::Avx512 => unsafe { self.closest_avx2(ray, test, touch, tally) },
+            _ => self.closest_baseline(ray, test, touch, tally),
         }
     }
 
@@ -586,24 +599,36 @@ impl WideBvh {
         ray: &BvhRay,
         test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
+        tally: &impl Tally,
     ) -> Option<(u32, f32)> {
         // SAFETY: the baseline runs on every CPU.
-        unsafe { self.closest_in::<Halves>(ray, test, touch) }
+        unsafe { self.closest_in::<Halves>(ray, test, touch, tally) }
     }
 
     /// True if `test(leaf, ray)` holds for some leaf whose box the ray enters within
     /// `(0, ray.t_max]` (any-hit query for shadow rays).
     #[inline]
     pub fn any(&self, ray: &BvhRay, test: impl FnMut(u32, &BvhRay) -> bool) -> bool {
+        self.any_tallied(ray, test, &())
+    }
+
+    /// [`WideBvh::any`], telling `tally` each node test.
+    #[inline]
+    pub fn any_tallied(
+        &self,
+        ray: &BvhRay,
+        test: impl FnMut(u32, &BvhRay) -> bool,
+        tally: &impl Tally,
+    ) -> bool {
         debug_assert!(self.isa.available());
         match self.isa {
             // SAFETY: `isa` is private to this file and set only by `collapse` and `Default`
             // (both `Isa::detect`) and by `set_isa`, which checks: AVX2 (or AVX-512, whose
             // CPUs all have AVX2: its node test is AVX2's) only where the CPU has it.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 | Isa::Avx512 => unsafe { self.any_avx2(ray, test) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { self.any_avx2(ray, test, tally) },
             // SAFETY: the baseline runs on every CPU.
-            _ => unsafe { self.any_in::<Halves>(ray, test) },
+            _ => unsafe { self.any_in::<Halves>(ray, test, tally) },
         }
     }
 
@@ -634,9 +659,10 @@ impl WideBvh {
         ray: &BvhRay,
         test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
+        tally: &impl Tally,
     ) -> Option<(u32, f32)> {
         // SAFETY: the caller's.
-        unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch) }
+        unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch, tally) }
     }
 
     /// [`WideBvh::any`] compiled for AVX2, the node test inlined into it (the leaf test, a
@@ -646,9 +672,14 @@ impl WideBvh {
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn any_avx2(&self, ray: &BvhRay, test: impl FnMut(u32, &BvhRay) -> bool) -> bool {
+    unsafe fn any_avx2(
+        &self,
+        ray: &BvhRay,
+        test: impl FnMut(u32, &BvhRay) -> bool,
+        tally: &impl Tally,
+    ) -> bool {
         // SAFETY: the caller's.
-        unsafe { self.any_in::<super::simd::avx2::Avx2>(ray, test) }
+        unsafe { self.any_in::<super::simd::avx2::Avx2>(ray, test, tally) }
     }
 
     /// The node test of interior node `node` (a reference): the children's entry distances,
@@ -687,6 +718,7 @@ impl WideBvh {
         ray: &BvhRay,
         mut test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
         touch: impl Fn(u32),
+        tally: &impl Tally,
     ) -> Option<(u32, f32)> {
         if self.is_empty() {
             return None;
@@ -697,6 +729,7 @@ impl WideBvh {
         // the misses of `rtis bench`'s incoherent rays at 10k triangles), and they leave
         // before the traversal's state is set up (5-11% less time per miss, measured).
         let root = &self.top[0];
+        tally.nodes(1);
         // SAFETY: the caller's.
         let (mut near, mut mask) = unsafe { root.hit(&rb, ray.t_max) };
         if mask == 0 {
@@ -738,6 +771,7 @@ impl WideBvh {
                 };
                 cur = c;
             }
+            tally.nodes(1);
             // SAFETY: the caller's.
             (near, mask, child) = unsafe { self.visit(cur, &rb, t_max) };
         }
@@ -830,6 +864,7 @@ impl WideBvh {
         &self,
         ray: &BvhRay,
         mut test: impl FnMut(u32, &BvhRay) -> bool,
+        tally: &impl Tally,
     ) -> bool {
         if self.is_empty() {
             return false;
@@ -840,6 +875,7 @@ impl WideBvh {
         let mut sp = 0usize;
         let mut node = self.root();
         loop {
+            tally.nodes(1);
             // SAFETY: the caller's.
             let (_, mut mask, child) = unsafe { self.visit(node, &rb, ray.t_max) };
             while mask != 0 {

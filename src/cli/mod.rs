@@ -9,6 +9,7 @@ mod import;
 pub mod interrupt;
 mod merge;
 mod render;
+mod replay;
 mod warptest;
 mod watch;
 
@@ -46,6 +47,9 @@ enum Command {
     Converge(converge::ConvergeArgs),
     /// Test every sampler against its pdf (chi-squared), with a page of histograms.
     Warptest(warptest::WarptestArgs),
+    /// Trace one camera sample again, exactly as the render traced it, and print its path
+    /// vertex by vertex (a firefly's, say).
+    Replay(replay::ReplayArgs),
     /// Print speed figures: the course's Cornell box under each shader (seconds, Mrays/s, own
     /// peak memory), the price of each effect, and BVH build and ray rates for meshes.
     Bench(bench::BenchArgs),
@@ -63,6 +67,7 @@ pub struct Interrupted;
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Replay(args) => replay::run(args),
         Command::Watch(args) => watch::run(args),
         Command::Check { scene } => check::run(&scene),
         Command::Import(args) => import::run(args),

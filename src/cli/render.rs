@@ -7,6 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rtis::accel::Isa;
 use rtis::render::estimate::{self, MAX_RAYS_UNFORCED, human_seconds};
 use rtis::render::film::Image;
+use rtis::render::inspect;
 use rtis::render::output::Transfer;
 use rtis::render::pass::{self, Pass};
 use rtis::render::progressive::{self, Ending};
@@ -72,6 +73,35 @@ pub struct RenderArgs {
     /// measure what it is worth. The image is the same in each.
     #[arg(long, value_enum, default_value_t = IsaChoice::Auto)]
     isa: IsaChoice,
+    /// Also write per-pixel statistics as layers of this EXR: time, rays by kind, BVH node
+    /// and primitive tests, path length, variance of the estimate, and albedo, normal and
+    /// depth at the first hit (docs/inspect.md). The image is the same, to the bit.
+    #[arg(long, value_name = "FILE.exr", conflicts_with_all = INSPECT_CONFLICTS)]
+    aov: Option<PathBuf>,
+    /// Also write the image split by technique (emitted, light-sampled, BSDF-sampled, each
+    /// with its MIS weight) and by bounce (direct, 1, 2, 3+) as layers of this EXR; the parts
+    /// sum exactly to the image. Path only.
+    #[arg(long, value_name = "FILE.exr", conflicts_with_all = INSPECT_CONFLICTS)]
+    parts: Option<PathBuf>,
+    /// Keep the N single samples that stand out most above their pixel's mean (by luminance),
+    /// with the path of each, as JSON in NAME.fireflies.json beside the image (at most 10000).
+    #[arg(long, value_name = "N", conflicts_with_all = INSPECT_CONFLICTS,
+          value_parser = clap::value_parser!(u32).range(1..=MAX_FIREFLIES as i64))]
+    fireflies: Option<u32>,
+}
+
+/// Most fireflies `--fireflies` keeps.
+pub const MAX_FIREFLIES: u32 = 10_000;
+
+/// What an inspected render (`--aov`, `--parts`, `--fireflies`) cannot be combined with: it
+/// renders all the samples in one go.
+const INSPECT_CONFLICTS: [&str; 4] = ["pass", "time", "resume", "display"];
+
+impl RenderArgs {
+    /// True if the render is inspected (`--aov`, `--parts` or `--fireflies`).
+    fn inspected(&self) -> bool {
+        self.aov.is_some() || self.parts.is_some() || self.fireflies.is_some()
+    }
 }
 
 /// `--isa` of `rtis render`.
@@ -117,6 +147,33 @@ pub fn film_size(scene: (u32, u32), width: Option<u32>, height: Option<u32>) -> 
         (None, Some(h2)) => (keep(h2, w, h), h2),
         (None, None) => (w, h),
     }
+}
+
+/// The scene at `path` (the embedded box if none) with the command line's film size and spp
+/// (`size`: width, height, spp), transfer and seed, where given.
+pub fn load_overridden(
+    path: Option<&Path>,
+    size: (Option<u32>, Option<u32>, Option<u32>),
+    transfer: Option<Transfer>,
+    seed: Option<u64>,
+) -> Result<rtis::scene::Scene, CliError> {
+    let mut scene = load(path)?;
+    let film = &mut scene.settings.film;
+    let (width, height) = film_size((film.width, film.height), size.0, size.1);
+    let overridden = Film {
+        width,
+        height,
+        spp: size.2.unwrap_or(film.spp),
+        transfer: transfer.unwrap_or(film.transfer),
+        filter: film.filter,
+    };
+    *film = overridden
+        .checked()
+        .map_err(|e| format!("command-line film override: {e}"))?;
+    if let Some(seed) = seed {
+        scene.settings.seed = seed;
+    }
+    Ok(scene)
 }
 
 /// Most worker threads per core: more only add overhead.
@@ -216,22 +273,12 @@ fn parse_transfer(s: &str) -> Result<Transfer, String> {
 pub fn run(a: RenderArgs) -> Result<(), CliError> {
     // Refused before the scene is read.
     let isa = a.isa.isa()?;
-    let mut scene = load(a.scene.as_deref())?;
-    let film = &mut scene.settings.film;
-    let (width, height) = film_size((film.width, film.height), a.width, a.height);
-    let overridden = Film {
-        width,
-        height,
-        spp: a.spp.unwrap_or(film.spp),
-        transfer: a.transfer.unwrap_or(film.transfer),
-        filter: film.filter,
-    };
-    *film = overridden
-        .checked()
-        .map_err(|e| format!("command-line film override: {e}"))?;
-    if let Some(seed) = a.seed {
-        scene.settings.seed = seed;
-    }
+    let scene = load_overridden(
+        a.scene.as_deref(),
+        (a.width, a.height, a.spp),
+        a.transfer,
+        a.seed,
+    )?;
     let stem = a
         .scene
         .as_deref()
@@ -259,12 +306,30 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     if let Some(path) = &a.stats {
         output::check_folder(path)?;
     }
+    for path in [&a.aov, &a.parts].into_iter().flatten() {
+        if !is_exr(path) {
+            return Err(format!(
+                "{}: per-pixel layers are written as an .exr file",
+                path.display()
+            )
+            .into());
+        }
+        output::check_writable(path)?;
+    }
+
     let threads = thread_count(a.threads)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
 
     let mut prepared = rtis::extract(&scene);
+    if a.parts.is_some() && !matches!(prepared.shader, rtis::shader::Shader::Path(_)) {
+        return Err(
+            "--parts splits the path tracer's light by technique and bounce: the scene's \
+             shader is not Path (set shader: Path(...) in the scene)"
+                .into(),
+        );
+    }
     assert!(
         prepared.geometry.bvh.set_isa(isa),
         "checked by IsaChoice::isa"
@@ -355,6 +420,9 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
             out.display()
         );
         return Ok(());
+    }
+    if a.inspected() {
+        return inspected(&prepared, &pool, &bar, &out, &a, &est);
     }
     let film = prepared.film;
     if film.width as u64 * film.height as u64 > progressive::MAX_PIXELS {
@@ -567,6 +635,93 @@ fn render_in_one_go(
         },
         out,
         stats,
+        est,
+    )
+}
+
+/// An inspected render: all the samples in one go, measured pixel by pixel; the image, then
+/// the layers and fireflies asked for. Ctrl-C writes nothing.
+fn inspected(
+    prepared: &rtis::RenderScene,
+    pool: &rayon::ThreadPool,
+    bar: &ProgressBar,
+    out: &Path,
+    a: &RenderArgs,
+    est: &estimate::Estimate,
+) -> Result<(), CliError> {
+    let tick = || bar.inc(1);
+    let fireflies = a.fireflies.unwrap_or(0) as usize;
+    let result = {
+        let _graceful = Graceful::begin("stopping: an inspected render writes nothing unfinished");
+        eprintln!(
+            "rendering {} tiles in one go, inspected (Ctrl-C stops and writes nothing)",
+            render::tile_count(prepared)
+        );
+        pool.install(|| inspect::inspect(prepared, fireflies, &tick, &interrupt::STOP))
+    };
+    bar.finish_and_clear();
+    if result.tiles_done < result.tiles {
+        eprintln!("interrupted: an inspected render writes nothing unfinished");
+        return Err(Box::new(Interrupted));
+    }
+    let film = prepared.film;
+    output::save(&result.image, out, film.transfer)?;
+    if let Some(path) = &a.aov {
+        output::write_layers(path, film.width, film.height, &inspect::aov_layers(&result))?;
+        let nodes: u64 = result.pixels.iter().map(|p| p.nodes).sum();
+        let prims: u64 = result.pixels.iter().map(|p| p.prims).sum();
+        eprintln!(
+            "per-pixel statistics -> {} ({nodes} BVH node tests, {prims} primitive tests)",
+            path.display()
+        );
+    }
+    if let Some(path) = &a.parts {
+        output::write_layers(
+            path,
+            film.width,
+            film.height,
+            &inspect::part_layers(&result),
+        )?;
+        eprintln!("image by technique and by bounce -> {}", path.display());
+    }
+    if fireflies > 0 {
+        let path = out.with_extension("fireflies.json");
+        let json = serde_json::to_string_pretty(&serde_json::json!({
+            "scene": a.scene.as_ref().map(|p| p.display().to_string()),
+            "width": film.width,
+            "height": film.height,
+            "spp": film.spp,
+            "seed": prepared.seed,
+            "fireflies": result.fireflies,
+        }))?;
+        output::write_file(&path, json.as_bytes())?;
+        if let Some(f) = result.fireflies.first() {
+            eprintln!(
+                "{} fireflies -> {}; the largest: pixel {},{} sample {}, luminance {} \
+                 (replay it with rtis replay SCENE --pixel {},{} --sample {})",
+                result.fireflies.len(),
+                path.display(),
+                f.pixel[0],
+                f.pixel[1],
+                f.sample,
+                f.luminance,
+                f.pixel[0],
+                f.pixel[1],
+                f.sample
+            );
+        }
+    }
+    summary(
+        prepared,
+        pool,
+        &Summary {
+            spp: film.spp as u64,
+            rounds: 1,
+            seconds: result.seconds,
+            stats: result.stats,
+        },
+        out,
+        a.stats.as_deref(),
         est,
     )
 }

@@ -156,3 +156,15 @@ pub fn rel_se_map(a: &Image, reference: &Image) -> Vec<f32> {
         })
         .collect()
 }
+
+/// Per-pixel squared error `(x - r)^2`, averaged over channels.
+pub fn se_map(a: &Image, reference: &Image) -> Vec<f32> {
+    a.pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(p, r)| {
+            let d = p.as_dvec3() - r.as_dvec3();
+            (d * d).element_sum() as f32 / 3.0
+        })
+        .collect()
+}

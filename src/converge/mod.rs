@@ -8,11 +8,13 @@ pub mod warptest;
 
 use crate::material::microfacet::{Microfacet, NormalSampling};
 use crate::material::{Material, Model};
+use crate::render::inspect::{Firefly, inspect};
 use crate::render::{RenderScene, film::Image, render};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
 use crate::shader::{Global, Path, Shader};
 use crate::texture::{TexelFilter, TextureKind, mip_levels};
 use std::fmt::Write as _;
+use std::sync::atomic::AtomicBool;
 
 /// One setting of the ladder.
 #[derive(Clone, Debug)]
@@ -282,7 +284,15 @@ pub struct Measured {
     pub row: Row,
     /// The first seed's image.
     pub image: Image,
+    /// Seconds each pixel of the first seed's image took to trace, from an inspected render
+    /// of it (row-major).
+    pub pixel_seconds: Vec<f32>,
+    /// The first seed's samples that stand out most above their pixels, with their paths.
+    pub fireflies: Vec<Firefly>,
 }
+
+/// Fireflies the report keeps per rung.
+pub const REPORT_FIREFLIES: usize = 8;
 
 /// Time and measure every rung: `seeds` independent renders (seeds `scene.seed + k`), the
 /// first timed as the median of `runs`. `reference_noise` is the reference's own noise
@@ -353,9 +363,15 @@ pub fn sweep(
             variance: parts.variance,
             bias2: parts.bias2,
         };
+        // Where the time went and the largest samples: an inspected render of the first
+        // seed, untimed (its image is the same, to the bit).
+        let inspected = inspect(&s, REPORT_FIREFLIES, &|| {}, &AtomicBool::new(false));
+        debug_assert_eq!(inspected.image, out.image);
         Measured {
             row,
             image: out.image,
+            pixel_seconds: inspected.pixels.iter().map(|p| p.seconds as f32).collect(),
+            fireflies: inspected.fireflies,
         }
     };
     let mut done = Vec::new();

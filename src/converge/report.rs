@@ -6,12 +6,15 @@
 //! plot as SVG, where hovering a point names the rung and clicking it shows the rung; a table of
 //! time, rays, RMSE, relMSE, mean FLIP, bias^2 and variance per rung; an "equal error" view
 //! (for a chosen RMSE, the time each family needs to reach it, interpolated on the log-log
-//! curve); and the price of each effect of the scene.
+//! curve); the price of each effect of the scene; where each rung's time goes (time per
+//! pixel, squared error per pixel and their product, the inverse efficiency); and each rung's
+//! largest samples circled on its image, with their paths.
 
-use super::metrics::{flip, rel_se_map};
-use super::{Measured, Row};
+use super::metrics::{flip, rel_se_map, se_map};
+use super::{Measured, REPORT_FIREFLIES, Row};
 use crate::render::film::Image;
 use crate::render::output::{Transfer, to_rgb8};
+use crate::shader::record::Event;
 use std::fmt::Write;
 
 /// What switching one effect off saves and costs.
@@ -90,6 +93,17 @@ fn colour_bar(max: f32, label: &str) -> String {
         "<div class=\"bar\"><span>0</span><img src=\"{}\" alt=\"colour bar\" width=\"256\" \
          height=\"12\"><span>{max:.3} {label}</span></div>",
         png_uri(&img)
+    )
+}
+
+/// A colour bar from 0 to a maximum that the page writes into the span `id` (a scale that
+/// changes with the rung shown).
+fn colour_bar_labelled(id: &str, label: &str) -> String {
+    let ramp: Vec<f32> = (0..256).map(|i| i as f32 / 255.0).collect();
+    format!(
+        "<div class=\"bar\"><span>0</span><img src=\"{}\" alt=\"colour bar\" width=\"256\" \
+         height=\"12\"><span><span id=\"{id}\"></span> {label}</span></div>",
+        png_uri(&magma(&ramp, 256, 1, 1.0))
     )
 }
 
@@ -205,9 +219,13 @@ td:first-child,th:first-child,td:nth-child(2){text-align:left}tr.sel{background:
 .compare{position:relative;display:inline-block;line-height:0}\
 .compare img{image-rendering:pixelated;width:540px}\
 #top{position:absolute;left:0;top:0;clip-path:inset(0 50% 0 0)}\
-.maps{display:flex;gap:16px}.maps figure{margin:0}.maps img{image-rendering:pixelated;width:360px}\
+.maps{display:flex;flex-wrap:wrap;gap:16px}.maps figure{margin:0}.maps img{image-rendering:pixelated;width:360px}\
 .bar{display:flex;align-items:center;gap:6px;font-size:12px}.bar img{height:12px}\
-.pt{cursor:pointer}.note{color:#a40}";
+.pt{cursor:pointer}.note{color:#a40}\
+.fireflies{display:flex;gap:16px;align-items:flex-start}.ffimg{position:relative;line-height:0}\
+.ffimg img{image-rendering:pixelated;width:540px}\
+#ffmarks{position:absolute;left:0;top:0;width:100%;height:100%}\
+.ff{fill:none;stroke:#0ff;stroke-width:0.6}";
 
 const SCRIPT: &str = r#"
 const rungs = JSON.parse(document.getElementById('data').textContent);
@@ -217,6 +235,33 @@ function show(i) {
   document.getElementById('relmap').src = r.relmap;
   document.getElementById('flipmap').src = r.flipmap;
   document.getElementById('rungname').textContent = r.family + ' ' + r.label;
+  for (const m of ['timemap', 'errmap', 'productmap']) document.getElementById(m).src = r[m];
+  document.getElementById('timemax').textContent = r.timemax.toPrecision(3);
+  document.getElementById('ffimage').src = r.image;
+  const ns = 'http://www.w3.org/2000/svg';
+  const marks = document.getElementById('ffmarks');
+  marks.replaceChildren();
+  const rows = [];
+  r.fireflies.forEach((f, k) => {
+    const c = document.createElementNS(ns, 'circle');
+    c.setAttribute('cx', f.x + 0.5);
+    c.setAttribute('cy', f.y + 0.5);
+    c.setAttribute('r', 1.5);
+    c.setAttribute('class', 'ff');
+    const t = document.createElementNS(ns, 'title');
+    t.textContent = '#' + (k + 1) + ': pixel ' + f.x + ',' + f.y + ' sample ' + f.sample;
+    c.appendChild(t);
+    marks.appendChild(c);
+    const tr = document.createElement('tr');
+    for (const v of [k + 1, f.x + ',' + f.y, f.sample, f.luminance.toPrecision(4),
+                     f.excess.toPrecision(4), f.path]) {
+      const td = document.createElement('td');
+      td.textContent = v;
+      tr.appendChild(td);
+    }
+    rows.push(tr);
+  });
+  document.getElementById('fftable').replaceChildren(...rows);
   document.querySelectorAll('#rows tr').forEach((tr, k) => tr.classList.toggle('sel', k === i));
 }
 const slider = document.getElementById('slider');
@@ -248,6 +293,24 @@ equalError();
 show(0);
 "#;
 
+/// A path in a few words: the kinds of the surfaces it met, in order, and how it ended
+/// (`Phong > Transmissive > Transmissive > escaped`).
+fn path_summary(events: &[Event]) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for e in events {
+        match e {
+            Event::Hit { kind, .. } => parts.push((*kind).to_string()),
+            Event::Escape { .. } => parts.push("escaped".into()),
+            _ => {}
+        }
+    }
+    if parts.is_empty() {
+        "(not recorded: a shader other than Path)".into()
+    } else {
+        parts.join(" > ")
+    }
+}
+
 /// The report as one HTML page.
 pub fn html(r: &Report) -> String {
     let (w, h) = (r.reference.width, r.reference.height);
@@ -269,15 +332,56 @@ pub fn html(r: &Report) -> String {
         p.sort_by(f32::total_cmp);
         p.get(p.len() / 2).copied().unwrap_or(1.0).max(1e-6)
     };
+    // Where the time goes: time per pixel (microseconds), squared error per pixel, and their
+    // product, each on one scale for every rung (the median of their 99th percentiles).
+    let time_maps: Vec<Vec<f32>> = r
+        .rungs
+        .iter()
+        .map(|m| m.pixel_seconds.iter().map(|t| t * 1e6).collect())
+        .collect();
+    let err_maps: Vec<Vec<f32>> = r
+        .rungs
+        .iter()
+        .map(|m| se_map(&m.image, r.reference))
+        .collect();
+    let product_maps: Vec<Vec<f32>> = time_maps
+        .iter()
+        .zip(&err_maps)
+        .map(|(t, e)| t.iter().zip(e).map(|(t, e)| t * e).collect())
+        .collect();
+    let scale = |maps: &[Vec<f32>]| {
+        let mut p: Vec<f32> = maps.iter().map(|m| p99(m)).collect();
+        p.sort_by(f32::total_cmp);
+        p.get(p.len() / 2).copied().unwrap_or(1.0).max(1e-12)
+    };
+    // Time on each rung's own scale (rungs differ in time by their spp; where it goes is the
+    // question), error and product on one scale for all.
+    let (err_max, product_max) = (scale(&err_maps), scale(&product_maps));
     let mut data = Vec::new();
-    for (m, rel) in r.rungs.iter().zip(&rel_maps) {
+    for (k, (m, rel)) in r.rungs.iter().zip(&rel_maps).enumerate() {
         let f = flip(&m.image, r.reference);
+        let fireflies: Vec<serde_json::Value> = m
+            .fireflies
+            .iter()
+            .map(|f| {
+                serde_json::json!({
+                    "x": f.pixel[0], "y": f.pixel[1], "sample": f.sample,
+                    "luminance": f.luminance, "excess": f.excess,
+                    "path": path_summary(&f.path),
+                })
+            })
+            .collect();
         data.push(serde_json::json!({
             "family": m.row.family, "label": m.row.label, "seconds": m.row.seconds,
             "rmse": m.row.rmse,
             "image": png_uri(&to_rgb8(&m.image, r.transfer)),
             "relmap": png_uri(&magma(rel, w, h, rel_max)),
             "flipmap": png_uri(&f.heatmap),
+            "timemap": png_uri(&magma(&time_maps[k], w, h, p99(&time_maps[k]).max(1e-12))),
+            "timemax": p99(&time_maps[k]),
+            "errmap": png_uri(&magma(&err_maps[k], w, h, err_max)),
+            "productmap": png_uri(&magma(&product_maps[k], w, h, product_max)),
+            "fireflies": fireflies,
         }));
     }
     let rows: Vec<&Row> = r.rungs.iter().map(|m| &m.row).collect();
@@ -307,6 +411,31 @@ pub fn html(r: &Report) -> String {
          </figcaption>{}</figure></div>",
         colour_bar(rel_max, "(median 99th percentile)"),
         colour_bar(1.0, "")
+    );
+    let _ = write!(
+        s,
+        "<h2>Where the time goes</h2><p>The rung's time per pixel, its squared error per pixel, \
+         and their product (error &times; time: the inverse of the efficiency, lower is \
+         better). A rung that spends its time where the error is not shows it at a glance: \
+         bright time where the error is dark. Time from an inspected render of the same image \
+         (<code>rtis render --aov</code>).</p><div class=\"maps\">\
+         <figure><img id=\"timemap\" alt=\"time per pixel\"><figcaption>time per pixel\
+         </figcaption>{}</figure>\
+         <figure><img id=\"errmap\" alt=\"squared error per pixel\"><figcaption>squared error \
+         (x - r)^2</figcaption>{}</figure>\
+         <figure><img id=\"productmap\" alt=\"error times time\"><figcaption>error &times; \
+         time</figcaption>{}</figure></div>\
+         <h2>Fireflies</h2><p>The rung's {REPORT_FIREFLIES} samples that stand out most above \
+         their pixel's mean (by luminance), circled on its image, with the path that made each (<code>rtis render \
+         --fireflies N</code> writes them with every vertex; <code>rtis replay</code> retraces \
+         one).</p><div class=\"fireflies\"><div class=\"ffimg\"><img id=\"ffimage\" \
+         alt=\"rung with its fireflies\"><svg id=\"ffmarks\" viewBox=\"0 0 {w} {h}\" \
+         preserveAspectRatio=\"none\"></svg></div><table><thead><tr><th>#</th><th>pixel</th>\
+         <th>sample</th><th>luminance</th><th>above its pixel</th><th>path</th></tr></thead><tbody id=\"fftable\">\
+         </tbody></table></div>",
+        colour_bar_labelled("timemax", "&micro;s (the rung's 99th percentile)"),
+        colour_bar(err_max, "(median 99th percentile)"),
+        colour_bar(product_max, "&micro;s (median 99th percentile)"),
     );
     let _ = write!(
         s,

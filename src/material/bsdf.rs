@@ -31,6 +31,16 @@ pub enum Bsdf {
 }
 
 impl Bsdf {
+    /// The BSDF's kind as scene files name it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Bsdf::RoughConductor(_) => "RoughConductor",
+            Bsdf::RoughDielectric(_) => "RoughDielectric",
+            Bsdf::RoughPlastic(_) => "RoughPlastic",
+            Bsdf::Plastic(_) => "Plastic",
+        }
+    }
+
     /// `f(wo, wi) |cos(theta_i)|` without delta lobes.
     #[inline]
     pub fn eval(&self, wo: Vec3A, wi: Vec3A) -> Vec3A {

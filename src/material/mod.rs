@@ -26,6 +26,7 @@ pub use model::Model;
 pub use phong::{Phong, reflect};
 pub use transmissive::{Refraction, Transmissive, fresnel_dielectric};
 
+use conductor::Conductor;
 use glam::Vec3A;
 
 /// A prepared material.
@@ -66,6 +67,38 @@ impl Material {
             Material::Transmissive(_) => true,
             Material::Bsdf(b) => b.transmits(),
             Material::Phong(_) | Material::Mirror(_) | Material::Conductor(_) => false,
+        }
+    }
+
+    /// The colour a denoiser's albedo layer expects of the material (OIDN's and Mitsuba's
+    /// `albedo` AOV): the diffuse reflectance of Phong and the plastics, the tint of mirrors
+    /// and glass (a rough dielectric's transmittance), a metal's reflectance at normal
+    /// incidence (its Fresnel term at `cos = 1` times its `specular_reflectance`).
+    pub fn albedo(&self) -> Vec3A {
+        let metal = |m: &Conductor| {
+            let f = |c: usize| conductor::fresnel_conductor(1.0, m.eta[c], m.k[c]);
+            Vec3A::new(f(0), f(1), f(2)) * m.specular_reflectance
+        };
+        match self {
+            Material::Phong(p) => p.kd,
+            Material::Mirror(m) => m.color,
+            Material::Conductor(m) => metal(m),
+            Material::Transmissive(g) => g.color,
+            Material::Bsdf(Bsdf::RoughConductor(b)) => metal(&b.metal),
+            Material::Bsdf(Bsdf::RoughDielectric(b)) => b.specular_transmittance,
+            Material::Bsdf(Bsdf::RoughPlastic(b)) => b.coating.diffuse_reflectance,
+            Material::Bsdf(Bsdf::Plastic(b)) => b.coating.diffuse_reflectance,
+        }
+    }
+
+    /// The material's kind as scene files name it (for replays and firefly reports).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Material::Phong(_) => "Phong",
+            Material::Mirror(_) => "Mirror",
+            Material::Conductor(_) => "Conductor",
+            Material::Transmissive(_) => "Transmissive",
+            Material::Bsdf(b) => b.kind(),
         }
     }
 

@@ -23,7 +23,7 @@ pub struct ExactSum {
 
 impl ExactSum {
     /// Add `v`, a finite `f32 >= 0` (NaN, infinities and negatives are the caller's to drop).
-    #[inline]
+    #[inline(always)]
     pub fn add(&mut self, v: f32) {
         debug_assert!(v.is_finite() && v >= 0.0);
         let bits = v.to_bits() & 0x7fff_ffff;
@@ -38,6 +38,34 @@ impl ExactSum {
         if mantissa == 0 {
             return;
         }
+        let (word, offset) = ((shift / 64) as usize, shift % 64);
+        let wide = (mantissa as u128) << offset;
+        self.add_at(word, wide as u64);
+        self.add_at(word + 1, (wide >> 64) as u64);
+    }
+
+    /// Add `v`, a finite `f64 >= 0` that is a whole multiple of `2^-149` below `2^171` (an
+    /// exact sum of `f32` values; others are the caller's bug).
+    #[inline]
+    pub fn add_f64(&mut self, v: f64) {
+        debug_assert!(v.is_finite() && v >= 0.0);
+        let bits = v.to_bits() & 0x7fff_ffff_ffff_ffff;
+        let exp = (bits >> 52) as i64;
+        // A subnormal f64 is far below 2^-149: only zero is a multiple of it.
+        if exp == 0 {
+            debug_assert_eq!(bits, 0, "{v} is not a multiple of 2^-149");
+            return;
+        }
+        // v = mantissa * 2^(exp - 1075) = mantissa * 2^(shift - 149).
+        let mantissa = (bits & 0xf_ffff_ffff_ffff) | 1 << 52;
+        let shift = exp - 1075 + 149;
+        let (mantissa, shift) = if shift < 0 {
+            // Its low bits are zero (a multiple of 2^-149): the shift drops nothing.
+            debug_assert_eq!(mantissa & ((1 << -shift) - 1), 0, "{v}");
+            (mantissa >> -shift, 0)
+        } else {
+            (mantissa, shift as u32)
+        };
         let (word, offset) = ((shift / 64) as usize, shift % 64);
         let wide = (mantissa as u128) << offset;
         self.add_at(word, wide as u64);
@@ -89,7 +117,7 @@ pub struct RgbSum(pub [ExactSum; 3]);
 
 impl RgbSum {
     /// Add a sample's radiance (finite, non-negative).
-    #[inline]
+    #[inline(always)]
     pub fn add(&mut self, l: Vec3A) {
         self.0[0].add(l.x);
         self.0[1].add(l.y);
@@ -143,6 +171,24 @@ mod tests {
         let mut big = ExactSum::default();
         big.add(f32::MAX);
         assert_eq!(big.to_f64(), f32::MAX as f64);
+        // An f64 that sums f32 values exactly lands on the bits of adding them one by one,
+        // from the subnormal f32 to the largest.
+        let f32_sub = f32::from_bits(1);
+        for group in [
+            &[1.0, 0.1, 7.25][..],
+            &[f32_sub, f32::MIN_POSITIVE / 8.0],
+            &[3.5e30],
+            &[f32::MAX],
+        ] {
+            let (mut one_by_one, mut at_once) = (ExactSum::default(), ExactSum::default());
+            let mut sum = 0.0f64;
+            for &v in group {
+                one_by_one.add(v);
+                sum += v as f64;
+            }
+            at_once.add_f64(sum);
+            assert_eq!(at_once, one_by_one, "{group:?}");
+        }
         let mut tiny = ExactSum::default();
         tiny.add(f32::from_bits(1));
         assert_eq!(tiny.to_f64(), 2f64.powi(-149));

@@ -6,6 +6,7 @@ pub mod effects;
 pub mod estimate;
 pub mod exact;
 pub mod film;
+pub mod inspect;
 pub mod output;
 pub mod pass;
 pub mod progressive;
@@ -14,8 +15,9 @@ pub mod tev;
 
 pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};
 
+use crate::geometry::Ray;
 use crate::sampling::{Sampler, pixel_sample};
-use crate::shader::radiance;
+use crate::shader::{self, Record, Technique};
 use crate::stats::RayStats;
 use exact::RgbSum;
 use film::Image;
@@ -57,9 +59,9 @@ impl Rendered {
 /// The colour of pixel `(col, row)`: the mean radiance of its `spp` camera samples, summed
 /// exactly ([`exact`]), so that the order of the samples never changes a bit.
 ///
-/// The last line of defence against numerical failure: a sample whose radiance is NaN,
-/// infinite or negative is dropped (it adds zero) and counted in `stats.dropped`, so one bad
-/// sample can never poison a pixel, and the count says that it happened.
+/// The last line of defence against numerical failure: a sample with a contribution that is
+/// NaN, infinite or negative is dropped (it adds zero) and counted in `stats.dropped`, so one
+/// bad sample can never poison a pixel, and the count says that it happened.
 #[inline]
 pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStats) -> Vec3A {
     pixel_sum(scene, col, row, 0..scene.film.spp, stats).mean(scene.film.spp as u64)
@@ -76,13 +78,16 @@ pub fn pixel_sum(
 ) -> RgbSum {
     let mut sum = RgbSum::default();
     for s in samples {
-        sum.add(render_sample(scene, col, row, s, stats));
+        let mut sample = SampleSum::default();
+        trace_sample(scene, col, row, s, stats, &mut sample);
+        sample.keep_into(&mut sum, stats);
     }
     sum
 }
 
-/// Radiance of camera sample `s` of pixel `(col, row)`, from the sample's own random stream;
-/// zero (and counted in `stats.dropped`) when it is NaN, infinite or negative.
+/// The exact sum of the contributions of camera sample `s` of pixel `(col, row)` (the path
+/// tracer's are several, every other shader's one), from the sample's own random stream;
+/// zero, and counted in `stats.dropped`, when one of them is NaN, infinite or negative.
 #[inline]
 pub fn render_sample(
     scene: &RenderScene,
@@ -90,7 +95,32 @@ pub fn render_sample(
     row: u32,
     s: u32,
     stats: &mut RayStats,
-) -> Vec3A {
+) -> RgbSum {
+    let mut sample = SampleSum::default();
+    trace_sample(scene, col, row, s, stats, &mut sample);
+    sample.kept(stats)
+}
+
+/// Trace camera sample `s` of pixel `(col, row)` from the sample's own random stream, telling
+/// `rec` what it finds (its contributions, and the path's events if it keeps them).
+#[inline]
+pub fn trace_sample<R: Record>(
+    scene: &RenderScene,
+    col: u32,
+    row: u32,
+    s: u32,
+    stats: &mut RayStats,
+    rec: &mut R,
+) {
+    let ray = camera_ray(scene, col, row, s);
+    let mut tracer = scene.tracer(ray.1, stats);
+    shader::radiance(&scene.shader, &mut tracer, &ray.0, rec);
+}
+
+/// The camera ray of sample `s` of pixel `(col, row)`, and the sample's random stream after
+/// it (which the shader goes on drawing from).
+#[inline(always)]
+pub fn camera_ray(scene: &RenderScene, col: u32, row: u32, s: u32) -> (Ray, Sampler) {
     let film = &scene.film;
     let pixel = row as u64 * film.width as u64 + col as u64;
     let mut sampler = Sampler::new(scene.seed, pixel, s as u64);
@@ -100,13 +130,97 @@ pub fn render_sample(
     let u = (col as f32 + dx) / film.width as f32;
     let v = (row as f32 + dy) / film.height as f32;
     let ray = scene.camera.ray(u, v, || sampler.next_2d());
-    let mut tracer = scene.tracer(sampler, stats);
-    let l = radiance(&scene.shader, &mut tracer, &ray);
-    if l.is_finite() && l.min_element() >= 0.0 {
-        l
-    } else {
-        stats.dropped += 1;
-        Vec3A::ZERO
+    (ray, sampler)
+}
+
+/// The exact sum of one sample's contributions, and whether one of them failed (NaN, infinite
+/// or negative).
+///
+/// Most samples' contributions add exactly in `f64` (a sum of `f32` values within 29 binary
+/// orders of magnitude of one another has no rounding in `f64`'s 53 bits), so each is added
+/// there and checked by Knuth's TwoSum, whose error term is the exact rounding error of the
+/// add (Knuth, TAOCP vol. 2, 4.2.2): a contribution whose add would round goes to the
+/// fixed-point accumulator instead. The sum is then exact either way, at a few floating-point
+/// operations per contribution instead of three fixed-point adds.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SampleSum {
+    /// The contributions whose adds were exact, summed in `f64`.
+    fast: glam::DVec3,
+    /// The others, summed in fixed point.
+    rest: RgbSum,
+    /// Whether `rest` holds any.
+    rounded: bool,
+    /// True if a contribution was NaN, infinite or negative: the sample is dropped.
+    pub failed: bool,
+}
+
+impl SampleSum {
+    /// The exact sum of the valid contributions.
+    #[inline]
+    pub fn sum(&self) -> RgbSum {
+        let mut sum = RgbSum::default();
+        self.add_to(&mut sum);
+        sum
+    }
+
+    /// Add the exact sum of the valid contributions to `sum`.
+    #[inline(always)]
+    fn add_to(&self, sum: &mut RgbSum) {
+        for (c, s) in sum.0.iter_mut().enumerate() {
+            s.add_f64(self.fast[c]);
+        }
+        if self.rounded {
+            *sum += self.rest;
+        }
+    }
+
+    /// Add the sum the pixel keeps to the pixel's `sum`: this one, or nothing (counted in
+    /// `stats.dropped`) if it failed.
+    #[inline(always)]
+    pub fn keep_into(&self, sum: &mut RgbSum, stats: &mut RayStats) {
+        if self.failed {
+            stats.dropped += 1;
+        } else {
+            self.add_to(sum);
+        }
+    }
+
+    /// The sum the pixel keeps: this one, or zero (counted in `stats.dropped`) if it failed.
+    #[inline]
+    pub fn kept(self, stats: &mut RayStats) -> RgbSum {
+        if self.failed {
+            stats.dropped += 1;
+            RgbSum::default()
+        } else {
+            self.sum()
+        }
+    }
+}
+
+/// True for a contribution a pixel can hold: finite and non-negative.
+#[inline]
+pub fn valid(l: Vec3A) -> bool {
+    l.is_finite() && l.min_element() >= 0.0
+}
+
+impl Record for SampleSum {
+    #[inline(always)]
+    fn add(&mut self, l: Vec3A, _: Technique, _: u32) {
+        if !valid(l) {
+            self.failed = true;
+            return;
+        }
+        // TwoSum: s = a + b and its rounding error, exactly.
+        let (a, b) = (self.fast, l.as_dvec3());
+        let s = a + b;
+        let bb = s - a;
+        let err = (a - (s - bb)) + (b - bb);
+        if err == glam::DVec3::ZERO {
+            self.fast = s;
+        } else {
+            self.rest.add(l);
+            self.rounded = true;
+        }
     }
 }
 
@@ -186,34 +300,51 @@ fn by_tiles<T: Clone + Default + Send>(
     stop: &AtomicBool,
     pixel: impl Fn(u32, u32, &mut RayStats) -> T + Sync,
 ) -> Tiled<T> {
+    by_tiles_with(scene, on_tile, stop, |col, row, stats, _: &mut ()| {
+        pixel(col, row, stats)
+    })
+    .0
+}
+
+/// [`by_tiles`] with a state per tile that `pixel` updates (for what a tile keeps of its
+/// pixels, as the largest samples); the states of the tiles rendered come back in tile order.
+fn by_tiles_with<T: Clone + Default + Send, S: Default + Send>(
+    scene: &RenderScene,
+    on_tile: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+    pixel: impl Fn(u32, u32, &mut RayStats, &mut S) -> T + Sync,
+) -> (Tiled<T>, Vec<S>) {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..tiles_x).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let done: Vec<Option<(Vec<T>, RayStats)>> = tiles
+    let done: Vec<Option<(Vec<T>, RayStats, S)>> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             if stop.load(Ordering::Relaxed) {
                 return None;
             }
             let mut stats = RayStats::default();
+            let mut state = S::default();
             let mut px = Vec::with_capacity((TILE * TILE) as usize);
             for row in y0..(y0 + TILE).min(h) {
                 for col in x0..(x0 + TILE).min(w) {
-                    px.push(pixel(col, row, &mut stats));
+                    px.push(pixel(col, row, &mut stats, &mut state));
                 }
             }
             on_tile();
-            Some((px, stats))
+            Some((px, stats, state))
         })
         .collect();
     let mut pixels = vec![T::default(); w as usize * h as usize];
     let mut stats = RayStats::default();
+    let mut states = Vec::new();
     let mut tiles_done = 0;
-    for (&(x0, y0), (px, st)) in tiles.iter().zip(done).filter_map(|(t, d)| Some((t, d?))) {
+    for (&(x0, y0), (px, st, state)) in tiles.iter().zip(done).filter_map(|(t, d)| Some((t, d?))) {
         stats += st;
+        states.push(state);
         tiles_done += 1;
         let tw = (x0 + TILE).min(w) - x0;
         for (i, p) in px.into_iter().enumerate() {
@@ -221,16 +352,52 @@ fn by_tiles<T: Clone + Default + Send>(
             pixels[(row * w + col) as usize] = p;
         }
     }
-    Tiled {
+    let tiled = Tiled {
         pixels,
         stats,
         seconds: start.elapsed().as_secs_f64(),
         tiles_done,
         tiles: tiles.len() as u64,
-    }
+    };
+    (tiled, states)
 }
 
 /// Number of tiles a render of this film has (for progress bars).
 pub fn tile_count(scene: &RenderScene) -> u64 {
     (scene.film.width.div_ceil(TILE) * scene.film.height.div_ceil(TILE)) as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sample's sum is exact whatever its contributions: those whose f64 adds would round go
+    /// to the fixed-point accumulator, the total is the exact one; a failed contribution
+    /// drops the sample.
+    #[test]
+    fn sample_sums_are_exact_over_any_range() {
+        let mut rng = Sampler::new(7, 0, 0);
+        for _ in 0..2000 {
+            let (mut sample, mut want) = (SampleSum::default(), RgbSum::default());
+            let n = 1 + (rng.next_f32() * 12.0) as usize;
+            for _ in 0..n {
+                // Magnitudes from 2^-140 to 2^120.
+                let v = |u: f32| (2.0f32).powf(u * 260.0 - 140.0);
+                let l = Vec3A::new(v(rng.next_f32()), v(rng.next_f32()), v(rng.next_f32()));
+                sample.add(l, Technique::Light, 1);
+                want.add(l);
+            }
+            assert_eq!(sample.sum(), want);
+            let mut stats = RayStats::default();
+            let mut pixel = RgbSum::default();
+            sample.keep_into(&mut pixel, &mut stats);
+            assert_eq!(pixel, want);
+        }
+        let mut sample = SampleSum::default();
+        sample.add(Vec3A::ONE, Technique::Light, 1);
+        sample.add(Vec3A::new(1.0, f32::NAN, 0.0), Technique::Bsdf, 2);
+        let mut stats = RayStats::default();
+        assert_eq!(sample.kept(&mut stats), RgbSum::default());
+        assert_eq!(stats.dropped, 1);
+    }
 }

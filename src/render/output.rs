@@ -249,3 +249,30 @@ pub fn load(path: &Path) -> Result<Image, OutputError> {
             .collect(),
     })
 }
+
+/// Write float channels `layers` (name and row-major values) of a `width` x `height` image as
+/// one OpenEXR file, through a temporary file and a rename.
+pub fn write_layers(
+    path: &Path,
+    width: u32,
+    height: u32,
+    layers: &[(String, Vec<f32>)],
+) -> Result<(), OutputError> {
+    use exr::prelude::*;
+    let channels: Vec<AnyChannel<FlatSamples>> = layers
+        .iter()
+        .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v.clone())))
+        .collect();
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::named("rtis"),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels.into()),
+    );
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    exr::prelude::Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| io_err(path, e))?;
+    write_file(path, &bytes.into_inner())
+}

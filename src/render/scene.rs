@@ -170,6 +170,7 @@ impl RenderScene {
             sampler,
             stats,
             audit: self.audit,
+            traversal: None,
         }
     }
 }

@@ -11,12 +11,14 @@ pub mod global;
 mod intersection;
 mod normal;
 pub mod path;
+pub mod record;
 pub mod surface;
 
 pub use global::Global;
 pub use path::Path;
+pub use record::{Record, Technique};
 
-use crate::accel::Geometry;
+use crate::accel::{Geometry, Traversal};
 use crate::effects::Effects;
 use crate::geometry::{Hit, Ray};
 use crate::light::{Emitters, Light};
@@ -93,6 +95,9 @@ pub struct Tracer<'a> {
     pub stats: &'a mut RayStats,
     /// The observer of every ray traced, if any ([`RayAudit`]).
     pub audit: Option<RayAudit>,
+    /// The counters of nodes and primitives tested, when an inspected render measures them
+    /// (a render leaves it unset: its queries are compiled without counters).
+    pub traversal: Option<&'a Traversal>,
 }
 
 impl Tracer<'_> {
@@ -112,14 +117,20 @@ impl Tracer<'_> {
     #[inline]
     pub fn trace(&mut self, ray: &Ray, kind: RayKind) -> Option<Hit> {
         self.count(ray, kind);
-        self.geometry.intersect(ray)
+        match self.traversal {
+            None => self.geometry.intersect(ray),
+            Some(t) => self.geometry.intersect_tallied(ray, t),
+        }
     }
 
     /// True if nothing blocks the shadow ray (counted).
     #[inline]
     pub fn unoccluded(&mut self, ray: &Ray) -> bool {
         self.count(ray, RayKind::Shadow);
-        !self.geometry.occluded(ray)
+        !match self.traversal {
+            None => self.geometry.occluded(ray),
+            Some(t) => self.geometry.occluded_tallied(ray, true, t),
+        }
     }
 
     /// [`Tracer::unoccluded`] for a shadow ray towards a point light that no plane can hide
@@ -127,14 +138,19 @@ impl Tracer<'_> {
     #[inline]
     pub fn unoccluded_in_room(&mut self, ray: &Ray) -> bool {
         self.count(ray, RayKind::Shadow);
-        !self.geometry.occluded_in_room(ray)
+        !match self.traversal {
+            None => self.geometry.occluded_in_room(ray),
+            Some(t) => self.geometry.occluded_tallied(ray, false, t),
+        }
     }
 }
 
-/// Radiance arriving at the camera along the camera ray `ray` under `shader`.
+/// Radiance arriving at the camera along the camera ray `ray` under `shader`, told to `rec`:
+/// the path tracer's contributions one by one, every other shader's radiance whole
+/// ([`Technique::Shader`]).
 #[inline]
-pub fn radiance(shader: &Shader, tr: &mut Tracer, ray: &Ray) -> Vec3A {
-    match *shader {
+pub fn radiance<R: Record>(shader: &Shader, tr: &mut Tracer, ray: &Ray, rec: &mut R) {
+    let l = match *shader {
         Shader::Intersection { color } => intersection::radiance(tr, ray, color),
         Shader::Depth {
             max_distance,
@@ -146,6 +162,7 @@ pub fn radiance(shader: &Shader, tr: &mut Tracer, ray: &Ray) -> Vec3A {
             light_samples,
         } => direct::radiance(tr, ray, max_specular, light_samples),
         Shader::Global(g) => global::radiance(tr, ray, &g),
-        Shader::Path(p) => path::radiance(tr, ray, &p),
-    }
+        Shader::Path(p) => return path::radiance(tr, ray, &p, rec),
+    };
+    rec.add(l, Technique::Shader, 0);
 }

@@ -23,6 +23,7 @@
 //!   by `eta^2 = (n_wo / n_wi)^2`, as radiance does (`docs/transport.md`).
 
 use super::Tracer;
+use super::record::{Event, Record, Technique, arr, ray_name};
 use super::surface::{
     Interaction, Lobe, area_lights, emitted, one_light, point_lights, reflectance, sky,
     specular_bounce,
@@ -80,12 +81,14 @@ struct Scattered {
 /// the largest `max_depth` and `rr_depth` a scene may ask for.
 pub const MAX_DEPTH: u32 = 1024;
 
-/// Radiance along a camera ray. Scattering into an effect that is off ends the path.
-pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
+/// Trace the path of a camera ray, telling `rec` each contribution it finds (with its
+/// technique and the path's length) and, if it keeps them, each event. The radiance along the
+/// camera ray is the sum of the contributions. Scattering into an effect that is off ends the
+/// path.
+pub fn radiance<R: Record>(tr: &mut Tracer, camera_ray: &Ray, p: &Path, rec: &mut R) {
     let model = tr.model;
     let lights = p.lights_under(model);
     let max_depth = p.max_depth.unwrap_or(MAX_DEPTH).min(MAX_DEPTH);
-    let mut l = Vec3A::ZERO;
     let mut beta = Vec3A::ONE;
     let mut ray = *camera_ray;
     let mut kind = RayKind::Camera;
@@ -97,14 +100,33 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
     // The Phong vertex the ray left, if it was BRDF-sampled there (None for camera rays and
     // after mirrors and glass).
     let mut scattered: Option<Scattered> = None;
+    // Whether any vertex so far sampled its direction from a non-delta lobe: light met after
+    // mirrors and glass only is `Emitted`, after such a vertex `Bsdf`.
+    let mut sampled = false;
+    let found = |scattered: Option<Scattered>, sampled: bool| match (scattered, sampled) {
+        (None, false) => Technique::Emitted,
+        _ => Technique::Bsdf,
+    };
     loop {
         // Escaped rays see the background, or the environment light weighted against the
         // light sample that could have found it.
         let Some(hit) = tr.trace(&ray, kind) else {
-            l += beta * escaped(tr, &ray, scattered, lights);
+            rec.event(|| Event::Escape { d: arr(ray.d) });
+            let le = escaped(tr, &ray, scattered, lights);
+            add(rec, beta * le, found(scattered, sampled), depth);
             break;
         };
         let si = Interaction::new(tr, &ray, hit);
+        rec.event(|| {
+            let material = tr.geometry.prim(si.hit.prim).material;
+            Event::Hit {
+                p: arr(si.hit.p),
+                n: arr(si.n),
+                material,
+                kind: si.material().kind(),
+                beta: arr(beta),
+            }
+        });
         // Emitted light L_e, weighted against the light sample that could have found it.
         let le = emitted(tr, &si);
         if le != Vec3A::ZERO {
@@ -118,15 +140,21 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                     power_heuristic(v.pdf, pdf_light)
                 }
             };
-            l += beta * le * w;
+            add(rec, beta * le * w, found(scattered, sampled), depth);
         }
         if depth >= max_depth {
             break;
         }
-        // Scatter: the next ray, its weight g(wi) / pdf(wi) and its kind.
-        let (next_ray, weight, next) = match (si.material(), model) {
+        // Scatter: the next ray, its weight g(wi) / pdf(wi), its density (None for a
+        // specular direction) and its kind.
+        let (next_ray, weight, pdf, next) = match (si.material(), model) {
             (Material::Phong(phong), _) => {
-                l += beta * next_event(tr, &si, phong, p);
+                add(
+                    rec,
+                    beta * next_event(tr, &si, phong, p),
+                    Technique::Light,
+                    depth + 1,
+                );
                 if !tr.effects.indirect {
                     break;
                 }
@@ -135,14 +163,15 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                     break;
                 };
                 scattered = Some(Scattered { p: si.hit.p, pdf });
-                (si.spawn(wi), weight, RayKind::Indirect)
+                (si.spawn(wi), weight, Some(pdf), RayKind::Indirect)
             }
             // A BSDF: next-event estimation with its eval and pdf, then its own sampler. Its
             // weights are f |cos| / pdf under either model (rough materials ask for the
             // Physical one; see docs/transport.md).
             (Material::Bsdf(bsdf), _) => {
                 let shading = si.shading(tr, bsdf);
-                l += beta * next_event(tr, &si, &shading, p);
+                let nee = next_event(tr, &si, &shading, p);
+                add(rec, beta * nee, Technique::Light, depth + 1);
                 if !tr.effects.indirect {
                     break;
                 }
@@ -159,7 +188,13 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                     pdf: s.pdf,
                 });
                 eta_scale *= s.eta * s.eta;
-                (si.spawn(frame.to_world(s.wi)), s.weight, RayKind::Indirect)
+                let pdf = (!s.delta).then_some(s.pdf);
+                (
+                    si.spawn(frame.to_world(s.wi)),
+                    s.weight,
+                    pdf,
+                    RayKind::Indirect,
+                )
             }
             // Fresnel-weighted choice between reflection and refraction.
             (Material::Transmissive(g), Model::Physical) => {
@@ -179,13 +214,13 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
                     break;
                 }
                 scattered = None;
-                (si.spawn(wi), weight, kind)
+                (si.spawn(wi), weight, None, kind)
             }
             // Mirrors, and the course's glass: the one scattered ray, as in Direct and Global.
             _ => match specular_bounce(&si, tr.effects) {
-                Some(bounce) => {
+                Some((ray, weight, kind)) => {
                     scattered = None;
-                    bounce
+                    (ray, weight, None, kind)
                 }
                 None => break,
             },
@@ -194,12 +229,21 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
         if si.leaks(next_ray.d) {
             break;
         }
+        rec.event(|| Event::Scatter {
+            wi: arr(next_ray.d),
+            pdf,
+            weight: arr(weight),
+            ray: ray_name(next),
+        });
+        sampled |= pdf.is_some();
         beta *= weight;
         depth += 1;
         // Russian roulette: survive with probability q, divide by q to stay unbiased.
         if depth >= p.rr_depth {
             let q = (beta * eta_scale).max_element().min(0.95);
-            if q <= 0.0 || tr.sampler.next_f32() >= q {
+            let survived = !(q <= 0.0 || tr.sampler.next_f32() >= q);
+            rec.event(|| Event::Roulette { q, survived });
+            if !survived {
                 break;
             }
             beta /= q;
@@ -207,7 +251,19 @@ pub fn radiance(tr: &mut Tracer, camera_ray: &Ray, p: &Path) -> Vec3A {
         ray = next_ray;
         kind = next;
     }
-    l
+}
+
+/// Tell `rec` of contribution `l` (found by `technique` along a path of `vertices` scattering
+/// vertices), and of the event when it keeps events; a zero contribution is not told.
+#[inline(always)]
+fn add<R: Record>(rec: &mut R, l: Vec3A, technique: Technique, vertices: u32) {
+    if l != Vec3A::ZERO {
+        rec.add(l, technique, vertices);
+        rec.event(|| Event::Add {
+            technique,
+            l: arr(l),
+        });
+    }
 }
 
 /// Radiance a ray that leaves the scene brings back: the background, or the environment's
@@ -260,6 +316,7 @@ fn next_event<L: Lobe>(tr: &mut Tracer, si: &Interaction, lobe: &L, p: &Path) ->
 
 /// Sample a direction at a Phong vertex: the direction, its weight `g / pdf` and its density;
 /// `None` when it falls below the surface or has no weight.
+#[inline(always)]
 fn sample_phong(
     tr: &mut Tracer,
     phong: &Phong,

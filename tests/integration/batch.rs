@@ -343,12 +343,10 @@ unsafe fn in_lanes<L: rtis::accel::Floats>(
     // SAFETY: as above.
     let live_mask = unsafe { L::from_array(flags).cmpne(L::splat(0.0)) };
     let m = g.occluded_lanes(
-        [v(0), v(1), v(2)],
-        [v(3), v(4), v(5)],
-        v(6),
-        v(7),
+        ([v(0), v(1), v(2)], [v(3), v(4), v(5)], v(6), v(7)),
         planes,
         live_mask,
+        &(),
     );
     let want: u32 = (0..L::LANES)
         .filter(|&i| live >> i & 1 == 1 && one[first + i])

@@ -126,19 +126,21 @@ proptest! {
     /// Reciprocity: `f(wo, wi) / n_o^2 = f(wi, wo) / n_i^2` with the cosine taken out (Veach
     /// 1997, eq. 5.14: the indices are 1 except inside a dielectric, whose radiance BTDF
     /// carries `1 / eta'^2`), for every BSDF at roughness 1e-4 to 1 and indices 1.0001 to 4;
-    /// `f` is finite and non-negative. Tolerance 1e-3 relative, for directions 1e-2 or more
-    /// from the horizon and from the horizon of their (generalised) half vector's facet,
-    /// `n_o wo + n_i wi`: a direction grazing the facet is refracted near total internal
+    /// `f` is finite and non-negative. Tolerance 1e-3 relative, for directions 3e-2 or more
+    /// from the horizon (at `wo.z` = 0.0104 a Beckmann dielectric of index 4 and roughness 1
+    /// gave 0.12%: the cosine divided out there is as ill-conditioned) and from the horizon of
+    /// their (generalised) half vector's facet, `n_o wo + n_i wi`: a direction grazing the facet is refracted near total internal
     /// reflection, where the transmitted cosine `sqrt(1 - eta^2 sin^2)` is ill-conditioned (its
-    /// derivative unbounded), so single precision cannot give both directions 1e-3 (seen: 0.15%
-    /// at `|wi.wm|` = 0.007).
+    /// relative error grows as `1 / cos^2`), so single precision cannot give both directions
+    /// 1e-3 (seen: 0.15% at `|wi.wm|` = 0.007, and at 0.0107, where moving `wi` by 1e-6 moved
+    /// `f(wo, wi)` by 0.4%).
     #[test]
     fn every_bsdf_is_reciprocal(b in any_bsdf(), wo in unit(), wi in unit()) {
         let (a, c) = (b.eval(wo, wi), b.eval(wi, wo));
         prop_assert!(a.is_finite() && a.min_element() >= 0.0, "{a}");
         let wm = (index(&b, wo) * wo + index(&b, wi) * wi).normalize_or_zero();
-        let off_facet_horizon = wo.dot(wm).abs() > 1e-2 && wi.dot(wm).abs() > 1e-2;
-        if wo.z.abs() > 1e-2 && wi.z.abs() > 1e-2 && off_facet_horizon {
+        let off_facet_horizon = wo.dot(wm).abs() > 3e-2 && wi.dot(wm).abs() > 3e-2;
+        if wo.z.abs() > 3e-2 && wi.z.abs() > 3e-2 && off_facet_horizon {
             let no2 = index(&b, wo).powi(2);
             let ni2 = index(&b, wi).powi(2);
             let (fa, fc) = (a / wi.z.abs() / no2, c / wo.z.abs() / ni2);

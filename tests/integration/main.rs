@@ -24,6 +24,7 @@ mod global_weights;
 mod golden;
 mod hard_cases;
 mod import;
+mod inspect;
 mod lights;
 mod material_textures;
 mod materials;

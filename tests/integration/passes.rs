@@ -226,7 +226,7 @@ fn partial_merges_preview_the_mean_of_exactly_their_samples() {
                 let mut sum = rtis::render::exact::RgbSum::default();
                 let mut stats = rtis::stats::RayStats::default();
                 for &k in &held {
-                    sum.add(rtis::render::render_sample(&s, col, row, k, &mut stats));
+                    sum += rtis::render::render_sample(&s, col, row, k, &mut stats);
                 }
                 let m = sum.mean(held.len() as u64);
                 want.push([m.x.to_bits(), m.y.to_bits(), m.z.to_bits()]);

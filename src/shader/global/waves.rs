@@ -309,7 +309,8 @@ fn trace_tree(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         s.phongs.clear();
         // Each bounce of the mirror and glass chains in one batch, until every chain ends.
         while !s.now.rays.is_empty() {
-            tr.geometry.intersect_batch(&s.now.rays, &mut s.hits);
+            tr.geometry
+                .intersect_batch_tallied(&s.now.rays, &mut s.hits, tr.traversal);
             s.bounced.clear();
             for k in 0..s.now.rays.len() {
                 let i = s.now.nodes[k];
@@ -643,9 +644,12 @@ unsafe fn point_sums<L: Floats>(
                 audit_lanes(audit, o, wi, o_err, dist * end, L::bitmask(valid));
             }
             let planes = !in_room;
-            let blocked = tr
-                .geometry
-                .occluded_lanes(o, wi, o_err, dist * end, planes, valid);
+            let blocked = tr.geometry.occluded_lanes(
+                (o, wi, o_err, dist * end),
+                planes,
+                valid,
+                &tr.traversal,
+            );
             valid & !blocked
         } else {
             valid

@@ -19,6 +19,7 @@
 //! is the depth-first walk's to the bit.
 
 use super::{LightLanes, Scratch, point_sums};
+use crate::accel::Tally;
 use crate::accel::lanes::{RayLanes, abs_max, dot};
 use crate::accel::{Floats, Isa, MAX_LANES};
 use crate::geometry::{Hit, Origins, Ray, UNIT_ROUNDOFF};
@@ -291,6 +292,7 @@ unsafe fn chunk<L: Floats>(
     let lanes = RayLanes::from_parts(o, d, o_err);
     // The nearest hits and their records, in the lanes.
     let near = unsafe { geometry.nearest_lanes(&lanes, t_max) };
+    tr.traversal.prims(count as u64 * geometry.lane_prims());
     let (hit, t_max, slot) = (near.hit, near.t, array(near.slot));
     // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal),
     // and `Origins::new`: the point moved off the surface by its error's projection on the
