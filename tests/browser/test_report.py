@@ -75,3 +75,44 @@ def test_report_loads_shows_its_parts_and_the_slider_works(report, browser):
     # The equal-error view answers for every family.
     assert len(browser.find_elements(By.CSS_SELECTOR, "#equal tr")) >= 3
     assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+
+
+def test_report_shows_where_the_time_goes_and_the_fireflies(report, browser):
+    from selenium.webdriver.common.by import By
+
+    browser.get(report.as_uri())
+    rows = browser.find_elements(By.CSS_SELECTOR, "#rows tr")
+    maps = ["timemap", "errmap", "productmap", "ffimage"]
+
+    def shown():
+        out = {}
+        for m in maps:
+            img = browser.find_element(By.ID, m)
+            assert img.get_attribute("src").startswith("data:image/png;base64,")
+            assert browser.execute_script(
+                "return arguments[0].complete && arguments[0].naturalWidth > 0", img)
+            assert img.is_displayed()
+            out[m] = img.get_attribute("src")
+        return out
+
+    # The time, error and error x time maps of the first rung, its scale written out.
+    first = shown()
+    assert float(browser.find_element(By.ID, "timemax").text) > 0
+    # Its fireflies: one circle per table row, at most eight, on the rung's image, each row
+    # naming a path of surfaces.
+    circles = browser.find_elements(By.CSS_SELECTOR, "#ffmarks circle.ff")
+    table = browser.find_elements(By.CSS_SELECTOR, "#fftable tr")
+    assert 1 <= len(circles) == len(table) <= 8
+    assert all(c.is_displayed() for c in circles)
+    # Choosing the last rung (Path at the most spp) changes every map and the fireflies.
+    rows[-1].click()
+    last = shown()
+    assert all(first[m] != last[m] for m in maps)
+    table = browser.find_elements(By.CSS_SELECTOR, "#fftable tr")
+    assert len(table) >= 1
+    path = table[0].find_elements(By.TAG_NAME, "td")[-1].text
+    assert "Phong" in path or "Mirror" in path or "Transmissive" in path, path
+    # Ranked: each firefly stands out no more than the one before.
+    excess = [float(r.find_elements(By.TAG_NAME, "td")[4].text) for r in table]
+    assert excess == sorted(excess, reverse=True), excess
+    assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
