@@ -58,6 +58,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 README = os.path.join(ROOT, "README.md")
@@ -311,12 +312,13 @@ def inspect(_runs):
         box = "scenes/cornell-physical.ron"
         args = [box, "--width", str(width), "--spp", "16"]
         def seconds(extra):
+            """Best wall-clock seconds of three runs (the whole command: reading the scene,
+            rendering, writing every file)."""
             best = None
             for _ in range(3):
-                stats = os.path.join(d, "stats.json")
-                run(["render", *args, "-o", os.path.join(d, "box.exr"), "--stats", stats, *extra])
-                with open(stats) as f:
-                    t = json.load(f)["seconds"]
+                start = time.perf_counter()
+                run(["render", *args, "-o", os.path.join(d, "box.exr"), *extra])
+                t = time.perf_counter() - start
                 best = t if best is None else min(best, t)
             return best
         plain = seconds([])
@@ -330,18 +332,21 @@ def inspect(_runs):
     if len(lines) > 16:
         lines = lines[:8] + ["..."] + lines[-7:]
     return "\n".join([
-        "| the Path 16-spp rung | time per pixel | error &times; time |",
+        "| the Path 16-spp rung | time per pixel | variance &times; time |",
         "|---|---|---|",
         "| ![the rung](docs/images/inspect-image.png) | ![time per pixel](docs/images/inspect-time.png) "
-        "| ![error times time](docs/images/inspect-efficiency.png) |",
+        "| ![variance times time](docs/images/inspect-efficiency.png) |",
         "",
         f"*`rtis converge {scene}` at {width} px, the report's maps of its Path rung at 16 spp "
-        f"(`Path`, Course model): time per pixel on the rung's own scale, and squared error times time "
-        f"(the inverse efficiency). {rung['fireflies'][0]['path']} made its largest firefly.*",
+        f"(`Path`, Course model): time per pixel on the rung's own scale, and the variance per pixel "
+        f"(across 2 seeds) times the time per pixel, the inverse efficiency (bright: error that is "
+        f"dear to remove). The path "
+        f"{rung['fireflies'][0]['path']} made the sample that stands out most above the reference.*",
         "",
         f"An inspected render (`--aov --parts --fireflies 5`) of `{box}` at {width} px and 16 spp took "
-        f"{inspected:.2f} s against {plain:.2f} s plain ({inspected / plain:.2f}x): the price of the "
-        f"counters, the clock, the split by technique and bounce and the first-hit layers. Its largest "
+        f"{inspected:.2f} s against {plain:.2f} s plain, wall clock ({inspected / plain:.2f}x): the price "
+        f"of the counters, the clock, the split by technique and bounce, the first-hit layers and "
+        f"writing two more files; the cheaper a scene's samples, the larger its share. Its largest "
         f"firefly, pixel {x},{y} sample {top['sample']} (luminance {top['luminance']:.3g}, "
         f"{top['excess']:.3g} above its pixel), replayed:",
         "",

@@ -4,7 +4,8 @@ use serde::Serialize;
 use std::ops::AddAssign;
 
 /// Why a ray was traced.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum RayKind {
     /// From the camera through a pixel.
     Camera,
@@ -31,8 +32,9 @@ pub struct RayStats {
     pub refraction: u64,
     /// Indirect rays.
     pub indirect: u64,
-    /// Camera samples whose radiance came out NaN, infinite or negative: dropped (counted as
-    /// zero), never averaged into a pixel. Zero for every valid scene; not a ray count.
+    /// Camera samples with a contribution that came out NaN, infinite or negative, or whose
+    /// contributions sum beyond the largest `f32`: dropped (counted as zero), never averaged
+    /// into a pixel. Zero for every valid scene; not a ray count.
     pub dropped: u64,
 }
 

@@ -79,8 +79,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE.exr", conflicts_with_all = INSPECT_CONFLICTS)]
     aov: Option<PathBuf>,
     /// Also write the image split by technique (emitted, light-sampled, BSDF-sampled, each
-    /// with its MIS weight) and by bounce (direct, 1, 2, 3+) as layers of this EXR; the parts
-    /// sum exactly to the image. Path only.
+    /// with its MIS weight) and by bounce (direct, 1, 2, 3+) as layers of this EXR: the parts'
+    /// exact sums add up to the image's, bit for bit (the layers, each rounded to f32, to
+    /// within rounding). Path only.
     #[arg(long, value_name = "FILE.exr", conflicts_with_all = INSPECT_CONFLICTS)]
     parts: Option<PathBuf>,
     /// Keep the N single samples that stand out most above their pixel's mean (by luminance),
@@ -88,6 +89,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", conflicts_with_all = INSPECT_CONFLICTS,
           value_parser = clap::value_parser!(u32).range(1..=MAX_FIREFLIES as i64))]
     fireflies: Option<u32>,
+}
+
+/// Where `--fireflies` writes: NAME.fireflies.json beside the image NAME.EXT.
+fn fireflies_path(image: &Path) -> PathBuf {
+    image.with_extension("fireflies.json")
 }
 
 /// Most fireflies `--fireflies` keeps.
@@ -306,6 +312,28 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
     if let Some(path) = &a.stats {
         output::check_folder(path)?;
     }
+    // Every file written is its own: a layer file over the image would replace it.
+    let fireflies_file = a.fireflies.map(|_| fireflies_path(&out));
+    let written: Vec<&Path> = [
+        Some(out.as_path()),
+        a.aov.as_deref(),
+        a.parts.as_deref(),
+        fireflies_file.as_deref(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for (i, p) in written.iter().enumerate() {
+        let same = |q: &Path| std::path::absolute(q).ok() == std::path::absolute(p).ok();
+        if written[..i].iter().any(|q| same(q)) {
+            return Err(format!(
+                "{}: written twice (the image, --aov, --parts and the fireflies' JSON each \
+                 need their own file)",
+                p.display()
+            )
+            .into());
+        }
+    }
     for path in [&a.aov, &a.parts].into_iter().flatten() {
         if !is_exr(path) {
             return Err(format!(
@@ -422,6 +450,17 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         return Ok(());
     }
     if a.inspected() {
+        let pixels = prepared.film.width as u64 * prepared.film.height as u64;
+        if pixels > progressive::MAX_PIXELS {
+            return Err(format!(
+                "--aov, --parts and --fireflies keep about 300 bytes per pixel: at most {} \
+                 pixels, and this film has {}x{}",
+                progressive::MAX_PIXELS,
+                prepared.film.width,
+                prepared.film.height
+            )
+            .into());
+        }
         return inspected(&prepared, &pool, &bar, &out, &a, &est);
     }
     let film = prepared.film;
@@ -657,7 +696,12 @@ fn inspected(
             "rendering {} tiles in one go, inspected (Ctrl-C stops and writes nothing)",
             render::tile_count(prepared)
         );
-        pool.install(|| inspect::inspect(prepared, fireflies, &tick, &interrupt::STOP))
+        let want = inspect::Inspect {
+            fireflies,
+            counters: a.aov.is_some(),
+            against: None,
+        };
+        pool.install(|| inspect::inspect(prepared, want, &tick, &interrupt::STOP))
     };
     bar.finish_and_clear();
     if result.tiles_done < result.tiles {
@@ -667,7 +711,7 @@ fn inspected(
     let film = prepared.film;
     output::save(&result.image, out, film.transfer)?;
     if let Some(path) = &a.aov {
-        output::write_layers(path, film.width, film.height, &inspect::aov_layers(&result))?;
+        output::write_layers(path, film.width, film.height, inspect::aov_layers(&result))?;
         let nodes: u64 = result.pixels.iter().map(|p| p.nodes).sum();
         let prims: u64 = result.pixels.iter().map(|p| p.prims).sum();
         eprintln!(
@@ -676,16 +720,11 @@ fn inspected(
         );
     }
     if let Some(path) = &a.parts {
-        output::write_layers(
-            path,
-            film.width,
-            film.height,
-            &inspect::part_layers(&result),
-        )?;
+        output::write_layers(path, film.width, film.height, inspect::part_layers(&result))?;
         eprintln!("image by technique and by bounce -> {}", path.display());
     }
     if fireflies > 0 {
-        let path = out.with_extension("fireflies.json");
+        let path = fireflies_path(out);
         let json = serde_json::to_string_pretty(&serde_json::json!({
             "scene": a.scene.as_ref().map(|p| p.display().to_string()),
             "width": film.width,

@@ -4,7 +4,7 @@ use super::CliError;
 use super::render::{load_overridden, side};
 use clap::Args;
 use rtis::render::inspect::{self, luminance};
-use rtis::shader::record::Event;
+use rtis::shader::record::{Event, ray_name};
 use std::path::PathBuf;
 
 /// Arguments of `rtis replay`.
@@ -125,12 +125,14 @@ pub fn run(a: ReplayArgs) -> Result<(), CliError> {
                 ray,
             } => match pdf {
                 Some(pdf) => println!(
-                    "  {ray} ray wi {} pdf {pdf:?} weight {}",
+                    "  {} ray wi {} pdf {pdf:?} weight {}",
+                    ray_name(*ray),
                     v3(*wi),
                     v3(*weight)
                 ),
                 None => println!(
-                    "  {ray} ray wi {} (specular) weight {}",
+                    "  {} ray wi {} (specular) weight {}",
+                    ray_name(*ray),
                     v3(*wi),
                     v3(*weight)
                 ),

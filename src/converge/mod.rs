@@ -8,7 +8,7 @@ pub mod warptest;
 
 use crate::material::microfacet::{Microfacet, NormalSampling};
 use crate::material::{Material, Model};
-use crate::render::inspect::{Firefly, inspect};
+use crate::render::inspect::{Firefly, Inspect, inspect};
 use crate::render::{RenderScene, film::Image, render};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
 use crate::shader::{Global, Path, Shader};
@@ -285,10 +285,32 @@ pub struct Measured {
     /// The first seed's image.
     pub image: Image,
     /// Seconds each pixel of the first seed's image took to trace, from an inspected render
-    /// of it (row-major).
+    /// of it without counters (row-major).
     pub pixel_seconds: Vec<f32>,
+    /// Each pixel's variance (the mean over channels): across the seeds' images, or with one
+    /// seed the variance of its estimate from its samples (zero at 1 spp).
+    pub pixel_variance: Vec<f32>,
     /// The first seed's samples that stand out most above their pixels, with their paths.
     pub fireflies: Vec<Firefly>,
+}
+
+/// The unbiased variance of each pixel across `images` (two or more), the mean over channels.
+pub fn pixel_variance(images: &[Image]) -> Vec<f32> {
+    let k = images.len() as f64;
+    (0..images[0].pixels.len())
+        .map(|i| {
+            let mean = images
+                .iter()
+                .map(|im| im.pixels[i].as_dvec3())
+                .sum::<glam::DVec3>()
+                / k;
+            let ss: glam::DVec3 = images
+                .iter()
+                .map(|im| (im.pixels[i].as_dvec3() - mean).powf(2.0))
+                .sum();
+            (ss / (k - 1.0)).element_sum() as f32 / 3.0
+        })
+        .collect()
 }
 
 /// Fireflies the report keeps per rung.
@@ -365,12 +387,29 @@ pub fn sweep(
         };
         // Where the time went and the largest samples: an inspected render of the first
         // seed, untimed (its image is the same, to the bit).
-        let inspected = inspect(&s, REPORT_FIREFLIES, &|| {}, &AtomicBool::new(false));
+        let want = Inspect {
+            fireflies: REPORT_FIREFLIES,
+            counters: false,
+            against: Some(reference),
+        };
+        let inspected = inspect(&s, want, &|| {}, &AtomicBool::new(false));
         debug_assert_eq!(inspected.image, out.image);
+        // Each pixel's variance: across the seeds where there are two or more, else the
+        // variance of its estimate from its own samples.
+        let pixel_variance = if images.len() >= 2 {
+            pixel_variance(&images)
+        } else {
+            let v = inspected
+                .pixels
+                .iter()
+                .map(|p| p.variance.element_sum() / 3.0);
+            v.collect()
+        };
         Measured {
             row,
             image: out.image,
             pixel_seconds: inspected.pixels.iter().map(|p| p.seconds as f32).collect(),
+            pixel_variance,
             fireflies: inspected.fireflies,
         }
     };

@@ -332,8 +332,9 @@ pub fn html(r: &Report) -> String {
         p.sort_by(f32::total_cmp);
         p.get(p.len() / 2).copied().unwrap_or(1.0).max(1e-6)
     };
-    // Where the time goes: time per pixel (microseconds), squared error per pixel, and their
-    // product, each on one scale for every rung (the median of their 99th percentiles).
+    // Where the time goes: time per pixel (microseconds), squared error per pixel, and
+    // variance times time, error and product each on one scale for every rung (the median of
+    // their 99th percentiles).
     let time_maps: Vec<Vec<f32>> = r
         .rungs
         .iter()
@@ -346,8 +347,13 @@ pub fn html(r: &Report) -> String {
         .collect();
     let product_maps: Vec<Vec<f32>> = time_maps
         .iter()
-        .zip(&err_maps)
-        .map(|(t, e)| t.iter().zip(e).map(|(t, e)| t * e).collect())
+        .zip(r.rungs)
+        .map(|(t, m)| {
+            t.iter()
+                .zip(&m.pixel_variance)
+                .map(|(t, v)| t * v)
+                .collect()
+        })
         .collect();
     let scale = |maps: &[Vec<f32>]| {
         let mut p: Vec<f32> = maps.iter().map(|m| p99(m)).collect();
@@ -414,28 +420,34 @@ pub fn html(r: &Report) -> String {
     );
     let _ = write!(
         s,
-        "<h2>Where the time goes</h2><p>The rung's time per pixel, its squared error per pixel, \
-         and their product (error &times; time: the inverse of the efficiency, lower is \
-         better). A rung that spends its time where the error is not shows it at a glance: \
-         bright time where the error is dark. Time from an inspected render of the same image \
+        "<h2>Where the time goes</h2><p>The rung's time per pixel, its squared error per pixel \
+         against the reference, and its variance per pixel times its time per pixel (the \
+         inverse of the efficiency, lower is better; the variance across the seeds, or with \
+         one seed the variance of the pixel's estimate from its samples). A rung that spends \
+         its time where the error is not shows it at a glance: bright time where the error is \
+         dark. Time from an inspected render of the same image, without its counters \
          (<code>rtis render --aov</code>).</p><div class=\"maps\">\
          <figure><img id=\"timemap\" alt=\"time per pixel\"><figcaption>time per pixel\
          </figcaption>{}</figure>\
          <figure><img id=\"errmap\" alt=\"squared error per pixel\"><figcaption>squared error \
          (x - r)^2</figcaption>{}</figure>\
-         <figure><img id=\"productmap\" alt=\"error times time\"><figcaption>error &times; \
-         time</figcaption>{}</figure></div>\
+         <figure><img id=\"productmap\" alt=\"variance times time\"><figcaption>variance \
+         &times; time</figcaption>{}</figure></div>\
          <h2>Fireflies</h2><p>The rung's {REPORT_FIREFLIES} samples that stand out most above \
-         their pixel's mean (by luminance), circled on its image, with the path that made each (<code>rtis render \
-         --fireflies N</code> writes them with every vertex; <code>rtis replay</code> retraces \
-         one).</p><div class=\"fireflies\"><div class=\"ffimg\"><img id=\"ffimage\" \
-         alt=\"rung with its fireflies\"><svg id=\"ffmarks\" viewBox=\"0 0 {w} {h}\" \
-         preserveAspectRatio=\"none\"></svg></div><table><thead><tr><th>#</th><th>pixel</th>\
-         <th>sample</th><th>luminance</th><th>above its pixel</th><th>path</th></tr></thead><tbody id=\"fftable\">\
+         the reference's pixel (by luminance), circled on its image, with the path that made \
+         each (<code>rtis render --fireflies N</code> writes them with every vertex; \
+         <code>rtis replay</code> retraces one).</p><div class=\"fireflies\"><div \
+         class=\"ffimg\"><img id=\"ffimage\" alt=\"rung with its fireflies\"><svg \
+         id=\"ffmarks\" viewBox=\"0 0 {w} {h}\" preserveAspectRatio=\"none\"></svg></div>\
+         <table><thead><tr><th>#</th><th>pixel</th><th>sample</th><th>luminance</th>\
+         <th>above the reference</th><th>path</th></tr></thead><tbody id=\"fftable\">\
          </tbody></table></div>",
         colour_bar_labelled("timemax", "&micro;s (the rung's 99th percentile)"),
         colour_bar(err_max, "(median 99th percentile)"),
-        colour_bar(product_max, "&micro;s (median 99th percentile)"),
+        colour_bar(
+            product_max,
+            "&micro;s &times; variance (median 99th percentile)"
+        ),
     );
     let _ = write!(
         s,

@@ -27,13 +27,15 @@ use crate::shader::{Record, Technique};
 use crate::stats::RayStats;
 use glam::{DVec3, Vec3A};
 use serde::Serialize;
+use std::collections::BinaryHeap;
 use std::ops::Range;
+use std::sync::Mutex;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-/// Parts of a pixel by technique, indexed by `Technique as usize` (the path tracer's three,
+/// Parts of a pixel by technique, indexed by [`Technique::index`] (the path tracer's three,
 /// then [`Technique::Shader`]).
-pub const TECHNIQUES: usize = 4;
+pub const TECHNIQUES: usize = Technique::ALL.len();
 
 /// What an inspected pixel measured (its exact sums, for tests and replays).
 #[derive(Clone, Debug, Default)]
@@ -126,8 +128,8 @@ pub struct Inspected {
 #[derive(Clone, Debug, Default)]
 struct Parts {
     sample: SampleSum,
-    techniques: [RgbSum; TECHNIQUES],
-    bounces: [RgbSum; BOUNCES],
+    techniques: [SampleSum; TECHNIQUES],
+    bounces: [SampleSum; BOUNCES],
 }
 
 impl Record for Parts {
@@ -135,8 +137,8 @@ impl Record for Parts {
     fn add(&mut self, l: Vec3A, technique: Technique, vertices: u32) {
         self.sample.add(l, technique, vertices);
         if valid(l) {
-            self.techniques[technique as usize].add(l);
-            self.bounces[bounce_of(vertices)].add(l);
+            self.techniques[technique.index()].add(l, technique, vertices);
+            self.bounces[bounce_of(vertices)].add(l, technique, vertices);
         }
     }
 }
@@ -150,48 +152,92 @@ struct Candidate {
     radiance: Vec3A,
 }
 
-/// The order of fireflies: larger excess first, then lower pixel index and sample (a total
-/// order, so the same ones are kept whatever the tiles and threads).
-fn before(a: &Candidate, b: &Candidate) -> std::cmp::Ordering {
-    b.excess
-        .total_cmp(&a.excess)
-        .then(a.pixel.cmp(&b.pixel))
-        .then(a.sample.cmp(&b.sample))
-}
+/// A candidate in the order of fireflies: larger excess first, then lower pixel index and
+/// sample (a total order, so the same ones are kept whatever the tiles and threads); "greater"
+/// is "ranked lower", so that a max-heap keeps the lowest ranked on top.
+#[derive(Clone, Copy, Debug)]
+struct Ranked(Candidate);
 
-/// The `n` largest candidates so far, in order.
-#[derive(Clone, Debug, Default)]
-struct Largest {
-    n: usize,
-    kept: Vec<Candidate>,
-}
-
-impl Largest {
-    fn offer(&mut self, c: Candidate) {
-        if self.n == 0 {
-            return;
-        }
-        if self.kept.len() == self.n
-            && before(&c, self.kept.last().expect("n > 0")) != std::cmp::Ordering::Less
-        {
-            return;
-        }
-        let at = self
-            .kept
-            .partition_point(|k| before(k, &c) == std::cmp::Ordering::Less);
-        self.kept.insert(at, c);
-        self.kept.truncate(self.n);
+impl Ord for Ranked {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        let (a, b) = (&self.0, &o.0);
+        b.excess
+            .total_cmp(&a.excess)
+            .then(a.pixel.cmp(&b.pixel))
+            .then(a.sample.cmp(&b.sample))
     }
 }
 
-/// Inspect the samples `samples` of pixel `(col, row)`: its exact sums, and its report;
-/// `on_sample` is told, once the pixel is done, each sample's index and kept radiance, and
-/// the pixel's colour.
+impl PartialOrd for Ranked {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl PartialEq for Ranked {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == std::cmp::Ordering::Equal
+    }
+}
+
+impl Eq for Ranked {}
+
+/// The `n` highest-ranked candidates so far (a heap with the lowest ranked on top).
+#[derive(Clone, Debug, Default)]
+struct Largest {
+    n: usize,
+    kept: BinaryHeap<Ranked>,
+}
+
+impl Largest {
+    /// Keep `c` if it ranks among the `n` highest so far.
+    fn offer(&mut self, c: Candidate) {
+        if self.kept.len() < self.n {
+            self.kept.push(Ranked(c));
+        } else if self.kept.peek().is_some_and(|low| Ranked(c) < *low) {
+            self.kept.pop();
+            self.kept.push(Ranked(c));
+        }
+    }
+
+    /// Keep the highest ranked of `self` and `other`.
+    fn merge(&mut self, other: Largest) {
+        for c in other.kept {
+            self.offer(c.0);
+        }
+    }
+
+    /// The candidates, highest ranked first.
+    fn ranked(self) -> Vec<Candidate> {
+        self.kept
+            .into_sorted_vec()
+            .into_iter()
+            .map(|r| r.0)
+            .collect()
+    }
+}
+
+/// What an inspected render measures besides its image, and what its fireflies stand out from.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Inspect<'a> {
+    /// Fireflies to keep (none if 0).
+    pub fireflies: usize,
+    /// Count BVH node and primitive tests (the time layer then includes the counting).
+    pub counters: bool,
+    /// The image fireflies stand out from (a reference); without one, each pixel's own mean,
+    /// and at 1 spp, where a pixel has no mean but its one sample, zero (they are then the
+    /// brightest samples).
+    pub against: Option<&'a Image>,
+}
+
+/// Inspect the samples `samples` of pixel `(col, row)`: its exact sums, and its report (its
+/// BVH counts if `counters`); `on_sample` is told, once the pixel is done, each sample's index
+/// and kept radiance, and the pixel's colour.
 pub fn inspect_pixel(
     scene: &RenderScene,
-    col: u32,
-    row: u32,
+    (col, row): (u32, u32),
     samples: Range<u32>,
+    counters: bool,
     stats: &mut RayStats,
     mut on_sample: impl FnMut(u32, Vec3A, Vec3A),
 ) -> (PixelSums, PixelReport) {
@@ -209,18 +255,18 @@ pub fn inspect_pixel(
         let start = Instant::now();
         let (ray, sampler) = camera_ray(scene, col, row, s);
         let mut tracer = scene.tracer(sampler, &mut own);
-        tracer.traversal = Some(&traversal);
+        tracer.traversal = counters.then_some(&traversal);
         crate::shader::radiance(&scene.shader, &mut tracer, &ray, &mut parts);
         report.seconds += start.elapsed().as_secs_f64();
         // Kept or dropped as the render keeps it.
         let kept = parts.sample.kept(&mut own);
-        if !parts.sample.failed {
+        if !parts.sample.failed() {
             sums.sum += kept;
             for (a, b) in sums.techniques.iter_mut().zip(&parts.techniques) {
-                *a += *b;
+                b.add_to(a);
             }
             for (a, b) in sums.bounces.iter_mut().zip(&parts.bounces) {
-                *a += *b;
+                b.add_to(a);
             }
         }
         let l = kept.mean(1);
@@ -264,44 +310,64 @@ pub fn inspect_pixel(
     (sums, report)
 }
 
-/// Render `scene` inspected: every pixel's report, and the `fireflies` samples that stand out
-/// most above their pixels' means (by luminance), with their paths. Tiles not started when `stop` is set stay black.
+/// Render `scene` inspected as `want` asks: every pixel's report, and the samples that stand
+/// out most above their pixels (by luminance), with their paths. Tiles not started when `stop`
+/// is set stay black.
 pub fn inspect(
     scene: &RenderScene,
-    fireflies: usize,
+    want: Inspect,
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
 ) -> Inspected {
     let spp = scene.film.spp;
     let width = scene.film.width as u64;
-    let (tiled, largest): (Tiled<PixelReport>, Vec<Largest>) = by_tiles_with(
+    // Each tile keeps its own highest ranked, merged into these as it finishes.
+    let all = Mutex::new(Largest {
+        n: want.fireflies,
+        kept: BinaryHeap::new(),
+    });
+    let tiled: Tiled<PixelReport> = by_tiles_with(
         scene,
         on_tile,
         stop,
         |col, row, stats, largest: &mut Largest| {
-            largest.n = fireflies;
+            largest.n = want.fireflies;
             let pixel = row as u64 * width + col as u64;
-            inspect_pixel(scene, col, row, 0..spp, stats, |sample, radiance, color| {
-                largest.offer(Candidate {
-                    excess: luminance(radiance) - luminance(color),
-                    pixel,
-                    sample,
-                    radiance,
-                })
-            })
+            let counters = want.counters;
+            inspect_pixel(
+                scene,
+                (col, row),
+                0..spp,
+                counters,
+                stats,
+                |sample, l, color| {
+                    if want.fireflies == 0 {
+                        return;
+                    }
+                    let from = match want.against {
+                        Some(image) => luminance(image.get(col, row)),
+                        None if spp > 1 => luminance(color),
+                        None => 0.0,
+                    };
+                    let excess = luminance(l) - from;
+                    // Only samples above their pixel stand out.
+                    if excess > 0.0 {
+                        largest.offer(Candidate {
+                            excess,
+                            pixel,
+                            sample,
+                            radiance: l,
+                        });
+                    }
+                },
+            )
             .1
         },
+        |largest| all.lock().expect("no tile panicked").merge(largest),
     );
-    // The largest of each tile's largest, then each one's path.
-    let mut all = Largest {
-        n: fireflies,
-        kept: Vec::new(),
-    };
-    for c in largest.into_iter().flat_map(|l| l.kept) {
-        all.offer(c);
-    }
+    // The highest ranked of all, then each one's path.
+    let all = all.into_inner().expect("no tile panicked").ranked();
     let fireflies = all
-        .kept
         .iter()
         .map(|c| {
             let (col, row) = ((c.pixel % width) as u32, (c.pixel / width) as u32);
@@ -367,7 +433,7 @@ pub fn replay(scene: &RenderScene, col: u32, row: u32, s: u32) -> Replayed {
     trace_sample(scene, col, row, s, &mut stats, &mut log);
     Replayed {
         sum: log.sample.kept(&mut stats),
-        failed: log.sample.failed,
+        failed: log.sample.failed(),
         events: log.events,
         stats,
     }
@@ -393,7 +459,7 @@ fn rgb(prefix: &str, pixels: &[PixelReport], part: impl Fn(&PixelReport) -> Vec3
 }
 
 /// The layers of `render --aov`: the image (`R`, `G`, `B`), then `time.us` (microseconds),
-/// `rays.KIND`, `bvh.nodes`, `bvh.prims`, `path.length`, `variance.R/G/B`, `albedo.R/G/B`,
+/// `rays.KIND`, `samples.dropped`, `bvh.nodes`, `bvh.prims`, `path.length`, `variance.R/G/B`, `albedo.R/G/B`,
 /// `normal.X/Y/Z` and `depth.Z`.
 pub fn aov_layers(r: &Inspected) -> Vec<Channel> {
     let px = &r.pixels;
@@ -407,6 +473,7 @@ pub fn aov_layers(r: &Inspected) -> Vec<Channel> {
     layers.push(one("rays.reflection", &|p| p.rays.reflection as f32));
     layers.push(one("rays.refraction", &|p| p.rays.refraction as f32));
     layers.push(one("rays.indirect", &|p| p.rays.indirect as f32));
+    layers.push(one("samples.dropped", &|p| p.rays.dropped as f32));
     layers.push(one("bvh.nodes", &|p| p.nodes as f32));
     layers.push(one("bvh.prims", &|p| p.prims as f32));
     layers.push(one("path.length", &|p| p.path_length));
@@ -429,7 +496,7 @@ pub fn part_layers(r: &Inspected) -> Vec<Channel> {
     let mut layers = rgb("", px, |p| p.color);
     for t in Technique::PATH {
         layers.extend(rgb(&format!("technique.{}", t.name()), px, |p| {
-            p.techniques[t as usize]
+            p.techniques[t.index()]
         }));
     }
     for (b, name) in crate::shader::record::BOUNCE_NAMES.iter().enumerate() {

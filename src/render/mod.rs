@@ -60,8 +60,9 @@ impl Rendered {
 /// exactly ([`exact`]), so that the order of the samples never changes a bit.
 ///
 /// The last line of defence against numerical failure: a sample with a contribution that is
-/// NaN, infinite or negative is dropped (it adds zero) and counted in `stats.dropped`, so one
-/// bad sample can never poison a pixel, and the count says that it happened.
+/// NaN, infinite or negative, or whose contributions sum beyond the largest `f32`, is dropped
+/// (it adds zero) and counted in `stats.dropped`, so one bad sample can never poison a pixel,
+/// and the count says that it happened.
 #[inline]
 pub fn render_pixel(scene: &RenderScene, col: u32, row: u32, stats: &mut RayStats) -> Vec3A {
     pixel_sum(scene, col, row, 0..scene.film.spp, stats).mean(scene.film.spp as u64)
@@ -87,7 +88,8 @@ pub fn pixel_sum(
 
 /// The exact sum of the contributions of camera sample `s` of pixel `(col, row)` (the path
 /// tracer's are several, every other shader's one), from the sample's own random stream;
-/// zero, and counted in `stats.dropped`, when one of them is NaN, infinite or negative.
+/// zero, and counted in `stats.dropped`, when one of them is NaN, infinite or negative or
+/// their sum is beyond the largest `f32`.
 #[inline]
 pub fn render_sample(
     scene: &RenderScene,
@@ -151,7 +153,7 @@ pub struct SampleSum {
     /// Whether `rest` holds any.
     rounded: bool,
     /// True if a contribution was NaN, infinite or negative: the sample is dropped.
-    pub failed: bool,
+    failed: bool,
 }
 
 impl SampleSum {
@@ -178,17 +180,26 @@ impl SampleSum {
     /// `stats.dropped`) if it failed.
     #[inline(always)]
     pub fn keep_into(&self, sum: &mut RgbSum, stats: &mut RayStats) {
-        if self.failed {
+        if self.failed() {
             stats.dropped += 1;
         } else {
             self.add_to(sum);
         }
     }
 
+    /// True if the sample failed: a contribution was NaN, infinite or negative, or their sum
+    /// is beyond the largest `f32` (finite contributions can add up to infinity).
+    #[inline(always)]
+    pub fn failed(&self) -> bool {
+        self.failed
+            || self.fast.max_element() > f32::MAX as f64
+            || (self.rounded && self.rest.0.iter().any(|c| c.to_f64() > f32::MAX as f64))
+    }
+
     /// The sum the pixel keeps: this one, or zero (counted in `stats.dropped`) if it failed.
     #[inline]
     pub fn kept(self, stats: &mut RayStats) -> RgbSum {
-        if self.failed {
+        if self.failed() {
             stats.dropped += 1;
             RgbSum::default()
         } else {
@@ -300,27 +311,31 @@ fn by_tiles<T: Clone + Default + Send>(
     stop: &AtomicBool,
     pixel: impl Fn(u32, u32, &mut RayStats) -> T + Sync,
 ) -> Tiled<T> {
-    by_tiles_with(scene, on_tile, stop, |col, row, stats, _: &mut ()| {
-        pixel(col, row, stats)
-    })
-    .0
+    by_tiles_with(
+        scene,
+        on_tile,
+        stop,
+        |col, row, stats, _: &mut ()| pixel(col, row, stats),
+        |()| {},
+    )
 }
 
 /// [`by_tiles`] with a state per tile that `pixel` updates (for what a tile keeps of its
-/// pixels, as the largest samples); the states of the tiles rendered come back in tile order.
+/// pixels, as its largest samples), handed to `finished` as the tile finishes.
 fn by_tiles_with<T: Clone + Default + Send, S: Default + Send>(
     scene: &RenderScene,
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
     pixel: impl Fn(u32, u32, &mut RayStats, &mut S) -> T + Sync,
-) -> (Tiled<T>, Vec<S>) {
+    finished: impl Fn(S) + Sync,
+) -> Tiled<T> {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..tiles_x).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
-    let done: Vec<Option<(Vec<T>, RayStats, S)>> = tiles
+    let done: Vec<Option<(Vec<T>, RayStats)>> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             if stop.load(Ordering::Relaxed) {
@@ -334,17 +349,16 @@ fn by_tiles_with<T: Clone + Default + Send, S: Default + Send>(
                     px.push(pixel(col, row, &mut stats, &mut state));
                 }
             }
+            finished(state);
             on_tile();
-            Some((px, stats, state))
+            Some((px, stats))
         })
         .collect();
     let mut pixels = vec![T::default(); w as usize * h as usize];
     let mut stats = RayStats::default();
-    let mut states = Vec::new();
     let mut tiles_done = 0;
-    for (&(x0, y0), (px, st, state)) in tiles.iter().zip(done).filter_map(|(t, d)| Some((t, d?))) {
+    for (&(x0, y0), (px, st)) in tiles.iter().zip(done).filter_map(|(t, d)| Some((t, d?))) {
         stats += st;
-        states.push(state);
         tiles_done += 1;
         let tw = (x0 + TILE).min(w) - x0;
         for (i, p) in px.into_iter().enumerate() {
@@ -352,14 +366,13 @@ fn by_tiles_with<T: Clone + Default + Send, S: Default + Send>(
             pixels[(row * w + col) as usize] = p;
         }
     }
-    let tiled = Tiled {
+    Tiled {
         pixels,
         stats,
         seconds: start.elapsed().as_secs_f64(),
         tiles_done,
         tiles: tiles.len() as u64,
-    };
-    (tiled, states)
+    }
 }
 
 /// Number of tiles a render of this film has (for progress bars).
@@ -393,6 +406,12 @@ mod tests {
             sample.keep_into(&mut pixel, &mut stats);
             assert_eq!(pixel, want);
         }
+        // Finite contributions whose sum is beyond the largest f32 fail the sample too.
+        let mut sample = SampleSum::default();
+        sample.add(Vec3A::splat(f32::MAX), Technique::Light, 1);
+        assert!(!sample.failed());
+        sample.add(Vec3A::new(0.0, f32::MAX, 0.0), Technique::Bsdf, 2);
+        assert!(sample.failed());
         let mut sample = SampleSum::default();
         sample.add(Vec3A::ONE, Technique::Light, 1);
         sample.add(Vec3A::new(1.0, f32::NAN, 0.0), Technique::Bsdf, 2);

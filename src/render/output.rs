@@ -256,12 +256,12 @@ pub fn write_layers(
     path: &Path,
     width: u32,
     height: u32,
-    layers: &[(String, Vec<f32>)],
+    layers: Vec<(String, Vec<f32>)>,
 ) -> Result<(), OutputError> {
     use exr::prelude::*;
     let channels: Vec<AnyChannel<FlatSamples>> = layers
-        .iter()
-        .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v.clone())))
+        .into_iter()
+        .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v)))
         .collect();
     let layer = Layer::new(
         (width as usize, height as usize),

@@ -88,6 +88,12 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
     if f.filter != crate::sampling::PixelFilter::Box {
         let _ = write!(h, "|{:?}", f.filter);
     }
+    // Path's samples have been exact sums of their contributions since the image split by
+    // technique: passes of earlier versions (each sample rounded once) are refused, never
+    // mixed.
+    if let crate::shader::Shader::Path(_) = scene.shader {
+        let _ = write!(h, "|exact contributions");
+    }
     h.0
 }
 

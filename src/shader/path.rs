@@ -23,7 +23,7 @@
 //!   by `eta^2 = (n_wo / n_wi)^2`, as radiance does (`docs/transport.md`).
 
 use super::Tracer;
-use super::record::{Event, Record, Technique, arr, ray_name};
+use super::record::{Event, Record, Technique, arr};
 use super::surface::{
     Interaction, Lobe, area_lights, emitted, one_light, point_lights, reflectance, sky,
     specular_bounce,
@@ -233,7 +233,7 @@ pub fn radiance<R: Record>(tr: &mut Tracer, camera_ray: &Ray, p: &Path, rec: &mu
             wi: arr(next_ray.d),
             pdf,
             weight: arr(weight),
-            ray: ray_name(next),
+            ray: next,
         });
         sampled |= pdf.is_some();
         beta *= weight;

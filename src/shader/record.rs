@@ -32,6 +32,24 @@ impl Technique {
     /// The path tracer's techniques, in the order images list them.
     pub const PATH: [Technique; 3] = [Technique::Emitted, Technique::Light, Technique::Bsdf];
 
+    /// Every technique, in the order of their index ([`Technique::index`]).
+    pub const ALL: [Technique; 4] = [
+        Technique::Emitted,
+        Technique::Light,
+        Technique::Bsdf,
+        Technique::Shader,
+    ];
+
+    /// The technique's index in arrays of parts.
+    pub fn index(self) -> usize {
+        match self {
+            Technique::Emitted => 0,
+            Technique::Light => 1,
+            Technique::Bsdf => 2,
+            Technique::Shader => 3,
+        }
+    }
+
     /// The name of the technique's image layer.
     pub fn name(self) -> &'static str {
         match self {
@@ -93,7 +111,7 @@ pub enum Event {
         /// The weight the throughput is multiplied by.
         weight: [f32; 3],
         /// The next ray's kind.
-        ray: &'static str,
+        ray: RayKind,
     },
     /// Russian roulette: the path survived with probability `q` (its throughput divided by
     /// `q`), or ended.

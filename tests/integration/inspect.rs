@@ -5,7 +5,7 @@
 
 use crate::common::{self, bits, scene};
 use rtis::render::exact::RgbSum;
-use rtis::render::inspect::{inspect, inspect_pixel, luminance, replay};
+use rtis::render::inspect::{Inspect, inspect, inspect_pixel, luminance, replay};
 use rtis::render::{pixel_sum, render, render_sample};
 use rtis::shader::record::Event;
 use rtis::stats::RayStats;
@@ -16,7 +16,8 @@ use std::sync::atomic::AtomicBool;
 fn room(shader: &str, model: &str) -> String {
     let bsdfs = if model == "Physical" {
         "(shape: Sphere(center: (0.8, -0.6, 0.3), radius: 0.4), material: RoughConductor(alpha: 0.2, material: \"Au\")),
-         (shape: Sphere(center: (0, -0.7, -0.8), radius: 0.3), material: RoughPlastic(alpha: 0.1, diffuse_reflectance: (0.2, 0.4, 0.7))),"
+         (shape: Sphere(center: (0, -0.7, -0.8), radius: 0.3), material: RoughPlastic(alpha: 0.1, diffuse_reflectance: (0.2, 0.4, 0.7))),
+         (shape: Sphere(center: (-0.4, 0.6, -0.9), radius: 0.3), material: Plastic(diffuse_reflectance: (0.6, 0.3, 0.2))),"
     } else {
         ""
     };
@@ -37,13 +38,22 @@ fn room(shader: &str, model: &str) -> String {
     )
 }
 
+/// An inspected render with its counters and `fireflies` fireflies ranked against each pixel.
+fn counted(fireflies: usize) -> Inspect<'static> {
+    Inspect {
+        fireflies,
+        counters: true,
+        against: None,
+    }
+}
+
 /// Every strategy and model of the path tracer, as scene text.
 fn path_variants() -> Vec<String> {
     let mut out = Vec::new();
     for model in ["Course", "Physical"] {
         for lights in ["Light", "Brdf", "Mis"] {
             for per_vertex in ["All", "One", "Importance"] {
-                for sampling in ["Cosine", "Brdf"] {
+                for sampling in ["Uniform", "Cosine", "Brdf"] {
                     let shader = format!(
                         "Path(max_depth: 6, rr_depth: 2, sampling: {sampling}, lights: {lights}, \
                          lights_per_vertex: {per_vertex})"
@@ -76,8 +86,14 @@ fn parts_sum_to_the_render_bit_for_bit() {
         for row in 0..s.film.height {
             for col in 0..s.film.width {
                 let mut stats = RayStats::default();
-                let (sums, _) =
-                    inspect_pixel(&s, col, row, 0..s.film.spp, &mut stats, |_, _, _| {});
+                let (sums, _) = inspect_pixel(
+                    &s,
+                    (col, row),
+                    0..s.film.spp,
+                    true,
+                    &mut stats,
+                    |_, _, _| {},
+                );
                 let render = pixel_sum(&s, col, row, 0..s.film.spp, &mut RayStats::default());
                 assert_eq!(sums.sum, render, "{text}");
                 assert_eq!(total(&sums.techniques), sums.sum, "{text}");
@@ -92,7 +108,7 @@ fn parts_sum_to_the_render_bit_for_bit() {
         // Emitted light is seen in every variant, and the light sample finds some wherever
         // it runs (point lights are always light-sampled).
         assert!(some_light[0] && some_light[1], "{text}");
-        let inspected = inspect(&s, 0, &|| {}, &AtomicBool::new(false));
+        let inspected = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
         let rendered = render(&s, &|| {});
         assert_eq!(bits(&inspected.image), bits(&rendered.image), "{text}");
         assert_eq!(inspected.stats, rendered.stats, "{text}");
@@ -107,22 +123,26 @@ fn mis_splits_the_area_light_between_both_techniques() {
         "Path(max_depth: 4, sampling: Brdf, lights: Mis)",
         "Physical",
     )));
-    let r = inspect(&s, 0, &|| {}, &AtomicBool::new(false));
+    let r = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
     let sum = |t: usize| -> f64 { r.pixels.iter().map(|p| p.techniques[t].x as f64).sum() };
     assert!(sum(1) > 0.0 && sum(2) > 0.0, "{} {}", sum(1), sum(2));
     // Under `Light` the area light met by a BSDF-sampled ray counts nothing: what the Bsdf
     // part holds came through mirrors and glass after a sampled vertex (weight 1), or is the
-    // background; with the mirror, the glass and the environment gone, only light sampling
-    // and what the camera sees remain.
+    // background; with the mirror, the glass, the smooth plastic's coating and the
+    // environment gone, only light sampling and what the camera sees remain.
     let text = room(
         "Path(max_depth: 4, sampling: Brdf, lights: Light)",
         "Physical",
     )
     .replace("Transmissive(ior: 1.5)", "Phong(kd: (0.5, 0.5, 0.5))")
     .replace("Mirror()", "Phong(kd: (0.5, 0.5, 0.5))")
+    .replace(
+        "Plastic(diffuse_reflectance: (0.6, 0.3, 0.2))",
+        "Phong(kd: (0.6, 0.3, 0.2))",
+    )
     .replace("(light: Environment(radiance: (0.3, 0.35, 0.4))),", "");
     let s = rtis::extract(&scene(&text));
-    let r = inspect(&s, 0, &|| {}, &AtomicBool::new(false));
+    let r = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
     assert!(
         r.pixels
             .iter()
@@ -180,7 +200,7 @@ fn a_replay_adds_what_the_render_added() {
 #[test]
 fn per_pixel_counts_sum_to_the_render() {
     let s = rtis::extract(&scene(&room("Path(rr_depth: 3)", "Physical")));
-    let r = inspect(&s, 0, &|| {}, &AtomicBool::new(false));
+    let r = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
     let mut sum = RayStats::default();
     for p in &r.pixels {
         sum += p.rays;
@@ -219,7 +239,7 @@ fn path_length_matches_the_cost_rule_in_the_closed_room() {
         ("Direct()", 1.0),
     ] {
         let s = rtis::extract(&scene(&closed_room(shader)));
-        let r = inspect(&s, 0, &|| {}, &AtomicBool::new(false));
+        let r = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
         for p in &r.pixels {
             assert_eq!(p.path_length, length, "{shader}");
             assert_eq!(p.nodes, 0, "{shader}");
@@ -228,32 +248,79 @@ fn path_length_matches_the_cost_rule_in_the_closed_room() {
     }
 }
 
-/// In a mesh the counters count: every ray tests the BVH's root, and the primitives of the
-/// leaves it reaches.
+/// In a mesh the counters count. Two triangles in one leaf fill the view: each camera ray of
+/// the Normal shader tests the root (one node test: the top node holds the leaf) and the leaf's
+/// two triangles, exactly. In a larger mesh every ray tests the root at least, and a pixel
+/// whose rays all miss it tests nothing more.
 #[test]
 fn bvh_counters_count_node_and_primitive_tests() {
+    let text = "Scene(film: (width: 12, height: 10, spp: 3), shader: Normal,
+          camera: Perspective(position: (0, 0, 3), look_at: (0, 0, 0), fov: 40),
+          entities: [(shape: Triangle(a: (-5, -5, 0), b: (5, -5, 0), c: (5, 5, 0)), material: Phong(kd: (0.5, 0.5, 0.5))),
+                     (shape: Triangle(a: (-5, -5, 0), b: (5, 5, 0), c: (-5, 5, 0)), material: Phong(kd: (0.5, 0.5, 0.5)))])";
+    let s = rtis::extract(&scene(text));
+    let r = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
+    for p in &r.pixels {
+        assert_eq!((p.nodes, p.prims), (3, 6), "{p:?}");
+    }
+    // Without counters nothing is counted, and the image is the same.
+    let quiet = inspect(&s, Inspect::default(), &|| {}, &AtomicBool::new(false));
+    assert!(quiet.pixels.iter().all(|p| p.nodes == 0 && p.prims == 0));
+    assert_eq!(bits(&quiet.image), bits(&r.image));
     let text = "Scene(film: (width: 12, height: 10, spp: 2), shader: Direct(),
           camera: Perspective(position: (0, 0, 3), look_at: (0, 0, 0), fov: 50),
           entities: [(shape: Mesh(path: \"assets/blob.obj\"), material: Phong(kd: (0.5, 0.5, 0.5))),
                      (light: Point(position: (0, 2, 2), intensity: (5, 5, 5)))])";
     let s = rtis::extract(&scene(text));
-    let r = inspect(&s, 0, &|| {}, &AtomicBool::new(false));
-    let (nodes, prims): (u64, u64) = r
-        .pixels
-        .iter()
-        .map(|p| (p.nodes, p.prims))
-        .fold((0, 0), |(a, b), (n, p)| (a + n, b + p));
-    assert!(
-        nodes >= r.stats.total(),
-        "{nodes} node tests for {} rays",
-        r.stats.total()
-    );
-    assert!(prims > 0);
-    // A pixel whose rays all miss the mesh tests the root and nothing else.
+    let r = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
+    assert!(r.pixels.iter().all(|p| p.nodes >= p.rays.total()));
+    assert!(r.pixels.iter().any(|p| p.prims > 0));
     assert!(
         r.pixels
             .iter()
             .any(|p| p.prims == 0 && p.nodes == p.rays.total())
+    );
+}
+
+/// At 1 spp a pixel's mean is its one sample: the fireflies are then the brightest samples,
+/// each above zero; ranked against an image, they stand out from it.
+#[test]
+fn fireflies_at_one_sample_are_the_brightest() {
+    let s = rtis::extract(&scene(
+        &room("Path(rr_depth: 3)", "Physical").replace("spp: 6", "spp: 1"),
+    ));
+    let r = inspect(&s, counted(4), &|| {}, &AtomicBool::new(false));
+    assert_eq!(r.fireflies.len(), 4);
+    let brightest = r
+        .image
+        .pixels
+        .iter()
+        .map(|&p| luminance(p))
+        .fold(0.0f32, f32::max);
+    assert_eq!(r.fireflies[0].luminance, brightest);
+    assert!(
+        r.fireflies
+            .iter()
+            .all(|f| f.excess > 0.0 && f.excess == f.luminance)
+    );
+    // Against a black image the same ranking; against the image itself nothing stands out.
+    let black = rtis::render::film::Image::new(s.film.width, s.film.height);
+    let want = Inspect {
+        fireflies: 4,
+        counters: false,
+        against: Some(&black),
+    };
+    let against_black = inspect(&s, want, &|| {}, &AtomicBool::new(false));
+    assert_eq!(against_black.fireflies[0].pixel, r.fireflies[0].pixel);
+    let want = Inspect {
+        fireflies: 4,
+        counters: false,
+        against: Some(&r.image),
+    };
+    assert!(
+        inspect(&s, want, &|| {}, &AtomicBool::new(false))
+            .fireflies
+            .is_empty()
     );
 }
 
@@ -263,9 +330,10 @@ fn bvh_counters_count_node_and_primitive_tests() {
 #[test]
 fn a_firefly_made_on_purpose_is_found_and_replayed() {
     let _limit = common::deadline(120);
-    // The light sits at the centre of a glass ball: it covers a tenth of a pixel or so, and
-    // only the camera rays that find it through the glass see it.
-    let text = "Scene(film: (width: 16, height: 12, spp: 16), shader: Path(rr_depth: 8, lights: Mis), model: Physical,
+    // The light sits at the centre of a glass ball: it covers a fraction of a pixel, and only
+    // the camera rays that find it through the glass see it. The film spans six tiles, so
+    // that the tiles' fireflies are merged.
+    let text = "Scene(film: (width: 40, height: 30, spp: 16), shader: Path(rr_depth: 8, lights: Mis), model: Physical,
           camera: Perspective(position: (0, 1, 4), look_at: (0, 0, 0), fov: 50),
           entities: [
             (shape: InfinitePlane(point: (0, -1, 0), normal: (0, 1, 0)), material: Phong(kd: (0.5, 0.5, 0.5))),
@@ -294,8 +362,8 @@ fn a_firefly_made_on_purpose_is_found_and_replayed() {
             .build()
             .unwrap()
     };
-    let one = pool(1).install(|| inspect(&s, 5, &|| {}, &AtomicBool::new(false)));
-    let two = pool(2).install(|| inspect(&s, 5, &|| {}, &AtomicBool::new(false)));
+    let one = pool(1).install(|| inspect(&s, counted(5), &|| {}, &AtomicBool::new(false)));
+    let two = pool(2).install(|| inspect(&s, counted(5), &|| {}, &AtomicBool::new(false)));
     let f = &one.fireflies[0];
     assert_eq!(
         (f.excess, f.pixel, f.sample),
@@ -417,21 +485,50 @@ fn the_cli_writes_the_same_image_and_its_layers() {
     let back: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(back["radiance"], f["radiance"]);
     assert_eq!(back["path"], f["path"]);
-    // Refused: parts of a shader that does not split, a pixel off the film, a sample past spp.
-    let o = run(&["replay", scene_arg, "--pixel", "999,0", "--sample", "0"]);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("outside the"));
-    let o = run(&[
-        &["replay", scene_arg, "--pixel", "1,1", "--sample", "4"][..],
-        &small,
-    ]
-    .concat());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("out of range"));
-    let o = run(&[
-        "render",
-        common::scenes_dir().join("cornell.ron").to_str().unwrap(),
-        "--parts",
-        parts.to_str().unwrap(),
-    ]);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("not Path"));
+    // Refused with a clear message and a non-zero exit, before rendering: a pixel off the
+    // film, a sample past spp, parts of a shader that does not split, a layer file named as
+    // the image; nothing is written.
+    let refused = |args: &[&str], says: &str| {
+        let o = run(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(says), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    };
+    refused(
+        &["replay", scene_arg, "--pixel", "999,0", "--sample", "0"],
+        "outside the",
+    );
+    refused(
+        &[
+            &["replay", scene_arg, "--pixel", "1,1", "--sample", "4"][..],
+            &small,
+        ]
+        .concat(),
+        "out of range",
+    );
+    let cornell = common::scenes_dir().join("cornell.ron");
+    let fresh = d.join("fresh.exr");
+    refused(
+        &[
+            "render",
+            cornell.to_str().unwrap(),
+            "--parts",
+            fresh.to_str().unwrap(),
+        ],
+        "not Path",
+    );
+    let twice = d.join("twice.exr");
+    refused(
+        &[
+            "render",
+            scene_arg,
+            "-o",
+            twice.to_str().unwrap(),
+            "--aov",
+            twice.to_str().unwrap(),
+        ],
+        "written twice",
+    );
+    assert!(!fresh.exists() && !twice.exists());
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -644,12 +644,12 @@ unsafe fn point_sums<L: Floats>(
                 audit_lanes(audit, o, wi, o_err, dist * end, L::bitmask(valid));
             }
             let planes = !in_room;
-            let blocked = tr.geometry.occluded_lanes(
-                (o, wi, o_err, dist * end),
-                planes,
-                valid,
-                &tr.traversal,
-            );
+            // Counted only in an inspected render; a render's queries have no counters.
+            let segments = (o, wi, o_err, dist * end);
+            let blocked = match tr.traversal {
+                None => tr.geometry.occluded_lanes(segments, planes, valid, &()),
+                Some(t) => tr.geometry.occluded_lanes(segments, planes, valid, t),
+            };
             valid & !blocked
         } else {
             valid
