@@ -48,7 +48,8 @@ enum Command {
     /// Test every sampler against its pdf (chi-squared), with a page of histograms.
     Warptest(warptest::WarptestArgs),
     /// Trace one camera sample again, exactly as the render traced it, and print its path
-    /// vertex by vertex (a firefly's, say).
+    /// vertex by vertex (a firefly's, say). Give it the --width, --height, --spp and --seed the
+    /// render was given, if any: a sample depends on them.
     Replay(replay::ReplayArgs),
     /// Print speed figures: the course's Cornell box under each shader (seconds, Mrays/s, own
     /// peak memory), the price of each effect, and BVH build and ray rates for meshes.

@@ -25,22 +25,12 @@ pub struct RenderArgs {
     /// Output image: .png (8-bit) or .exr (linear float). Default: the scene's name with .png.
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Override the film width in pixels (1 to 32768; alone, the height keeps the aspect ratio).
-    #[arg(long, allow_negative_numbers = true, value_parser = side())]
-    width: Option<u32>,
-    /// Override the film height in pixels (1 to 32768; alone, the width keeps the aspect ratio).
-    #[arg(long, allow_negative_numbers = true, value_parser = side())]
-    height: Option<u32>,
-    /// Override the samples per pixel (1 to 1048576).
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=rtis::render::MAX_SPP as i64))]
-    spp: Option<u32>,
+    #[command(flatten)]
+    film: Overrides,
     /// Worker threads (default: one per core; at most 4 per core). The image does not depend
     /// on it.
     #[arg(long, allow_negative_numbers = true)]
     threads: Option<usize>,
-    /// Override the scene's random seed.
-    #[arg(long)]
-    seed: Option<u64>,
     /// PNG transfer curve: srgb (default) or linear (the course's clamp-and-scale).
     #[arg(long, value_parser = parse_transfer)]
     transfer: Option<Transfer>,
@@ -110,6 +100,24 @@ impl RenderArgs {
     }
 }
 
+/// The film size, spp and seed of a render where the command line overrides the scene's (the
+/// same for `rtis replay`, whose sample depends on them).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct Overrides {
+    /// Override the film width in pixels (1 to 32768; alone, the height keeps the aspect ratio).
+    #[arg(long, allow_negative_numbers = true, value_parser = side())]
+    width: Option<u32>,
+    /// Override the film height in pixels (1 to 32768; alone, the width keeps the aspect ratio).
+    #[arg(long, allow_negative_numbers = true, value_parser = side())]
+    height: Option<u32>,
+    /// Override the samples per pixel (1 to 1048576).
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=rtis::render::MAX_SPP as i64))]
+    spp: Option<u32>,
+    /// Override the scene's random seed.
+    #[arg(long)]
+    seed: Option<u64>,
+}
+
 /// `--isa` of `rtis render`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum IsaChoice {
@@ -155,28 +163,27 @@ pub fn film_size(scene: (u32, u32), width: Option<u32>, height: Option<u32>) -> 
     }
 }
 
-/// The scene at `path` (the embedded box if none) with the command line's film size and spp
-/// (`size`: width, height, spp), transfer and seed, where given.
+/// The scene at `path` (the embedded box if none) with the command line's film size, spp and
+/// seed (`over`) and transfer, where given.
 pub fn load_overridden(
     path: Option<&Path>,
-    size: (Option<u32>, Option<u32>, Option<u32>),
+    over: Overrides,
     transfer: Option<Transfer>,
-    seed: Option<u64>,
 ) -> Result<rtis::scene::Scene, CliError> {
     let mut scene = load(path)?;
     let film = &mut scene.settings.film;
-    let (width, height) = film_size((film.width, film.height), size.0, size.1);
+    let (width, height) = film_size((film.width, film.height), over.width, over.height);
     let overridden = Film {
         width,
         height,
-        spp: size.2.unwrap_or(film.spp),
+        spp: over.spp.unwrap_or(film.spp),
         transfer: transfer.unwrap_or(film.transfer),
         filter: film.filter,
     };
     *film = overridden
         .checked()
         .map_err(|e| format!("command-line film override: {e}"))?;
-    if let Some(seed) = seed {
+    if let Some(seed) = over.seed {
         scene.settings.seed = seed;
     }
     Ok(scene)
@@ -279,12 +286,7 @@ fn parse_transfer(s: &str) -> Result<Transfer, String> {
 pub fn run(a: RenderArgs) -> Result<(), CliError> {
     // Refused before the scene is read.
     let isa = a.isa.isa()?;
-    let scene = load_overridden(
-        a.scene.as_deref(),
-        (a.width, a.height, a.spp),
-        a.transfer,
-        a.seed,
-    )?;
+    let scene = load_overridden(a.scene.as_deref(), a.film, a.transfer)?;
     let stem = a
         .scene
         .as_deref()
@@ -624,6 +626,18 @@ struct Summary {
     stats: RayStats,
 }
 
+impl Summary {
+    /// A render of all the film's samples in one round.
+    fn one_go(prepared: &rtis::RenderScene, seconds: f64, stats: RayStats) -> Summary {
+        Summary {
+            spp: prepared.film.spp as u64,
+            rounds: 1,
+            seconds,
+            stats,
+        }
+    }
+}
+
 /// A film too large for a progressive pass: tiles rendered once each with all their samples,
 /// as before progressive rendering; Ctrl-C keeps the tiles finished.
 fn render_in_one_go(
@@ -663,19 +677,8 @@ fn render_in_one_go(
         return Err(Box::new(Interrupted));
     }
     output::save(&result.image, out, film.transfer)?;
-    summary(
-        prepared,
-        pool,
-        &Summary {
-            spp: film.spp as u64,
-            rounds: 1,
-            seconds: result.seconds,
-            stats: result.stats,
-        },
-        out,
-        stats,
-        est,
-    )
+    let run = Summary::one_go(prepared, result.seconds, result.stats);
+    summary(prepared, pool, &run, out, stats, est)
 }
 
 /// An inspected render: all the samples in one go, measured pixel by pixel; the image, then
@@ -750,19 +753,8 @@ fn inspected(
             );
         }
     }
-    summary(
-        prepared,
-        pool,
-        &Summary {
-            spp: film.spp as u64,
-            rounds: 1,
-            seconds: result.seconds,
-            stats: result.stats,
-        },
-        out,
-        a.stats.as_deref(),
-        est,
-    )
+    let run = Summary::one_go(prepared, result.seconds, result.stats);
+    summary(prepared, pool, &run, out, a.stats.as_deref(), est)
 }
 
 /// Write the statistics file (if asked) and print the summary line.

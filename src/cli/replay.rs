@@ -1,7 +1,7 @@
 //! `rtis replay`: trace one camera sample again, as the render traced it, and print its path.
 
 use super::CliError;
-use super::render::{load_overridden, side};
+use super::render::{Overrides, load_overridden};
 use clap::Args;
 use rtis::render::inspect::{self, luminance};
 use rtis::shader::record::{Event, ray_name};
@@ -19,18 +19,10 @@ pub struct ReplayArgs {
     /// The sample's index in the pixel (0 to spp - 1).
     #[arg(long, value_name = "I")]
     sample: u32,
-    /// The film width the render had, if overridden (a sample depends on the film).
-    #[arg(long, allow_negative_numbers = true, value_parser = side())]
-    width: Option<u32>,
-    /// The film height the render had, if overridden.
-    #[arg(long, allow_negative_numbers = true, value_parser = side())]
-    height: Option<u32>,
-    /// The samples per pixel the render had, if overridden.
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=rtis::render::MAX_SPP as i64))]
-    spp: Option<u32>,
-    /// The seed the render had, if overridden.
-    #[arg(long)]
-    seed: Option<u64>,
+    /// The render's overrides of the scene's film and seed, if it had any (a sample depends on
+    /// them): give the ones given to `rtis render`.
+    #[command(flatten)]
+    film: Overrides,
     /// Print the sample as JSON (the form of `render --fireflies`).
     #[arg(long)]
     json: bool,
@@ -53,7 +45,7 @@ fn v3(v: [f32; 3]) -> String {
 
 /// Run `rtis replay`.
 pub fn run(a: ReplayArgs) -> Result<(), CliError> {
-    let scene = load_overridden(a.scene.as_deref(), (a.width, a.height, a.spp), None, a.seed)?;
+    let scene = load_overridden(a.scene.as_deref(), a.film, None)?;
     let film = scene.settings.film;
     let (x, y) = a.pixel;
     if x >= film.width || y >= film.height {

@@ -269,10 +269,19 @@ pub fn write_layers(
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(channels.into()),
     );
+    let bytes = exr_bytes(layer).map_err(|e| io_err(path, e))?;
+    write_file(path, &bytes)
+}
+
+/// One layer of float or integer channels as the bytes of an OpenEXR file.
+pub fn exr_bytes(
+    layer: exr::prelude::Layer<exr::prelude::AnyChannels<exr::prelude::FlatSamples>>,
+) -> Result<Vec<u8>, String> {
+    use exr::prelude::*;
     let mut bytes = std::io::Cursor::new(Vec::new());
     exr::prelude::Image::from_layer(layer)
         .write()
         .to_buffered(&mut bytes)
-        .map_err(|e| io_err(path, e))?;
-    write_file(path, &bytes.into_inner())
+        .map_err(|e| e.to_string())?;
+    Ok(bytes.into_inner())
 }

@@ -293,12 +293,7 @@ impl Pass {
             Encoding::SMALL_LOSSLESS,
             AnyChannels::sort(channels.into()),
         );
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        exr::prelude::Image::from_layer(layer)
-            .write()
-            .to_buffered(&mut bytes)
-            .map_err(|e| e.to_string())?;
-        Ok(bytes.into_inner())
+        super::output::exr_bytes(layer)
     }
 
     /// Write the pass to `path` (an .exr name) through a temporary file and a rename.

@@ -387,6 +387,20 @@ fn a_firefly_made_on_purpose_is_found_and_replayed() {
     assert!(one.fireflies.windows(2).all(|w| w[0].excess >= w[1].excess));
 }
 
+/// The float channels of an EXR file by name.
+fn channels(path: &std::path::Path) -> std::collections::HashMap<String, Vec<f32>> {
+    let image = exr::prelude::read_all_flat_layers_from_file(path).unwrap();
+    image.layer_data[0]
+        .channel_data
+        .list
+        .iter()
+        .map(|c| {
+            let values = c.sample_data.values_as_f32().collect();
+            (c.name.to_string(), values)
+        })
+        .collect()
+}
+
 /// `render --aov --parts --fireflies` writes the image of a plain render, to the bit, and its
 /// layers; the fireflies' JSON names a sample that `rtis replay` retraces to the same
 /// radiance; bad asks are refused before rendering.
@@ -432,14 +446,9 @@ fn the_cli_writes_the_same_image_and_its_layers() {
         std::fs::read(&plain).unwrap(),
         std::fs::read(&inspected).unwrap()
     );
-    // The layers are there.
-    let layers = exr::prelude::read_all_flat_layers_from_file(&aov).unwrap();
-    let names: Vec<String> = layers.layer_data[0]
-        .channel_data
-        .list
-        .iter()
-        .map(|c| c.name.to_string())
-        .collect();
+    // The layers are there: the time layer measured, the parts adding up to the image
+    // within the rounding of each part's mean.
+    let aov_layers = channels(&aov);
     for want in [
         "time.us",
         "rays.shadow",
@@ -450,22 +459,36 @@ fn the_cli_writes_the_same_image_and_its_layers() {
         "normal.Z",
         "depth.Z",
     ] {
-        assert!(names.iter().any(|n| n == want), "{want} in {names:?}");
+        assert!(aov_layers.contains_key(want), "{want}");
     }
-    let layers = exr::prelude::read_all_flat_layers_from_file(&parts).unwrap();
-    let names: Vec<String> = layers.layer_data[0]
-        .channel_data
-        .list
-        .iter()
-        .map(|c| c.name.to_string())
-        .collect();
+    assert!(aov_layers["time.us"].iter().all(|&t| t > 0.0));
+    let part_layers = channels(&parts);
     for want in [
         "technique.light.R",
         "technique.bsdf.G",
         "bounce.direct.B",
         "bounce.3+.R",
     ] {
-        assert!(names.iter().any(|n| n == want), "{want} in {names:?}");
+        assert!(part_layers.contains_key(want), "{want}");
+    }
+    for c in ["R", "G", "B"] {
+        let image = &part_layers[c];
+        for split in [
+            ["technique.emitted", "technique.light", "technique.bsdf", ""],
+            ["bounce.direct", "bounce.1", "bounce.2", "bounce.3+"],
+        ] {
+            for (i, &want) in image.iter().enumerate() {
+                let sum: f32 = split
+                    .iter()
+                    .filter(|p| !p.is_empty())
+                    .map(|p| part_layers[&format!("{p}.{c}")][i])
+                    .sum();
+                assert!(
+                    (sum - want).abs() <= 1e-5 * want.max(1.0),
+                    "{split:?} {c}: {sum} vs {want}"
+                );
+            }
+        }
     }
     // The largest firefly, replayed.
     let json: serde_json::Value =
