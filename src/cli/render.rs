@@ -63,9 +63,10 @@ pub struct RenderArgs {
     /// measure what it is worth. The image is the same in each.
     #[arg(long, value_enum, default_value_t = IsaChoice::Auto)]
     isa: IsaChoice,
-    /// Also write per-pixel statistics as layers of this EXR: time, rays by kind, BVH node
-    /// and primitive tests, path length, variance of the estimate, and albedo, normal and
-    /// depth at the first hit (docs/inspect.md). The image is the same, to the bit.
+    /// Also write per-pixel statistics as layers of this EXR: time, rays by kind, dropped
+    /// samples, BVH node and primitive tests, path length, variance of the estimate, and
+    /// albedo, normal and depth at the first hit (docs/inspect.md). The image is the same, to
+    /// the bit.
     #[arg(long, value_name = "FILE.exr", conflicts_with_all = INSPECT_CONFLICTS)]
     aov: Option<PathBuf>,
     /// Also write the image split by technique (emitted, light-sampled, BSDF-sampled, each
@@ -74,11 +75,29 @@ pub struct RenderArgs {
     /// within rounding). Path only.
     #[arg(long, value_name = "FILE.exr", conflicts_with_all = INSPECT_CONFLICTS)]
     parts: Option<PathBuf>,
-    /// Keep the N single samples that stand out most above their pixel's mean (by luminance),
-    /// with the path of each, as JSON in NAME.fireflies.json beside the image (at most 10000).
+    /// Keep the N single samples that stand out most above their pixel's mean by luminance (at
+    /// 1 spp the brightest), with the path of each, as JSON in NAME.fireflies.json beside the
+    /// image (at most 10000).
     #[arg(long, value_name = "N", conflicts_with_all = INSPECT_CONFLICTS,
           value_parser = clap::value_parser!(u32).range(1..=MAX_FIREFLIES as i64))]
     fireflies: Option<u32>,
+}
+
+/// True if `a` and `b` name one file: the same name in the same folder, the folders resolved
+/// (`..`, links) where they exist.
+fn same_file(a: &Path, b: &Path) -> bool {
+    let resolved = |p: &Path| {
+        let folder = match p.parent() {
+            Some(f) if !f.as_os_str().is_empty() => f,
+            _ => Path::new("."),
+        };
+        let folder = folder
+            .canonicalize()
+            .or_else(|_| std::path::absolute(folder))
+            .unwrap_or_else(|_| folder.to_path_buf());
+        (folder, p.file_name().map(|n| n.to_os_string()))
+    };
+    resolved(a) == resolved(b)
 }
 
 /// Where `--fireflies` writes: NAME.fireflies.json beside the image NAME.EXT.
@@ -321,17 +340,28 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         a.aov.as_deref(),
         a.parts.as_deref(),
         fireflies_file.as_deref(),
+        a.stats.as_deref(),
     ]
     .into_iter()
     .flatten()
     .collect();
     for (i, p) in written.iter().enumerate() {
-        let same = |q: &Path| std::path::absolute(q).ok() == std::path::absolute(p).ok();
-        if written[..i].iter().any(|q| same(q)) {
+        if written[..i].iter().any(|q| same_file(q, p)) {
             return Err(format!(
-                "{}: written twice (the image, --aov, --parts and the fireflies' JSON each \
-                 need their own file)",
+                "{}: written twice (the image, --aov, --parts, the fireflies' JSON and --stats \
+                 each need their own file)",
                 p.display()
+            )
+            .into());
+        }
+    }
+    if a.inspected() {
+        let (w, h) = (scene.settings.film.width, scene.settings.film.height);
+        if w as u64 * h as u64 > progressive::MAX_PIXELS {
+            return Err(format!(
+                "--aov, --parts and --fireflies hold up to 800 bytes per pixel while they render: \
+                 at most {} pixels, and this film has {w}x{h}",
+                progressive::MAX_PIXELS,
             )
             .into());
         }
@@ -391,13 +421,15 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
                 held.samples(),
                 held.spp
             );
-            held
+            Some(held)
         }
-        None => Pass::empty(&prepared),
+        // Only a progressive render holds a pass (120 bytes per pixel) while it runs.
+        None => None,
     };
-    let to_render = match a.pass {
-        Some(_) => samples.len() as u32,
-        None => prepared.film.spp - start.samples() as u32,
+    let to_render = match (a.pass, &start) {
+        (Some(_), _) => samples.len() as u32,
+        (None, Some(held)) => prepared.film.spp - held.samples() as u32,
+        (None, None) => prepared.film.spp,
     };
 
     // What it will cost: the shader's rule and a short calibration (for a pass, its share).
@@ -452,17 +484,6 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         return Ok(());
     }
     if a.inspected() {
-        let pixels = prepared.film.width as u64 * prepared.film.height as u64;
-        if pixels > progressive::MAX_PIXELS {
-            return Err(format!(
-                "--aov, --parts and --fireflies keep about 300 bytes per pixel: at most {} \
-                 pixels, and this film has {}x{}",
-                progressive::MAX_PIXELS,
-                prepared.film.width,
-                prepared.film.height
-            )
-            .into());
-        }
         return inspected(&prepared, &pool, &bar, &out, &a, &est);
     }
     let film = prepared.film;
@@ -522,7 +543,7 @@ pub fn run(a: RenderArgs) -> Result<(), CliError> {
         pool.install(|| {
             progressive::refine(
                 &prepared,
-                start,
+                start.unwrap_or_else(|| Pass::empty(&prepared)),
                 a.time,
                 &tick,
                 &interrupt::STOP,
@@ -738,9 +759,23 @@ fn inspected(
         }))?;
         output::write_file(&path, json.as_bytes())?;
         if let Some(f) = result.fireflies.first() {
+            // The command that replays it: the scene and the overrides this render was given.
+            let mut replay = String::from("rtis replay");
+            if let Some(scene) = &a.scene {
+                replay += &format!(" {}", scene.display());
+            }
+            let o = a.film;
+            for (flag, v) in [("width", o.width), ("height", o.height), ("spp", o.spp)] {
+                if let Some(v) = v {
+                    replay += &format!(" --{flag} {v}");
+                }
+            }
+            if let Some(seed) = o.seed {
+                replay += &format!(" --seed {seed}");
+            }
             eprintln!(
-                "{} fireflies -> {}; the largest: pixel {},{} sample {}, luminance {} \
-                 (replay it with rtis replay SCENE --pixel {},{} --sample {})",
+                "{} fireflies -> {}; the largest: pixel {},{} sample {}, luminance {} (replay \
+                 it with {replay} --pixel {},{} --sample {})",
                 result.fireflies.len(),
                 path.display(),
                 f.pixel[0],

@@ -14,7 +14,7 @@ pub struct ReplayArgs {
     /// Cornell box of the course.
     scene: Option<PathBuf>,
     /// The pixel: column and row from the top left, as X,Y.
-    #[arg(long, value_parser = parse_pixel, value_name = "X,Y")]
+    #[arg(long, value_parser = parse_pixel, value_name = "X,Y", allow_hyphen_values = true)]
     pixel: (u32, u32),
     /// The sample's index in the pixel (0 to spp - 1).
     #[arg(long, value_name = "I")]

@@ -288,8 +288,8 @@ pub struct Measured {
     /// of it without counters (row-major).
     pub pixel_seconds: Vec<f32>,
     /// Each pixel's variance (the mean over channels): across the seeds' images, or with one
-    /// seed the variance of its estimate from its samples (zero at 1 spp).
-    pub pixel_variance: Vec<f32>,
+    /// seed the variance of its estimate from its samples; unknown with one seed at 1 spp.
+    pub pixel_variance: Option<Vec<f32>>,
     /// The first seed's samples that stand out most above their pixels, with their paths.
     pub fireflies: Vec<Firefly>,
 }
@@ -397,13 +397,13 @@ pub fn sweep(
         // Each pixel's variance: across the seeds where there are two or more, else the
         // variance of its estimate from its own samples.
         let pixel_variance = if images.len() >= 2 {
-            pixel_variance(&images)
+            Some(pixel_variance(&images))
+        } else if s.film.spp >= 2 {
+            let v = inspected.pixels.iter();
+            Some(v.map(|p| p.variance.element_sum() / 3.0).collect())
         } else {
-            let v = inspected
-                .pixels
-                .iter()
-                .map(|p| p.variance.element_sum() / 3.0);
-            v.collect()
+            // One image of one sample per pixel: nothing to measure its spread by.
+            None
         };
         Measured {
             row,

@@ -7,8 +7,9 @@
 //! time, rays, RMSE, relMSE, mean FLIP, bias^2 and variance per rung; an "equal error" view
 //! (for a chosen RMSE, the time each family needs to reach it, interpolated on the log-log
 //! curve); the price of each effect of the scene; where each rung's time goes (time per
-//! pixel, squared error per pixel and their product, the inverse efficiency); and each rung's
-//! largest samples circled on its image, with their paths.
+//! pixel, squared error per pixel, and variance times time, the inverse efficiency); and the
+//! samples of each rung that stand out most above the reference, circled on its image, with
+//! their paths.
 
 use super::metrics::{flip, rel_se_map, se_map};
 use super::{Measured, REPORT_FIREFLIES, Row};
@@ -235,7 +236,12 @@ function show(i) {
   document.getElementById('relmap').src = r.relmap;
   document.getElementById('flipmap').src = r.flipmap;
   document.getElementById('rungname').textContent = r.family + ' ' + r.label;
-  for (const m of ['timemap', 'errmap', 'productmap']) document.getElementById(m).src = r[m];
+  for (const m of ['timemap', 'errmap']) document.getElementById(m).src = r[m];
+  // A rung of one seed at 1 spp has no variance to measure: say so instead of a map.
+  const product = document.getElementById('productmap');
+  product.style.display = r.productmap ? '' : 'none';
+  if (r.productmap) product.src = r.productmap;
+  document.getElementById('productnote').style.display = r.productmap ? 'none' : '';
   document.getElementById('timemax').textContent = r.timemax.toPrecision(3);
   document.getElementById('ffimage').src = r.image;
   const ns = 'http://www.w3.org/2000/svg';
@@ -345,14 +351,12 @@ pub fn html(r: &Report) -> String {
         .iter()
         .map(|m| se_map(&m.image, r.reference))
         .collect();
-    let product_maps: Vec<Vec<f32>> = time_maps
+    let product_maps: Vec<Option<Vec<f32>>> = time_maps
         .iter()
         .zip(r.rungs)
         .map(|(t, m)| {
-            t.iter()
-                .zip(&m.pixel_variance)
-                .map(|(t, v)| t * v)
-                .collect()
+            let v = m.pixel_variance.as_ref()?;
+            Some(t.iter().zip(v).map(|(t, v)| t * v).collect())
         })
         .collect();
     let scale = |maps: &[Vec<f32>]| {
@@ -362,7 +366,15 @@ pub fn html(r: &Report) -> String {
     };
     // Time on each rung's own scale (rungs differ in time by their spp; where it goes is the
     // question), error and product on one scale for all.
-    let (err_max, product_max) = (scale(&err_maps), scale(&product_maps));
+    // The product's scale over the rungs where it is known and not zero (a deterministic
+    // rung has no variance).
+    let known: Vec<Vec<f32>> = product_maps
+        .iter()
+        .flatten()
+        .filter(|m| p99(m) > 0.0)
+        .cloned()
+        .collect();
+    let (err_max, product_max) = (scale(&err_maps), scale(&known));
     let mut data = Vec::new();
     for (k, (m, rel)) in r.rungs.iter().zip(&rel_maps).enumerate() {
         let f = flip(&m.image, r.reference);
@@ -386,7 +398,9 @@ pub fn html(r: &Report) -> String {
             "timemap": png_uri(&magma(&time_maps[k], w, h, p99(&time_maps[k]).max(1e-12))),
             "timemax": p99(&time_maps[k]),
             "errmap": png_uri(&magma(&err_maps[k], w, h, err_max)),
-            "productmap": png_uri(&magma(&product_maps[k], w, h, product_max)),
+            "productmap": product_maps[k]
+                .as_ref()
+                .map(|p| png_uri(&magma(p, w, h, product_max))),
             "fireflies": fireflies,
         }));
     }
@@ -425,14 +439,16 @@ pub fn html(r: &Report) -> String {
          inverse of the efficiency, lower is better; the variance across the seeds, or with \
          one seed the variance of the pixel's estimate from its samples). A rung that spends \
          its time where the error is not shows it at a glance: bright time where the error is \
-         dark. Time from an inspected render of the same image, without its counters \
-         (<code>rtis render --aov</code>).</p><div class=\"maps\">\
+         dark. Time from an inspected render of the same image (as <code>rtis render \
+         --aov</code> measures it, but without counting BVH tests).</p><div class=\"maps\">\
          <figure><img id=\"timemap\" alt=\"time per pixel\"><figcaption>time per pixel\
          </figcaption>{}</figure>\
          <figure><img id=\"errmap\" alt=\"squared error per pixel\"><figcaption>squared error \
          (x - r)^2</figcaption>{}</figure>\
-         <figure><img id=\"productmap\" alt=\"variance times time\"><figcaption>variance \
-         &times; time</figcaption>{}</figure></div>\
+         <figure><img id=\"productmap\" alt=\"variance times time\"><p id=\"productnote\" \
+         class=\"note\" style=\"display:none\">unknown: one image of 1 spp has no spread to \
+         measure (run with --seeds 2 or more)</p><figcaption>variance &times; time\
+         </figcaption>{}</figure></div>\
          <h2>Fireflies</h2><p>The rung's {REPORT_FIREFLIES} samples that stand out most above \
          the reference's pixel (by luminance), circled on its image, with the path that made \
          each (<code>rtis render --fireflies N</code> writes them with every vertex; \

@@ -91,8 +91,9 @@ pub struct Firefly {
     pub radiance: [f32; 3],
     /// Its luminance (Rec. 709 weights).
     pub luminance: f32,
-    /// Its luminance less its pixel's (the mean of the pixel's samples), by which fireflies
-    /// are ranked: how far the sample stands out, what it adds to the pixel's error.
+    /// Its luminance less that of what it is ranked against ([`Inspect::against`]: a
+    /// reference's pixel, or its own pixel's mean, or zero at 1 spp): how far the sample
+    /// stands out. Fireflies are ranked by it.
     pub excess: f32,
     /// Its path, event by event (for the path tracer; other shaders record none).
     pub path: Vec<Event>,

@@ -191,9 +191,15 @@ impl SampleSum {
     /// is beyond the largest `f32` (finite contributions can add up to infinity).
     #[inline(always)]
     pub fn failed(&self) -> bool {
-        self.failed
-            || self.fast.max_element() > f32::MAX as f64
-            || (self.rounded && self.rest.0.iter().any(|c| c.to_f64() > f32::MAX as f64))
+        let beyond = |c: usize| {
+            let rest = if self.rounded {
+                self.rest.0[c].to_f64()
+            } else {
+                0.0
+            };
+            self.fast[c] + rest > f32::MAX as f64
+        };
+        self.failed || beyond(0) || beyond(1) || beyond(2)
     }
 
     /// The sum the pixel keeps: this one, or zero (counted in `stats.dropped`) if it failed.
@@ -412,6 +418,13 @@ mod tests {
         assert!(!sample.failed());
         sample.add(Vec3A::new(0.0, f32::MAX, 0.0), Technique::Bsdf, 2);
         assert!(sample.failed());
+        // Also when the part summed in f64 and the part summed in fixed point are each below
+        // it: 2^126 and 2^74 add exactly, 1.5 * 2^127 would round and goes to fixed point.
+        let mut sample = SampleSum::default();
+        for v in [2f32.powi(126), 2f32.powi(74), 1.5 * 2f32.powi(127)] {
+            sample.add(Vec3A::splat(v), Technique::Light, 1);
+        }
+        assert!(sample.rounded && sample.failed());
         let mut sample = SampleSum::default();
         sample.add(Vec3A::ONE, Technique::Light, 1);
         sample.add(Vec3A::new(1.0, f32::NAN, 0.0), Technique::Bsdf, 2);

@@ -95,7 +95,8 @@ def test_report_shows_where_the_time_goes_and_the_fireflies(report, browser):
             out[m] = img.get_attribute("src")
         return out
 
-    # The time, error and error x time maps of the first rung, its scale written out.
+    # The time, error and variance x time maps of the first rung (2 seeds: its variance is
+    # known), its scale written out.
     first = shown()
     assert float(browser.find_element(By.ID, "timemax").text) > 0
     # Its fireflies: one circle per table row, at most eight, on the rung's image, each row
@@ -115,4 +116,21 @@ def test_report_shows_where_the_time_goes_and_the_fireflies(report, browser):
     # Ranked: each firefly stands out no more than the one before.
     excess = [float(r.find_elements(By.TAG_NAME, "td")[4].text) for r in table]
     assert excess == sorted(excess, reverse=True), excess
+    assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+
+
+def test_report_says_when_a_rung_has_no_variance_to_measure(tmp_path, browser):
+    from selenium.webdriver.common.by import By
+
+    # One seed: the 1-spp rungs have no spread to measure; Path at 4 spp and more has.
+    subprocess.run([RTIS, "converge", "--width", "32", "--runs", "1", "--seeds", "1",
+                    "--reference-spp", "16", "--out", str(tmp_path)], check=True,
+                   capture_output=True)
+    browser.get((tmp_path / "report.html").as_uri())
+    rows = browser.find_elements(By.CSS_SELECTOR, "#rows tr")
+    note = browser.find_element(By.ID, "productnote")
+    product = browser.find_element(By.ID, "productmap")
+    assert note.is_displayed() and not product.is_displayed()
+    rows[-1].click()
+    assert product.is_displayed() and not note.is_displayed()
     assert not [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]

@@ -164,6 +164,21 @@ fn variance_and_bias_of_known_images() {
     assert!((mse - 0.01).abs() < 1e-7, "{mse}");
 }
 
+/// Each pixel's variance across seeds, for the report's variance x time map: the unbiased one,
+/// the mean over channels; three seeds of 0.5, 0.7 and 0.9 in every channel give 0.04, a
+/// pixel equal in every seed gives 0.
+#[test]
+fn pixel_variance_of_known_images() {
+    let img = |v: f32| Image {
+        width: 2,
+        height: 1,
+        pixels: vec![glam::Vec3A::splat(v), glam::Vec3A::new(0.25, 0.5, 1.0)],
+    };
+    let v = converge::pixel_variance(&[img(0.5), img(0.7), img(0.9)]);
+    assert!((v[0] - 0.04).abs() < 1e-7, "{v:?}");
+    assert_eq!(v[1], 0.0);
+}
+
 /// The decomposition's formula, exactly: two seeds at `mu + b + d` and `mu + b - d` against a
 /// reference `mu` give a per-pixel variance of `2 d^2` (the unbiased one, over K - 1 = 1), a mean
 /// `b` off the reference, and so `bias2 = b^2 - 2 d^2 / 2 - v_r` with the given reference noise

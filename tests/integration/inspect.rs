@@ -552,6 +552,48 @@ fn the_cli_writes_the_same_image_and_its_layers() {
         ],
         "written twice",
     );
-    assert!(!fresh.exists() && !twice.exists());
+    // The same file by another name (`sub/../`), and --stats over the fireflies' JSON.
+    std::fs::create_dir_all(d.join("sub")).unwrap();
+    let round = d.join("sub").join("..").join("twice.exr");
+    refused(
+        &[
+            "render",
+            scene_arg,
+            "-o",
+            round.to_str().unwrap(),
+            "--aov",
+            twice.to_str().unwrap(),
+        ],
+        "written twice",
+    );
+    let json = d.join("twice.fireflies.json");
+    refused(
+        &[
+            "render",
+            scene_arg,
+            "-o",
+            twice.to_str().unwrap(),
+            "--fireflies",
+            "2",
+            "--stats",
+            json.to_str().unwrap(),
+        ],
+        "written twice",
+    );
+    // A film beyond what an inspected render holds is refused before the scene is prepared.
+    refused(
+        &[
+            "render",
+            scene_arg,
+            "--width",
+            "4096",
+            "--height",
+            "4096",
+            "--aov",
+            fresh.to_str().unwrap(),
+        ],
+        "at most",
+    );
+    assert!(!fresh.exists() && !twice.exists() && !json.exists());
     std::fs::remove_dir_all(&d).unwrap();
 }
