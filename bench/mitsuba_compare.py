@@ -1,22 +1,33 @@
 #!/usr/bin/env python3
-"""Side by side: Mitsuba 3 and rtis render the same physically based Cornell box.
+"""Side by side: Mitsuba 3 and rtis render the same scenes, samples per second and error.
 
-Not run in CI. Renders the scene of tests/data/REFERENCE-README.md (the course's box, every
-sphere diffuse, three point lights) with Mitsuba 3's `path` integrator and with rtis's `Path`
-shader under `model: Physical` (scenes/cornell-physical.ron) at the same samples per pixel, in
-one invocation so both share the machine's state, and prints for each: wall seconds, samples per
-second, and RMSE against the 4096-spp Mitsuba reference image (tests/data, mirrored left-right
-to rtis's camera convention). Equal-error comparison: the ratio of samples per second, and the
-time each needs to reach the other's error (RMSE falls as 1/sqrt(spp) for both).
+Not run in CI. Three scenes, each rendered by Mitsuba 3's `path` integrator and by rtis's `Path`
+shader under `model: Physical` at the same samples per pixel, in one invocation so both share the
+machine's state:
+
+- `diffuse`: the course's box with every sphere diffuse and three point lights
+  (scenes/cornell-physical.ron, tests/data/REFERENCE-README.md), against the stored 4096-spp
+  Mitsuba image;
+- `full`: the same box with the course's mirror ball and a Fresnel glass ball (ior 1.1), against
+  a Mitsuba image rendered here at --reference-spp in two independent halves (their difference
+  measures its own noise);
+- `area`: Mitsuba's own `cornell_box()` lit by its area light (scenes/mitsuba-cornell.ron),
+  against the stored 4096-spp Mitsuba image.
+
+For each it prints wall seconds, samples per second, RMSE against the reference and the
+renderer's own RMSE (the reference's noise taken out), and the time each needs to reach the
+smallest own error (RMSE falls as 1/sqrt(spp)). rtis renders with the same estimator as
+Mitsuba's `path` (one light sample per vertex, MIS with the BSDF sample) and with its other
+strategies: every point light at every vertex, one by importance, light or BSDF sampling alone.
 
 Setup (once):
-    pip install mitsuba numpy
+    .venv/bin/pip install mitsuba numpy
     apt-get install libllvm19        # for the fast llvm_ad_rgb variant
-    export DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so
     cargo build --release
 
 Usage:
-    python3 bench/mitsuba_compare.py [--spp 64] [--variant llvm_ad_rgb]
+    .venv/bin/python bench/mitsuba_compare.py [--spp 64] [--scenes diffuse,full,area]
+        [--reference-spp 1024] [--variant llvm_ad_rgb]
 """
 
 import argparse
@@ -33,8 +44,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REFERENCE = os.path.join(ROOT, "tests/data/cornell_rtis_diffuse_360x288_dinf_spp4096.exr")
 
 
-def mitsuba_scene(mi, spp):
-    """The reference's scene as a Mitsuba dict (see tests/data/REFERENCE-README.md)."""
+def mitsuba_scene(mi, spp, full=False):
+    """The reference's scene as a Mitsuba dict (see tests/data/REFERENCE-README.md); with
+    `full`, the large sphere a tinted mirror and the middle one glass of index 1.1."""
     T = mi.ScalarTransform4f
 
     def wall(to_world, rgb):
@@ -43,6 +55,9 @@ def mitsuba_scene(mi, spp):
             "to_world": to_world,
             "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb}},
         }
+
+    def diffuse(rgb):
+        return {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb}}
 
     h = 1000.0  # half size of the rectangles standing in for infinite planes
     scene = {
@@ -63,17 +78,15 @@ def mitsuba_scene(mi, spp):
         "floor": wall(T().translate([0, -3, 0]).rotate([1, 0, 0], -90).scale(h), [0.8, 0.8, 0.8]),
         "back": wall(T().translate([0, 0, 9]).rotate([0, 1, 0], 180).scale(h), [0.3, 0.2, 0.7]),
     }
-    for name, c, r, rgb in [
-        ("big", [-1.5, -1.5, 3.5], 1.5, [0.8, 0.8, 0.8]),
-        ("mid", [1, 0, 2], 1.0, [0.8, 0.8, 0.8]),
-        ("red", [0.3, -2, 5], 1.0, [0.7, 0.2, 0.3]),
+    mirror = {"type": "conductor", "material": "none",
+              "specular_reflectance": {"type": "rgb", "value": [1, 0.9, 0.85]}}
+    glass = {"type": "dielectric", "int_ior": 1.1, "ext_ior": 1.0}
+    for name, c, r, bsdf in [
+        ("big", [-1.5, -1.5, 3.5], 1.5, mirror if full else diffuse([0.8, 0.8, 0.8])),
+        ("mid", [1, 0, 2], 1.0, glass if full else diffuse([0.8, 0.8, 0.8])),
+        ("red", [0.3, -2, 5], 1.0, diffuse([0.7, 0.2, 0.3])),
     ]:
-        scene[name] = {
-            "type": "sphere",
-            "center": c,
-            "radius": r,
-            "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb}},
-        }
+        scene[name] = {"type": "sphere", "center": c, "radius": r, "bsdf": bsdf}
     for i, z in enumerate([0, 3, 6]):
         scene[f"light{i}"] = {
             "type": "point",
@@ -81,6 +94,16 @@ def mitsuba_scene(mi, spp):
             "intensity": {"type": "rgb", "value": [7, 7, 7]},
         }
     return scene
+
+
+def area_scene(mi, spp):
+    """`mi.cornell_box()` as bench/mitsuba_area_reference.py renders it."""
+    d = mi.cornell_box()
+    d["integrator"] = {"type": "path", "max_depth": -1, "rr_depth": 5, "hide_emitters": False}
+    d["sensor"]["film"].update(width=128, height=128, rfilter={"type": "box"}, pixel_format="rgb",
+                               component_format="float32")
+    d["sensor"]["sampler"] = {"type": "independent", "sample_count": spp}
+    return d
 
 
 def read_exr(path):
@@ -93,12 +116,87 @@ def rmse(a, b):
     return float(np.sqrt(np.mean((a - b) ** 2)))
 
 
-REFERENCE_NOISE_RMSE = 0.007  # tests/data/REFERENCE-README.md
+# The rtis scene text of each comparison and its strategies: (label, what replaces the shader).
+PHYSICAL = open(os.path.join(ROOT, "scenes/cornell-physical.ron")).read().replace(
+    'extends: "cornell.ron"', f'extends: "{ROOT}/scenes/cornell.ron"')
+FULL = (PHYSICAL
+        .replace('(name: "mirror ball", shape: Sphere(center: (-1.5, -1.5, 3.5), radius: 1.5), material: Phong(kd: (0.8, 0.8, 0.8)))',
+                 '(name: "mirror ball", shape: Sphere(center: (-1.5, -1.5, 3.5), radius: 1.5), material: Mirror(color: (1, 0.9, 0.85)))')
+        .replace('(name: "glass ball",  shape: Sphere(center: (1, 0, 2), radius: 1),           material: Phong(kd: (0.8, 0.8, 0.8)))',
+                 '(name: "glass ball",  shape: Sphere(center: (1, 0, 2), radius: 1),           material: Transmissive(ior: 1.1))'))
+assert FULL.count("Mirror(") == 1 and FULL.count("Transmissive(") == 1, "cornell-physical.ron changed"
+AREA = open(os.path.join(ROOT, "scenes/mitsuba-cornell.ron")).read()
+POINT_STRATEGIES = [
+    ("rtis Path, one light (same strategy)", "lights_per_vertex: One"),
+    ("rtis Path, all lights", "lights_per_vertex: All"),
+    ("rtis Path, one by importance", "lights_per_vertex: Importance"),
+]
+AREA_STRATEGIES = [
+    ("rtis Path, MIS (same strategy)", "lights: Mis"),
+    ("rtis Path, light sampling", "lights: Light"),
+    ("rtis Path, BSDF sampling", "lights: Brdf"),
+]
+
+
+def rtis_rows(text, strategies, spp, ref, flip):
+    """rtis's rows: each strategy's seconds and RMSE against `ref` (flipped left-right first
+    if `flip`: Mitsuba's camera is right-handed)."""
+    rtis = os.path.join(ROOT, "target/release/rtis")
+    rows = []
+    with tempfile.TemporaryDirectory() as d:
+        for label, strategy in strategies:
+            scene_file = os.path.join(d, "scene.ron")
+            with open(scene_file, "w") as f:
+                f.write(text.replace("sampling: Brdf)", f"sampling: Brdf, {strategy})"))
+            out = os.path.join(d, "rtis.exr")
+            t = time.perf_counter()
+            subprocess.run([rtis, "render", scene_file, "--spp", str(spp), "-o", out], check=True,
+                           stderr=subprocess.DEVNULL)
+            seconds = time.perf_counter() - t
+            img = read_exr(out)
+            rows.append((label, seconds, rmse(img[:, ::-1, :] if flip else img, ref)))
+    return rows
+
+
+def mitsuba_row(mi, scene, spp, variant, ref):
+    """Mitsuba's row: seconds (its kernels compiled first, outside the timing) and RMSE."""
+    mi.render(scene, spp=1)
+    t = time.perf_counter()
+    img = np.array(mi.render(scene, spp=spp))
+    return ("Mitsuba 3 " + variant, time.perf_counter() - t, rmse(img, ref))
+
+
+def compare(name, mi, args):
+    """One scene: (width, height, reference noise RMSE, rows)."""
+    if name == "diffuse":
+        ref = read_exr(os.path.join(ROOT, "tests/data/cornell_rtis_diffuse_360x288_dinf_spp4096.exr"))
+        noise, size = 0.007, (360, 288)
+        rows = [mitsuba_row(mi, mi.load_dict(mitsuba_scene(mi, args.spp)), args.spp, args.variant, ref)]
+        rows += rtis_rows(PHYSICAL, POINT_STRATEGIES, args.spp, ref, True)
+    elif name == "full":
+        # The reference: two independent halves, their mean, and its noise from their difference.
+        half = mi.load_dict(mitsuba_scene(mi, args.reference_spp // 2, full=True))
+        a = np.array(mi.render(half, spp=args.reference_spp // 2, seed=1))
+        b = np.array(mi.render(half, spp=args.reference_spp // 2, seed=2))
+        ref, noise, size = (a + b) / 2, rmse(a, b) / 2, (360, 288)
+        rows = [mitsuba_row(mi, mi.load_dict(mitsuba_scene(mi, args.spp, full=True)), args.spp,
+                            args.variant, ref)]
+        rows += rtis_rows(FULL, POINT_STRATEGIES, args.spp, ref, True)
+    else:
+        ref = read_exr(os.path.join(ROOT, "tests/data/mitsuba_cornell_area_128_spp4096.exr"))
+        with open(os.path.join(ROOT, "tests/data/mitsuba_cornell_area_128_spp4096.json")) as f:
+            noise = json.load(f)["noise_rmse"]
+        size = (128, 128)
+        rows = [mitsuba_row(mi, mi.load_dict(area_scene(mi, args.spp)), args.spp, args.variant, ref)]
+        rows += rtis_rows(AREA, AREA_STRATEGIES, args.spp, ref, True)
+    return size, noise, rows
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--scenes", default="diffuse,full,area")
+    ap.add_argument("--reference-spp", type=int, default=1024)
     ap.add_argument("--variant", default="llvm_ad_rgb")
     args = ap.parse_args()
 
@@ -108,51 +206,25 @@ def main():
     import mitsuba as mi
 
     mi.set_variant(args.variant)
-    ref = read_exr(REFERENCE)
-    # Mitsuba's camera is right-handed: its image is rtis's mirrored left-right.
-    ref_rtis = ref[:, ::-1, :]
-
-    scene = mi.load_dict(mitsuba_scene(mi, args.spp))
-    mi.render(scene, spp=1)  # compile kernels outside the timing
-    t = time.perf_counter()
-    img = np.array(mi.render(scene, spp=args.spp))
-    t_mi = time.perf_counter() - t
-    rows = [("Mitsuba 3 " + args.variant, t_mi, rmse(img, ref))]
-
-    rtis = os.path.join(ROOT, "target/release/rtis")
-    with open(os.path.join(ROOT, "scenes/cornell-physical.ron")) as f:
-        text = f.read()
-    with tempfile.TemporaryDirectory() as d:
-        # The scene as it is (every point light at every vertex), with one light per vertex
-        # chosen by power (Mitsuba's own strategy), and with one chosen by its unshadowed
-        # contribution at the vertex (pbrt-v4's importance of a point light).
-        for label, per_vertex in [("rtis Path, all lights", "All"), ("rtis Path, one light", "One"),
-                                  ("rtis Path, one by importance", "Importance")]:
-            scene_file = os.path.join(d, f"{per_vertex}.ron")
-            with open(scene_file, "w") as f:
-                f.write(text.replace('extends: "cornell.ron"', f'extends: "{ROOT}/scenes/cornell.ron"')
-                        .replace("sampling: Brdf)", f"sampling: Brdf, lights_per_vertex: {per_vertex})"))
-            out = os.path.join(d, "rtis.exr")
-            cmd = [rtis, "render", scene_file, "--spp", str(args.spp), "-o", out]
-            t = time.perf_counter()
-            subprocess.run(cmd, check=True, stderr=subprocess.DEVNULL)
-            rows.append((label, time.perf_counter() - t, rmse(read_exr(out), ref_rtis)))
-
-    pixels = 360 * 288 * args.spp
-    print(f"{'renderer':<28} {'seconds':>8} {'Msamples/s':>11} {'RMSE':>9} {'own RMSE':>9}")
-    # The reference's own noise is part of every RMSE; the renderer's own error is what is
-    # left, and it falls as 1/sqrt(time): time to reach a common error e is t (own / e)^2.
-    own = [max(e * e - REFERENCE_NOISE_RMSE**2, 1e-12) ** 0.5 for _, _, e in rows]
-    for (name, t, e), o in zip(rows, own):
-        print(f"{name:<28} {t:>8.2f} {pixels / t / 1e6:>11.2f} {e:>9.5f} {o:>9.5f}")
-    target = min(own)
-    eq = [t * (o / target) ** 2 for (_, t, _), o in zip(rows, own)]
-    for (name, _, _), q in zip(rows[1:], eq[1:]):
-        print(f"at equal error (own RMSE {target:.5f}): Mitsuba {eq[0]:.2f} s, {name} {q:.2f} s: "
-              f"{eq[0] / q:.2f}x Mitsuba's speed")
-    print(json.dumps({"spp": args.spp, "variant": args.variant,
-                      "rows": [{"renderer": n, "seconds": t, "rmse": e, "own_rmse": o, "seconds_at_equal_error": q}
-                               for (n, t, e), o, q in zip(rows, own, eq)]}))
+    report = {"spp": args.spp, "variant": args.variant, "reference_spp": args.reference_spp, "scenes": {}}
+    for name in args.scenes.split(","):
+        (w, h), noise, rows = compare(name, mi, args)
+        samples = w * h * args.spp
+        # The reference's own noise is part of every RMSE; the renderer's own error is what is
+        # left, and it falls as 1/sqrt(time): time to reach a common error e is t (own / e)^2.
+        own = [max(e * e - noise**2, 1e-12) ** 0.5 for _, _, e in rows]
+        target = min(own)
+        eq = [t * (o / target) ** 2 for (_, t, _), o in zip(rows, own)]
+        print(f"\n{name}: {w}x{h} at {args.spp} spp (reference noise RMSE {noise:.5f})")
+        print(f"{'renderer':<40} {'seconds':>8} {'Msamples/s':>11} {'RMSE':>9} {'own RMSE':>9} {'equal-error s':>14}")
+        for (label, t, e), o, q in zip(rows, own, eq):
+            print(f"{label:<40} {t:>8.2f} {samples / t / 1e6:>11.2f} {e:>9.5f} {o:>9.5f} {q:>14.2f}")
+        report["scenes"][name] = {
+            "width": w, "height": h, "reference_noise": noise,
+            "rows": [{"renderer": n, "seconds": t, "rmse": e, "own_rmse": o, "seconds_at_equal_error": q}
+                     for (n, t, e), o, q in zip(rows, own, eq)],
+        }
+    print(json.dumps(report))
 
 
 if __name__ == "__main__":

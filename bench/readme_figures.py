@@ -565,18 +565,33 @@ def build(_runs):
 def mitsuba(_runs):
     out = venv_script(["bench/mitsuba_compare.py", "--spp", "64"])
     r = json.loads([l for l in out.splitlines() if l.startswith("{")][-1])
-    lines = [
-        "| renderer | seconds | Msamples/s | RMSE | own RMSE | seconds at equal error | speed at equal error |",
-        "|---|---|---|---|---|---|---|",
-    ]
-    base = r["rows"][0]["seconds_at_equal_error"]
-    samples = 360 * 288 * r["spp"]
-    for row in r["rows"]:
-        lines.append(
-            f"| {row['renderer']} | {row['seconds']:.2f} | {samples / row['seconds'] / 1e6:.2f} | {row['rmse']:.4f} | "
-            f"{row['own_rmse']:.4f} | {row['seconds_at_equal_error']:.2f} | {base / row['seconds_at_equal_error']:.2f}x Mitsuba |"
-        )
-    return "\n".join(lines + ["", stamp(f"`bench/mitsuba_compare.py --spp {r['spp']}` ({r['variant']})")])
+    titles = {
+        "diffuse": "The course's box, every sphere diffuse, three point lights (`scenes/cornell-physical.ron`)",
+        "full": "The full box: the mirror ball and a Fresnel glass ball (ior 1.1), three point lights",
+        "area": "Mitsuba's `cornell_box()`, lit by its area light (`scenes/mitsuba-cornell.ron`)",
+    }
+    lines = []
+    for name, sc in r["scenes"].items():
+        rows = sc["rows"]
+        mitsuba_rate = sc["width"] * sc["height"] * r["spp"] / rows[0]["seconds"]
+        base = rows[0]["seconds_at_equal_error"]
+        lines += [
+            f"{titles[name]}, {sc['width']}x{sc['height']} at {r['spp']} spp (reference noise RMSE "
+            f"{sc['reference_noise']:.4f}):",
+            "",
+            "| renderer | seconds | Msamples/s | samples/s vs Mitsuba | RMSE | own RMSE | seconds at equal error | speed at equal error |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
+        for row in rows:
+            rate = sc["width"] * sc["height"] * r["spp"] / row["seconds"]
+            lines.append(
+                f"| {row['renderer']} | {row['seconds']:.2f} | {rate / 1e6:.2f} | {rate / mitsuba_rate:.2f}x | "
+                f"{row['rmse']:.4f} | {row['own_rmse']:.4f} | {row['seconds_at_equal_error']:.2f} | "
+                f"{base / row['seconds_at_equal_error']:.2f}x Mitsuba |"
+            )
+        lines.append("")
+    return "\n".join(lines + [stamp(f"`bench/mitsuba_compare.py --spp {r['spp']}` ({r['variant']}; "
+                                    f"the full box's reference at {r['reference_spp']} spp)")])
 
 
 def block_re(name):
