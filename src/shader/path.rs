@@ -81,176 +81,223 @@ struct Scattered {
 /// the largest `max_depth` and `rr_depth` a scene may ask for.
 pub const MAX_DEPTH: u32 = 1024;
 
+/// A path in flight: the ray to trace next and what the path carries to its next vertex.
+#[derive(Clone, Copy, Debug)]
+pub struct PathState {
+    /// The ray to trace next.
+    pub ray: Ray,
+    /// Its kind.
+    pub kind: RayKind,
+    /// Throughput of the path up to the ray's origin.
+    beta: Vec3A,
+    /// Scattering vertices so far.
+    depth: u32,
+    /// The product of eta'^2 over the dielectric interfaces crossed: beta * eta_scale is the
+    /// throughput without the radiance scaling 1 / eta'^2, which Russian roulette reads, so
+    /// that a path inside glass is not ended for its lower radiance (pbrt-v4's `etaScale`).
+    eta_scale: f32,
+    /// The Phong vertex the ray left, if it was BRDF-sampled there (None for camera rays and
+    /// after mirrors and glass).
+    scattered: Option<Scattered>,
+    /// Whether any vertex so far sampled its direction from a non-delta lobe: light met after
+    /// mirrors and glass only is `Emitted`, after such a vertex `Bsdf`.
+    sampled: bool,
+}
+
+impl PathState {
+    /// The path of a camera ray, before its first trace.
+    pub fn new(camera_ray: &Ray) -> PathState {
+        PathState {
+            ray: *camera_ray,
+            kind: RayKind::Camera,
+            beta: Vec3A::ONE,
+            depth: 0,
+            eta_scale: 1.0,
+            scattered: None,
+            sampled: false,
+        }
+    }
+
+    /// The technique of light the ray meets: emitted (seen by the camera or through mirrors
+    /// and glass only) or BSDF-sampled.
+    fn found(&self) -> Technique {
+        match (self.scattered, self.sampled) {
+            (None, false) => Technique::Emitted,
+            _ => Technique::Bsdf,
+        }
+    }
+}
+
 /// Trace the path of a camera ray, telling `rec` each contribution it finds (with its
 /// technique and the path's length) and, if it keeps them, each event. The radiance along the
 /// camera ray is the sum of the contributions. Scattering into an effect that is off ends the
 /// path.
 pub fn radiance<R: Record>(tr: &mut Tracer, camera_ray: &Ray, p: &Path, rec: &mut R) {
+    let mut st = PathState::new(camera_ray);
+    loop {
+        let hit = tr.trace(&st.ray, st.kind);
+        if !step(tr, p, &mut st, hit, rec) {
+            break;
+        }
+    }
+}
+
+/// One vertex of a path: its ray met `hit` (traced and counted by the caller), or nothing.
+/// Add what the vertex finds (emitted light, next-event estimation) and sample the next ray
+/// into `st`; false when the path ends.
+#[inline(always)]
+pub fn step<R: Record>(
+    tr: &mut Tracer,
+    p: &Path,
+    st: &mut PathState,
+    hit: Option<crate::geometry::Hit>,
+    rec: &mut R,
+) -> bool {
     let model = tr.model;
     let lights = p.lights_under(model);
     let max_depth = p.max_depth.unwrap_or(MAX_DEPTH).min(MAX_DEPTH);
-    let mut beta = Vec3A::ONE;
-    let mut ray = *camera_ray;
-    let mut kind = RayKind::Camera;
-    let mut depth = 0;
-    // The product of eta'^2 over the dielectric interfaces crossed: beta * eta_scale is the
-    // throughput without the radiance scaling 1 / eta'^2, which Russian roulette reads, so
-    // that a path inside glass is not ended for its lower radiance (pbrt-v4's `etaScale`).
-    let mut eta_scale = 1.0f32;
-    // The Phong vertex the ray left, if it was BRDF-sampled there (None for camera rays and
-    // after mirrors and glass).
-    let mut scattered: Option<Scattered> = None;
-    // Whether any vertex so far sampled its direction from a non-delta lobe: light met after
-    // mirrors and glass only is `Emitted`, after such a vertex `Bsdf`.
-    let mut sampled = false;
-    let found = |scattered: Option<Scattered>, sampled: bool| match (scattered, sampled) {
-        (None, false) => Technique::Emitted,
-        _ => Technique::Bsdf,
+    // Escaped rays see the background, or the environment light weighted against the
+    // light sample that could have found it.
+    let Some(hit) = hit else {
+        rec.event(|| Event::Escape { d: arr(st.ray.d) });
+        let le = escaped(tr, &st.ray, st.scattered, lights);
+        add(rec, st.beta * le, st.found(), st.depth);
+        return false;
     };
-    loop {
-        // Escaped rays see the background, or the environment light weighted against the
-        // light sample that could have found it.
-        let Some(hit) = tr.trace(&ray, kind) else {
-            rec.event(|| Event::Escape { d: arr(ray.d) });
-            let le = escaped(tr, &ray, scattered, lights);
-            add(rec, beta * le, found(scattered, sampled), depth);
-            break;
+    let si = Interaction::new(tr, &st.ray, hit);
+    rec.event(|| {
+        let material = tr.geometry.prim(si.hit.prim).material;
+        Event::Hit {
+            p: arr(si.hit.p),
+            n: arr(si.n),
+            material,
+            kind: si.material().kind(),
+            beta: arr(st.beta),
+        }
+    });
+    // Emitted light L_e, weighted against the light sample that could have found it.
+    let le = emitted(tr, &si);
+    if le != Vec3A::ZERO {
+        let w = match (st.scattered, lights) {
+            (None, _) | (Some(_), LightSampling::Brdf) => 1.0,
+            (Some(_), LightSampling::Light) => 0.0,
+            (Some(v), LightSampling::Mis) => {
+                let light = &tr.emitters.lights[si.light as usize];
+                let pdf_light =
+                    tr.emitters.pmf(si.light as usize) * light.pdf(v.p, si.hit.p, si.hit.n);
+                power_heuristic(v.pdf, pdf_light)
+            }
         };
-        let si = Interaction::new(tr, &ray, hit);
-        rec.event(|| {
-            let material = tr.geometry.prim(si.hit.prim).material;
-            Event::Hit {
-                p: arr(si.hit.p),
-                n: arr(si.n),
-                material,
-                kind: si.material().kind(),
-                beta: arr(beta),
-            }
-        });
-        // Emitted light L_e, weighted against the light sample that could have found it.
-        let le = emitted(tr, &si);
-        if le != Vec3A::ZERO {
-            let w = match (scattered, lights) {
-                (None, _) | (Some(_), LightSampling::Brdf) => 1.0,
-                (Some(_), LightSampling::Light) => 0.0,
-                (Some(v), LightSampling::Mis) => {
-                    let light = &tr.emitters.lights[si.light as usize];
-                    let pdf_light =
-                        tr.emitters.pmf(si.light as usize) * light.pdf(v.p, si.hit.p, si.hit.n);
-                    power_heuristic(v.pdf, pdf_light)
-                }
-            };
-            add(rec, beta * le * w, found(scattered, sampled), depth);
-        }
-        if depth >= max_depth {
-            break;
-        }
-        // Scatter: the next ray, its weight g(wi) / pdf(wi), its density (None for a
-        // specular direction) and its kind.
-        let (next_ray, weight, pdf, next) = match (si.material(), model) {
-            (Material::Phong(phong), _) => {
-                add(
-                    rec,
-                    beta * next_event(tr, &si, phong, p),
-                    Technique::Light,
-                    depth + 1,
-                );
-                if !tr.effects.indirect {
-                    break;
-                }
-                let Some((wi, weight, pdf)) = sample_phong(tr, phong, &si, model, p.sampling)
-                else {
-                    break;
-                };
-                scattered = Some(Scattered { p: si.hit.p, pdf });
-                (si.spawn(wi), weight, Some(pdf), RayKind::Indirect)
-            }
-            // A BSDF: next-event estimation with its eval and pdf, then its own sampler. Its
-            // weights are f |cos| / pdf under either model (rough materials ask for the
-            // Physical one; see docs/transport.md).
-            (Material::Bsdf(bsdf), _) => {
-                let shading = si.shading(tr, bsdf);
-                let nee = next_event(tr, &si, &shading, p);
-                add(rec, beta * nee, Technique::Light, depth + 1);
-                if !tr.effects.indirect {
-                    break;
-                }
-                let frame = shading.frame;
-                let uc = tr.sampler.next_f32();
-                let (u1, u2) = tr.sampler.next_2d();
-                let Some(s) = bsdf.sample(frame.to_local(si.wo), uc, u1, u2) else {
-                    break;
-                };
-                // A delta lobe's direction cannot be found by a light sample: its emitter
-                // counts whole, as after a mirror.
-                scattered = (!s.delta).then_some(Scattered {
-                    p: si.hit.p,
-                    pdf: s.pdf,
-                });
-                eta_scale *= s.eta * s.eta;
-                let pdf = (!s.delta).then_some(s.pdf);
-                (
-                    si.spawn(frame.to_world(s.wi)),
-                    s.weight,
-                    pdf,
-                    RayKind::Indirect,
-                )
-            }
-            // Fresnel-weighted choice between reflection and refraction.
-            (Material::Transmissive(g), Model::Physical) => {
-                let r = g.refract(si.wo, si.hit.n);
-                let f = fresnel_dielectric(r.cos_i.abs(), r.eta);
-                let (wi, weight, kind, on) = if tr.sampler.next_f32() < f {
-                    let wr = reflect(si.wo, si.n);
-                    (wr, Vec3A::ONE, RayKind::Reflection, tr.effects.reflection)
-                } else {
-                    // Radiance crossing into the wo side is scaled by (n_wo / n_wi)^2 = eta^2.
-                    let w = g.color * (r.eta * r.eta);
-                    eta_scale /= r.eta * r.eta;
-                    (r.wt, w, RayKind::Refraction, tr.effects.refraction)
-                };
-                // An effect that is off ends the path.
-                if !on {
-                    break;
-                }
-                scattered = None;
-                (si.spawn(wi), weight, None, kind)
-            }
-            // Mirrors, and the course's glass: the one scattered ray, as in Direct and Global.
-            _ => match specular_bounce(&si, tr.effects) {
-                Some((ray, weight, kind)) => {
-                    scattered = None;
-                    (ray, weight, None, kind)
-                }
-                None => break,
-            },
-        };
-        // A normal-mapped surface sends no ray through itself (nor reflects one from below).
-        if si.leaks(next_ray.d) {
-            break;
-        }
-        rec.event(|| Event::Scatter {
-            wi: arr(next_ray.d),
-            pdf,
-            weight: arr(weight),
-            ray: next,
-        });
-        sampled |= pdf.is_some();
-        beta *= weight;
-        depth += 1;
-        // Russian roulette: survive with probability q, divide by q to stay unbiased.
-        if depth >= p.rr_depth {
-            let q = (beta * eta_scale).max_element().min(0.95);
-            let survived = !(q <= 0.0 || tr.sampler.next_f32() >= q);
-            rec.event(|| Event::Roulette { q, survived });
-            if !survived {
-                break;
-            }
-            beta /= q;
-        }
-        ray = next_ray;
-        kind = next;
+        add(rec, st.beta * le * w, st.found(), st.depth);
     }
+    if st.depth >= max_depth {
+        return false;
+    }
+    // Scatter: the next ray, its weight g(wi) / pdf(wi), its density (None for a
+    // specular direction) and its kind.
+    let (next_ray, weight, pdf, next) = match (si.material(), model) {
+        (Material::Phong(phong), _) => {
+            add(
+                rec,
+                st.beta * next_event(tr, &si, phong, p),
+                Technique::Light,
+                st.depth + 1,
+            );
+            if !tr.effects.indirect {
+                return false;
+            }
+            let Some((wi, weight, pdf)) = sample_phong(tr, phong, &si, model, p.sampling) else {
+                return false;
+            };
+            st.scattered = Some(Scattered { p: si.hit.p, pdf });
+            (si.spawn(wi), weight, Some(pdf), RayKind::Indirect)
+        }
+        // A BSDF: next-event estimation with its eval and pdf, then its own sampler. Its
+        // weights are f |cos| / pdf under either model (rough materials ask for the
+        // Physical one; see docs/transport.md).
+        (Material::Bsdf(bsdf), _) => {
+            let shading = si.shading(tr, bsdf);
+            let nee = next_event(tr, &si, &shading, p);
+            add(rec, st.beta * nee, Technique::Light, st.depth + 1);
+            if !tr.effects.indirect {
+                return false;
+            }
+            let frame = shading.frame;
+            let uc = tr.sampler.next_f32();
+            let (u1, u2) = tr.sampler.next_2d();
+            let Some(s) = bsdf.sample(frame.to_local(si.wo), uc, u1, u2) else {
+                return false;
+            };
+            // A delta lobe's direction cannot be found by a light sample: its emitter
+            // counts whole, as after a mirror.
+            st.scattered = (!s.delta).then_some(Scattered {
+                p: si.hit.p,
+                pdf: s.pdf,
+            });
+            st.eta_scale *= s.eta * s.eta;
+            let pdf = (!s.delta).then_some(s.pdf);
+            (
+                si.spawn(frame.to_world(s.wi)),
+                s.weight,
+                pdf,
+                RayKind::Indirect,
+            )
+        }
+        // Fresnel-weighted choice between reflection and refraction.
+        (Material::Transmissive(g), Model::Physical) => {
+            let r = g.refract(si.wo, si.hit.n);
+            let f = fresnel_dielectric(r.cos_i.abs(), r.eta);
+            let (wi, weight, kind, on) = if tr.sampler.next_f32() < f {
+                let wr = reflect(si.wo, si.n);
+                (wr, Vec3A::ONE, RayKind::Reflection, tr.effects.reflection)
+            } else {
+                // Radiance crossing into the wo side is scaled by (n_wo / n_wi)^2 = eta^2.
+                let w = g.color * (r.eta * r.eta);
+                st.eta_scale /= r.eta * r.eta;
+                (r.wt, w, RayKind::Refraction, tr.effects.refraction)
+            };
+            // An effect that is off ends the path.
+            if !on {
+                return false;
+            }
+            st.scattered = None;
+            (si.spawn(wi), weight, None, kind)
+        }
+        // Mirrors, and the course's glass: the one scattered ray, as in Direct and Global.
+        _ => match specular_bounce(&si, tr.effects) {
+            Some((ray, weight, kind)) => {
+                st.scattered = None;
+                (ray, weight, None, kind)
+            }
+            None => return false,
+        },
+    };
+    // A normal-mapped surface sends no ray through itself (nor reflects one from below).
+    if si.leaks(next_ray.d) {
+        return false;
+    }
+    rec.event(|| Event::Scatter {
+        wi: arr(next_ray.d),
+        pdf,
+        weight: arr(weight),
+        ray: next,
+    });
+    st.sampled |= pdf.is_some();
+    st.beta *= weight;
+    st.depth += 1;
+    // Russian roulette: survive with probability q, divide by q to stay unbiased.
+    if st.depth >= p.rr_depth {
+        let q = (st.beta * st.eta_scale).max_element().min(0.95);
+        let survived = !(q <= 0.0 || tr.sampler.next_f32() >= q);
+        rec.event(|| Event::Roulette { q, survived });
+        if !survived {
+            return false;
+        }
+        st.beta /= q;
+    }
+    st.ray = next_ray;
+    st.kind = next;
+    true
 }
 
 /// Tell `rec` of contribution `l` (found by `technique` along a path of `vertices` scattering
