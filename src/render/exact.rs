@@ -38,10 +38,7 @@ impl ExactSum {
         if mantissa == 0 {
             return;
         }
-        let (word, offset) = ((shift / 64) as usize, shift % 64);
-        let wide = (mantissa as u128) << offset;
-        self.add_at(word, wide as u64);
-        self.add_at(word + 1, (wide >> 64) as u64);
+        self.add_scaled(mantissa as u64, shift);
     }
 
     /// Add `v`, a finite `f64 >= 0` that is a whole multiple of `2^-149` below `2^171` (an
@@ -66,6 +63,12 @@ impl ExactSum {
         } else {
             (mantissa, shift as u32)
         };
+        self.add_scaled(mantissa, shift);
+    }
+
+    /// Add `mantissa * 2^(shift - 149)` (a mantissa of at most 64 bits).
+    #[inline(always)]
+    fn add_scaled(&mut self, mantissa: u64, shift: u32) {
         let (word, offset) = ((shift / 64) as usize, shift % 64);
         let wide = (mantissa as u128) << offset;
         self.add_at(word, wide as u64);
