@@ -19,7 +19,9 @@
 
 use super::lanes::{RayLanes, SurfaceLanes, plane_surface, sphere_surface};
 use super::simd::{Floats, Isa, MAX_LANES};
-use super::{Geometry, Tally, Traversal};
+use super::wide::packet::{PACKET, octant};
+use super::{Geometry, LeafRay, Tally, Traversal};
+use crate::geometry::BvhRay;
 use crate::geometry::{Hit, Ray};
 use glam::Vec4;
 
@@ -106,6 +108,67 @@ impl Geometry {
             Isa::Avx512 => unsafe { self.intersect_avx512(rays, hits) },
             // SAFETY: `Vec4` runs on every CPU.
             _ => unsafe { self.intersect_in::<Vec4>(rays, hits) },
+        }
+    }
+
+    /// The nearest hit of each ray of `rays`, as [`Geometry::intersect`] finds it, into `hits`
+    /// (cleared first, then one entry per ray), for rays that run close together, as a camera's
+    /// do: in a scene whose only primitives are in the BVH, eight rays in a row that run into
+    /// the same octant walk the tree together ([`WideBvh::closest_packet`]); the others, and
+    /// every ray of other scenes, are traced alone. The answers are the same to the bit.
+    pub fn intersect_coherent(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+        hits.clear();
+        if self.has_packets() || self.bvh.is_empty() {
+            hits.extend(rays.iter().map(|r| self.intersect(r)));
+            return;
+        }
+        for chunk in rays.chunks(PACKET) {
+            let at = hits.len();
+            hits.extend(chunk.iter().map(|_| None));
+            let out = &mut hits[at..];
+            let boxes: [BvhRay; PACKET] =
+                std::array::from_fn(|i| BvhRay::boxes(chunk[i.min(chunk.len() - 1)]));
+            // The packet: the rays of the first ray's octant.
+            let back = octant(&boxes[0]);
+            let mut live = 0;
+            for (i, b) in boxes.iter().enumerate().take(chunk.len()) {
+                if octant(b) == back {
+                    live |= 1 << i;
+                }
+            }
+            let refs: [&BvhRay; PACKET] = std::array::from_fn(|i| {
+                if live & (1 << i) != 0 {
+                    &boxes[i]
+                } else {
+                    &boxes[0]
+                }
+            });
+            // Each ray's leaf constants when it reaches its first leaf, and the normal of its
+            // nearest lane hit, as in `intersect`.
+            let mut leaf_rays: [LeafRay; PACKET] = Default::default();
+            let mut normals = [None; PACKET];
+            let found = self.bvh.closest_packet(
+                &refs,
+                live,
+                back,
+                |i, b, t_max| {
+                    let (r, br) = leaf_rays[i].get(refs[i], self.has_triangles);
+                    let hit = self.blocks[b as usize].closest(&self.others, br, r, t_max);
+                    hit.map(|(lane, t, n)| {
+                        normals[i] = n;
+                        (4 * b + lane, t)
+                    })
+                },
+                &(),
+            );
+            for (i, (ray, hit)) in chunk.iter().zip(out.iter_mut()).enumerate() {
+                let alone = live & (1 << i) == 0 || found.tied & (1 << i) != 0;
+                *hit = if alone {
+                    self.intersect(ray)
+                } else {
+                    found.best[i].map(|(prim, t)| self.nearest_record(ray, prim, t, normals[i]))
+                };
+            }
         }
     }
 

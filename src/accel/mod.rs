@@ -500,17 +500,30 @@ impl Geometry {
                 .closest(lanes, &mut t_max, &mut best, PlaneLanes::hit);
         }
         let prim = best?;
-        Some(match lane_normal.filter(|_| best == bvh_best) {
+        Some(self.nearest_record(ray, prim, t_max, lane_normal.filter(|_| best == bvh_best)))
+    }
+
+    /// The hit record of `ray`'s nearest hit, on primitive `prim` at `t`, with the unit normal
+    /// the BVH's lane test computed for it if it did.
+    #[inline(always)]
+    fn nearest_record(
+        &self,
+        ray: &Ray,
+        prim: u32,
+        t: f32,
+        lane_normal: Option<glam::Vec3A>,
+    ) -> Hit {
+        match lane_normal {
             // A lane triangle whose normal the lane test computed: its record without
             // rebuilding the triangle (a cross product, a square root and three divisions on
             // the ray's last steps).
             Some(n) => {
                 let block = &self.blocks[prim as usize / 4];
                 let tri = block.triangle_with_normal(prim as usize % 4, n);
-                hit_on(tri.surface(ray, t_max), prim, t_max)
+                hit_on(tri.surface(ray, t), prim, t)
             }
-            None => self.hit_record(ray, prim, t_max),
-        })
+            None => self.hit_record(ray, prim, t),
+        }
     }
 
     /// The hit of `ray` on primitive `prim` at distance `t`.

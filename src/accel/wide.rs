@@ -24,6 +24,8 @@ use glam::Vec3A;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
+pub mod packet;
+
 /// A child reference: an interior node's index, or, when [`LEAF`] is set, a leaf's payload in
 /// the bits below it (its index in the leaves [`WideBvh::collapse`] returns).
 pub type ChildRef = u32;
@@ -298,6 +300,13 @@ pub fn prefetch<T>(x: *const T) {
 #[derive(Clone, Copy)]
 struct RayBox<L> {
     o: [L; 3],
+    /// The origin as the exit sides' distances take it: `o`, except on an axis the ray runs
+    /// parallel to (`1 / d` infinite), where it is moved one ulp away from the exit side, so
+    /// that an origin exactly on that side (a ray along a box's face) gets a large exit
+    /// distance, as the exact one is infinite, instead of `0 * MAX = 0`, which dropped the
+    /// box of a triangle whose edge the ray runs through (`tests/integration/batch.rs`).
+    /// An origin outside the slab by one ulp then enters it: a visit, never a hit.
+    o_exit: [L; 3],
     inv_d: [L; 3],
     /// `inv_d` raised by `1 + 4 eps` in magnitude (and kept finite): a positive exit distance
     /// it gives is not below the exact one, whatever the rounding of the four operations that
@@ -323,11 +332,13 @@ impl<L: Lanes8> RayBox<L> {
     unsafe fn new(o: Vec3A, inv_d: Vec3A) -> Self {
         let finite = |v: Vec3A| v.clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX));
         let inv_exit = finite(inv_d * (1.0 + 4.0 * f32::EPSILON));
+        let o_exit = exit_origin(o, inv_d);
         let inv_d = finite(inv_d);
         // SAFETY: the caller's. (No closure for the splats, as in `Planes::hit`.)
         unsafe {
             RayBox {
                 o: [L::splat(o.x), L::splat(o.y), L::splat(o.z)],
+                o_exit: [L::splat(o_exit.x), L::splat(o_exit.y), L::splat(o_exit.z)],
                 inv_d: [L::splat(inv_d.x), L::splat(inv_d.y), L::splat(inv_d.z)],
                 inv_exit: [
                     L::splat(inv_exit.x),
@@ -341,6 +352,19 @@ impl<L: Lanes8> RayBox<L> {
             }
         }
     }
+}
+
+/// The origin `o` of a ray of reciprocal direction `inv_d` as the node test's exit sides take
+/// it ([`RayBox::o_exit`]): on an axis where `inv_d` is infinite, one ulp away from the side
+/// the ray leaves a slab by (up when it runs towards smaller coordinates, `-0` included).
+#[inline(always)]
+fn exit_origin(o: Vec3A, inv_d: Vec3A) -> Vec3A {
+    let away = |o: f32, inv: f32| match (inv.is_infinite(), inv < 0.0) {
+        (false, _) => o,
+        (true, true) => o.next_up(),
+        (true, false) => o.next_down(),
+    };
+    Vec3A::new(away(o.x, inv_d.x), away(o.y, inv_d.y), away(o.z, inv_d.z))
 }
 
 /// `t` raised by `1 + 4 eps`: the reach the node test compares a computed entry distance with.
@@ -431,15 +455,15 @@ trait Planes {
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
     unsafe fn side<L: Lanes8>(&self, r: &RayBox<L>, axis: usize, exit: bool) -> L {
-        let inv = if exit {
-            &r.inv_exit[axis]
+        let (o, inv) = if exit {
+            (&r.o_exit[axis], &r.inv_exit[axis])
         } else {
-            &r.inv_d[axis]
+            (&r.o[axis], &r.inv_d[axis])
         };
         // SAFETY: the caller's.
         unsafe {
             self.planes::<L>(axis, r.back[axis] ^ exit as usize)
-                .sub(r.o[axis])
+                .sub(*o)
                 .mul(*inv)
         }
     }

@@ -287,11 +287,17 @@ fn rates(
             passes[k].push((start.elapsed().as_secs_f64(), hits));
         }
     }
+    rates_of(passes, rays.len())
+}
+
+/// Each instruction set's median rate (Mrays/s) over its passes of `rays` rays, and its hit
+/// count, which every set must agree on.
+fn rates_of(passes: Vec<Vec<(f64, usize)>>, rays: usize) -> Vec<(f64, usize)> {
     let out: Vec<(f64, usize)> = passes
         .into_iter()
         .map(|p| {
             let (seconds, hits) = median(p);
-            (rays.len() as f64 / seconds / 1e6, hits)
+            (rays as f64 / seconds / 1e6, hits)
         })
         .collect();
     assert!(
@@ -299,6 +305,33 @@ fn rates(
         "the instruction sets found different hits"
     );
     out
+}
+
+/// [`rates`] of nearest-hit queries made in batches of consecutive rays
+/// ([`Geometry::intersect_coherent`]).
+fn rates_in_batches(g: &mut Geometry, isas: &[Isa], rays: &[Ray], runs: u32) -> Vec<(f64, usize)> {
+    use rayon::prelude::*;
+    let mut passes: Vec<Vec<(f64, usize)>> = vec![Vec::new(); isas.len()];
+    for round in 0..runs.max(1) {
+        let mut order: Vec<usize> = (0..isas.len()).collect();
+        if round % 2 == 1 {
+            order.reverse();
+        }
+        for k in order {
+            assert!(g.bvh.set_isa(isas[k]), "checked by IsaArg::isas");
+            let g = &*g;
+            let start = Instant::now();
+            let hits: usize = rays
+                .par_chunks(4096)
+                .map_init(Vec::new, |out, c| {
+                    g.intersect_coherent(c, out);
+                    out.iter().filter(|h| h.is_some()).count()
+                })
+                .sum();
+            passes[k].push((start.elapsed().as_secs_f64(), hits));
+        }
+    }
+    rates_of(passes, rays.len())
 }
 
 /// The median time of `runs` (at least 1) calls of `f`, which return a time and a result that
@@ -399,7 +432,9 @@ fn meshes_section(
             })
             .collect();
         let closest = |g: &Geometry, r: &Ray| g.intersect(r).is_some();
-        let camera_rates = rates(&mut g, isas, &camera, runs, closest);
+        // Camera rays go in packets ([`Geometry::intersect_coherent`]), as a renderer hands
+        // over a tile's rays together.
+        let camera_rates = rates_in_batches(&mut g, isas, &camera, runs);
         // Shadow rays from the visible surface towards a light at (2, 3, -3).
         let light = Vec3A::new(2.0, 3.0, -3.0);
         let shadow: Vec<Ray> = camera

@@ -2,7 +2,9 @@
 //! with AVX2) against one primitive at a time give what the one-ray queries give, to the bit,
 //! in every instruction set the CPU runs, on random scenes of spheres and planes (and, through
 //! the BVH, triangles) at scales from 1e-3 to 1e5, for rays from anywhere and rays leaving a
-//! hit, where the error bands decide.
+//! hit, where the error bands decide. Coherent rays in packets through the BVH
+//! (`Geometry::intersect_coherent`, `src/accel/wide/packet.rs`) give the one-ray hits too,
+//! shared edges and their ties included.
 
 use glam::Vec3A;
 use proptest::prelude::*;
@@ -151,6 +153,175 @@ proptest! {
                 prop_assert_eq!(blocked[k], one, "{:?}: ray {} of {}", isa, k, rays.len());
             }
         }
+    }
+}
+
+/// Triangles only (a BVH scene): up to 300 at scale `s`, many small ones so that the tree has
+/// levels.
+fn triangles(s: f32) -> impl Strategy<Value = Vec<Prim>> {
+    let small = (point(s), point(0.1 * s), point(0.1 * s))
+        .prop_filter_map("zero area", |(a, b, c)| {
+            Triangle::new(a, a + b, a + c).map(|t| Prim::flat(Shape::Triangle(t)))
+        });
+    prop::collection::vec(small, 1..300)
+}
+
+/// Rays from one origin (a pinhole) through a `w` x `h` grid of directions spanning `[-f, f]`
+/// around `axis`, row by row, as a camera's; every fifth a segment of reach `t_max`.
+fn camera_rays(o: Vec3A, axis: Vec3A, f: f32, (w, h): (u32, u32), t_max: f32) -> Vec<Ray> {
+    let frame = rtis::geometry::Frame::from_normal(axis);
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+            let local = Vec3A::new(
+                f * (2.0 * x / w as f32 - 1.0),
+                f * (2.0 * y / h as f32 - 1.0),
+                1.0,
+            );
+            let d = frame.to_world(local.normalize());
+            if i % 5 == 0 {
+                Ray::segment(o, d, t_max)
+            } else {
+                Ray::new(o, d)
+            }
+        })
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Coherent rays traced in packets find the one-ray hits, field for field: a camera's
+    /// rays from anywhere (some crossing octants within a packet, some segments), and the
+    /// rays leaving their hits.
+    #[test]
+    fn coherent_packets_find_the_one_ray_hits(
+        (s, prims, o, axis, f, t) in scale().prop_flat_map(|s| (
+            Just(s),
+            triangles(s),
+            point(2.0 * s),
+            unit(),
+            0.01f32..1.5,
+            0.1f32..3.0,
+        ))
+    ) {
+        let g = Geometry::build(prims, Vec::new());
+        let mut rays = camera_rays(o, axis, f, (13, 9), t * s);
+        let dirs: Vec<Vec3A> = rays.iter().map(|r| r.d).collect();
+        rays.extend(rays.clone().iter().zip(dirs.iter().rev()).filter_map(|(r, &w)| {
+            g.intersect(r).map(|hit| Ray::spawn(&hit, w, f32::INFINITY))
+        }));
+        for (isa, g) in each_isa(g) {
+            let mut hits = Vec::new();
+            g.intersect_coherent(&rays, &mut hits);
+            prop_assert_eq!(hits.len(), rays.len());
+            for (k, (ray, hit)) in rays.iter().zip(&hits).enumerate() {
+                prop_assert_eq!(bits(hit), bits(&g.intersect(ray)), "{:?}: ray {} of {}", isa, k, rays.len());
+            }
+        }
+    }
+}
+
+/// A tessellated square on z = 0, `n` x `n` squares of side 1 from `at`, two triangles each.
+fn grid(n: u32, at: Vec3A) -> Vec<Prim> {
+    let v = |i: u32, j: u32| at + Vec3A::new(i as f32, j as f32, 0.0);
+    let mut prims = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            for (a, b, c) in [
+                (v(i, j), v(i + 1, j), v(i + 1, j + 1)),
+                (v(i, j), v(i + 1, j + 1), v(i, j + 1)),
+            ] {
+                prims.push(Prim::flat(Shape::Triangle(Triangle::new(a, b, c).unwrap())));
+            }
+        }
+    }
+    prims
+}
+
+/// Rays straight down (`-z`, its `x` and `y` negative zeros) through a `(2n + 1)^2` lattice
+/// of step 1/2 from the origin: the vertices, edges' midpoints and diagonals' midpoints of
+/// [`grid`]`(n, 0)`, row by row.
+fn lattice_rays(n: u32) -> Vec<Ray> {
+    (0..(2 * n + 1) * (2 * n + 1))
+        .map(|k| {
+            let (x, y) = (
+                (k % (2 * n + 1)) as f32 * 0.5,
+                (k / (2 * n + 1)) as f32 * 0.5,
+            );
+            Ray::new(Vec3A::new(x, y, 3.0), -Vec3A::Z)
+        })
+        .collect()
+}
+
+/// A tessellated square seen straight on through its vertices and edges, with rays parallel
+/// to two axes: each edge belongs to one of its triangles (the top-left rule), and every ray
+/// inside the square meets one, in packets as alone. The node test once dropped these: an
+/// origin exactly on a box's side along a parallel direction gave the exit `0 * MAX = 0`
+/// (`RayBox::o_exit`), and a packet's bounds inherit the one-ray arithmetic.
+#[test]
+fn rays_along_edges_meet_the_triangle_that_owns_the_edge() {
+    let n = 16;
+    let rays = lattice_rays(n);
+    let w = 2 * n as usize + 1;
+    for (isa, g) in each_isa(Geometry::build(grid(n, Vec3A::ZERO), Vec::new())) {
+        for len in [rays.len(), 3] {
+            let rays = &rays[..len];
+            let mut hits = Vec::new();
+            g.intersect_coherent(rays, &mut hits);
+            assert_eq!(hits.len(), len);
+            for (k, (ray, hit)) in rays.iter().zip(&hits).enumerate() {
+                assert_eq!(bits(hit), bits(&g.intersect(ray)), "{isa:?}: ray {k}");
+                let inside = (1..w - 1).contains(&(k % w)) && (1..w - 1).contains(&(k / w));
+                if inside {
+                    assert!(hit.is_some(), "{isa:?}: ray {k} fell through");
+                    assert_eq!(hit.unwrap().t, 3.0);
+                }
+            }
+        }
+    }
+}
+
+/// Two tessellated squares in one plane, the second shifted by a quarter square: every ray
+/// meets a triangle of each at the same distance, often in two leaves, where the one-ray rule
+/// keeps the one it visited last. The packet traversal sees these ties (the test counts
+/// them) and sends those rays to the one-ray query, so every hit is the one-ray hit.
+#[test]
+fn packets_send_their_ties_to_the_one_ray_query() {
+    use rtis::accel::wide::packet::{PACKET, octant};
+    use rtis::geometry::BvhRay;
+    let n = 16;
+    let mut prims = grid(n, Vec3A::ZERO);
+    prims.extend(grid(n - 1, Vec3A::new(0.25, 0.25, 0.0)));
+    let rays = lattice_rays(n);
+    for (isa, g) in each_isa(Geometry::build(prims, Vec::new())) {
+        let mut hits = Vec::new();
+        g.intersect_coherent(&rays, &mut hits);
+        for (k, (ray, hit)) in rays.iter().zip(&hits).enumerate() {
+            assert_eq!(bits(hit), bits(&g.intersect(ray)), "{isa:?}: ray {k}");
+        }
+        // The ties, counted from the packets themselves.
+        let mut tied = 0;
+        for chunk in rays.chunks(PACKET) {
+            let boxes: Vec<BvhRay> = chunk.iter().map(|r| BvhRay::boxes(*r)).collect();
+            let refs: [&BvhRay; PACKET] = std::array::from_fn(|i| &boxes[i.min(boxes.len() - 1)]);
+            let live = (1 << chunk.len()) - 1;
+            let found = g.bvh.closest_packet(
+                &refs,
+                live,
+                octant(refs[0]),
+                |i, b, t_max| {
+                    let full = refs[i].sheared();
+                    let br = rtis::accel::block::BlockRay::new(&full);
+                    g.blocks[b as usize]
+                        .closest(&g.others, &br, &full, t_max)
+                        .map(|(lane, t, _)| (4 * b + lane, t))
+                },
+                &(),
+            );
+            tied += found.tied.count_ones();
+        }
+        assert!(tied > 100, "{isa:?}: only {tied} ties");
     }
 }
 
