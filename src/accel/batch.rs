@@ -118,58 +118,75 @@ impl Geometry {
     /// every ray of other scenes, are traced alone. The answers are the same to the bit.
     pub fn intersect_coherent(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
         hits.clear();
-        if self.has_packets() || self.bvh.is_empty() {
-            hits.extend(rays.iter().map(|r| self.intersect(r)));
-            return;
-        }
         for chunk in rays.chunks(PACKET) {
-            let at = hits.len();
-            hits.extend(chunk.iter().map(|_| None));
-            let out = &mut hits[at..];
-            let boxes: [BvhRay; PACKET] =
-                std::array::from_fn(|i| BvhRay::boxes(chunk[i.min(chunk.len() - 1)]));
-            // The packet: the rays of the first ray's octant.
-            let back = octant(&boxes[0]);
-            let mut live = 0;
-            for (i, b) in boxes.iter().enumerate().take(chunk.len()) {
-                if octant(b) == back {
-                    live |= 1 << i;
-                }
+            let found = self.intersect_packet(chunk);
+            hits.extend_from_slice(&found[..chunk.len()]);
+        }
+    }
+
+    /// True if [`Geometry::intersect_packet`] traces packets here: every primitive is in the
+    /// BVH (elsewhere it traces ray by ray).
+    #[inline]
+    pub fn packets_pay(&self) -> bool {
+        !self.has_packets() && !self.bvh.is_empty()
+    }
+
+    /// The nearest hits of up to [`PACKET`] rays that run close together (lanes past
+    /// `rays.len()` are `None`), as [`Geometry::intersect_coherent`] finds them.
+    pub fn intersect_packet(&self, rays: &[Ray]) -> [Option<Hit>; PACKET] {
+        assert!(rays.len() <= PACKET, "at most {PACKET} rays in a packet");
+        let mut out = [None; PACKET];
+        if !self.packets_pay() || rays.is_empty() {
+            for (o, r) in out.iter_mut().zip(rays) {
+                *o = self.intersect(r);
             }
-            let refs: [&BvhRay; PACKET] = std::array::from_fn(|i| {
-                if live & (1 << i) != 0 {
-                    &boxes[i]
-                } else {
-                    &boxes[0]
-                }
-            });
-            // Each ray's leaf constants when it reaches its first leaf, and the normal of its
-            // nearest lane hit, as in `intersect`.
-            let mut leaf_rays: [LeafRay; PACKET] = Default::default();
-            let mut normals = [None; PACKET];
-            let found = self.bvh.closest_packet(
-                &refs,
-                live,
-                back,
-                |i, b, t_max| {
-                    let (r, br) = leaf_rays[i].get(refs[i], self.has_triangles);
-                    let hit = self.blocks[b as usize].closest(&self.others, br, r, t_max);
-                    hit.map(|(lane, t, n)| {
-                        normals[i] = n;
-                        (4 * b + lane, t)
-                    })
-                },
-                &(),
-            );
-            for (i, (ray, hit)) in chunk.iter().zip(out.iter_mut()).enumerate() {
-                let alone = live & (1 << i) == 0 || found.tied & (1 << i) != 0;
-                *hit = if alone {
-                    self.intersect(ray)
-                } else {
-                    found.best[i].map(|(prim, t)| self.nearest_record(ray, prim, t, normals[i]))
-                };
+            return out;
+        }
+        let boxes: [BvhRay; PACKET] =
+            std::array::from_fn(|i| BvhRay::boxes(rays[i.min(rays.len() - 1)]));
+        // The packet: the rays of the first ray's octant.
+        let back = octant(&boxes[0]);
+        let mut live = 0;
+        for (i, b) in boxes.iter().enumerate().take(rays.len()) {
+            if octant(b) == back {
+                live |= 1 << i;
             }
         }
+        let refs: [&BvhRay; PACKET] = std::array::from_fn(|i| {
+            if live & (1 << i) != 0 {
+                &boxes[i]
+            } else {
+                &boxes[0]
+            }
+        });
+        // Each ray's leaf constants when it reaches its first leaf, and the normal of its
+        // nearest lane hit, as in `intersect`.
+        let mut leaf_rays: [LeafRay; PACKET] = Default::default();
+        let mut normals = [None; PACKET];
+        let found = self.bvh.closest_packet(
+            &refs,
+            live,
+            back,
+            |i, b, t_max| {
+                let (r, br) = leaf_rays[i].get(refs[i], self.has_triangles);
+                let hit = self.blocks[b as usize].closest(&self.others, br, r, t_max);
+                hit.map(|(lane, t, n)| {
+                    normals[i] = n;
+                    (4 * b + lane, t)
+                })
+            },
+            &(),
+        );
+        for (i, (ray, hit)) in rays.iter().zip(out.iter_mut()).enumerate() {
+            // Rays of other octants, and ties, alone.
+            let alone = live & (1 << i) == 0 || found.tied & (1 << i) != 0;
+            *hit = if alone {
+                self.intersect(ray)
+            } else {
+                found.best[i].map(|(prim, t)| self.nearest_record(ray, prim, t, normals[i]))
+            };
+        }
+        out
     }
 
     /// Whether each ray of `rays` is blocked, as [`Geometry::occluded`] answers it, or as

@@ -15,10 +15,11 @@ pub mod tev;
 
 pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};
 
+use crate::accel::wide::packet::PACKET;
 use crate::geometry::Ray;
 use crate::sampling::{Sampler, pixel_sample};
-use crate::shader::{self, Record, Technique};
-use crate::stats::RayStats;
+use crate::shader::{self, Record, Shader, Technique};
+use crate::stats::{RayKind, RayStats};
 use exact::RgbSum;
 use film::Image;
 use glam::Vec3A;
@@ -78,6 +79,34 @@ pub fn pixel_sum(
     stats: &mut RayStats,
 ) -> RgbSum {
     let mut sum = RgbSum::default();
+    if let Shader::Path(p) = &scene.shader
+        && scene.geometry.packets_pay()
+    {
+        // The camera rays of a pixel run close together: in a scene whose primitives are all
+        // in the BVH, those of up to eight samples are traced in a packet (the one-ray hits to
+        // the bit), and each path goes on alone from its hit.
+        let mut first = samples.start;
+        while first < samples.end {
+            let n = (samples.end - first).min(PACKET as u32) as usize;
+            let mut rays = [Ray::new(Vec3A::ZERO, Vec3A::Z); PACKET];
+            let mut samplers: [Option<Sampler>; PACKET] = Default::default();
+            for (i, (ray, sampler)) in rays.iter_mut().zip(&mut samplers).enumerate().take(n) {
+                let (r, s) = camera_ray(scene, col, row, first + i as u32);
+                (*ray, *sampler) = (r, Some(s));
+            }
+            let hits = scene.geometry.intersect_packet(&rays[..n]);
+            for ((ray, hit), sampler) in rays.iter().zip(hits).zip(samplers).take(n) {
+                let Some(sampler) = sampler else { break };
+                let mut sample = SampleSum::default();
+                let mut tracer = scene.tracer(sampler, stats);
+                tracer.count(ray, RayKind::Camera);
+                shader::path::radiance_from(&mut tracer, ray, hit, p, &mut sample);
+                sample.keep_into(&mut sum, stats);
+            }
+            first += n as u32;
+        }
+        return sum;
+    }
     for s in samples {
         let mut sample = SampleSum::default();
         trace_sample(scene, col, row, s, stats, &mut sample);

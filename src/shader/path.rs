@@ -133,12 +133,24 @@ impl PathState {
 /// camera ray is the sum of the contributions. Scattering into an effect that is off ends the
 /// path.
 pub fn radiance<R: Record>(tr: &mut Tracer, camera_ray: &Ray, p: &Path, rec: &mut R) {
+    let hit = tr.trace(camera_ray, RayKind::Camera);
+    radiance_from(tr, camera_ray, hit, p, rec);
+}
+
+/// [`radiance`] of a camera ray whose nearest hit, `hit`, the caller has found and counted
+/// (with the camera rays of other samples, in a packet).
+#[inline]
+pub fn radiance_from<R: Record>(
+    tr: &mut Tracer,
+    camera_ray: &Ray,
+    hit: Option<crate::geometry::Hit>,
+    p: &Path,
+    rec: &mut R,
+) {
     let mut st = PathState::new(camera_ray);
-    loop {
-        let hit = tr.trace(&st.ray, st.kind);
-        if !step(tr, p, &mut st, hit, rec) {
-            break;
-        }
+    let mut hit = hit;
+    while step(tr, p, &mut st, hit, rec) {
+        hit = tr.trace(&st.ray, st.kind);
     }
 }
 
