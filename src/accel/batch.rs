@@ -124,6 +124,26 @@ impl Geometry {
         }
     }
 
+    /// True if rays that run close together are traced faster as a group
+    /// ([`Geometry::intersect_group`]) than one by one: where every primitive is in the BVH
+    /// (packets) or none is (lanes).
+    #[inline]
+    pub fn groups_pay(&self) -> bool {
+        self.packets_pay() || self.all_packed()
+    }
+
+    /// The nearest hits of `rays`, which run close together (a pixel's camera rays), into
+    /// `hits` (cleared first, then one entry per ray): in lanes where every primitive is packed
+    /// ([`Geometry::intersect_batch`]), else as [`Geometry::intersect_coherent`] traces them.
+    /// The one-ray hits to the bit, either way.
+    pub fn intersect_group(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+        if self.all_packed() {
+            self.intersect_batch(rays, hits);
+        } else {
+            self.intersect_coherent(rays, hits);
+        }
+    }
+
     /// True if [`Geometry::intersect_packet`] traces packets here: every primitive is in the
     /// BVH (elsewhere it traces ray by ray).
     #[inline]

@@ -15,7 +15,7 @@ pub mod tev;
 
 pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};
 
-use crate::accel::wide::packet::PACKET;
+use crate::accel::MAX_LANES;
 use crate::geometry::Ray;
 use crate::sampling::{Sampler, pixel_sample};
 use crate::shader::{self, Record, Shader, Technique};
@@ -80,22 +80,23 @@ pub fn pixel_sum(
 ) -> RgbSum {
     let mut sum = RgbSum::default();
     if let Shader::Path(p) = &scene.shader
-        && scene.geometry.packets_pay()
+        && scene.geometry.groups_pay()
     {
-        // The camera rays of a pixel run close together: in a scene whose primitives are all
-        // in the BVH, those of up to eight samples are traced in a packet (the one-ray hits to
-        // the bit), and each path goes on alone from its hit.
+        // The camera rays of a pixel run close together: those of up to `MAX_LANES` samples
+        // are traced as a group (in packets through the BVH, in lanes through packed
+        // primitives: the one-ray hits to the bit), and each path goes on alone from its hit.
+        let mut hits = Vec::with_capacity(MAX_LANES);
         let mut first = samples.start;
         while first < samples.end {
-            let n = (samples.end - first).min(PACKET as u32) as usize;
-            let mut rays = [Ray::new(Vec3A::ZERO, Vec3A::Z); PACKET];
-            let mut samplers: [Option<Sampler>; PACKET] = Default::default();
+            let n = (samples.end - first).min(MAX_LANES as u32) as usize;
+            let mut rays = [Ray::new(Vec3A::ZERO, Vec3A::Z); MAX_LANES];
+            let mut samplers: [Option<Sampler>; MAX_LANES] = Default::default();
             for (i, (ray, sampler)) in rays.iter_mut().zip(&mut samplers).enumerate().take(n) {
                 let (r, s) = camera_ray(scene, col, row, first + i as u32);
                 (*ray, *sampler) = (r, Some(s));
             }
-            let hits = scene.geometry.intersect_packet(&rays[..n]);
-            for ((ray, hit), sampler) in rays.iter().zip(hits).zip(samplers).take(n) {
+            scene.geometry.intersect_group(&rays[..n], &mut hits);
+            for ((ray, &hit), sampler) in rays.iter().zip(&hits).zip(samplers) {
                 let Some(sampler) = sampler else { break };
                 let mut sample = SampleSum::default();
                 let mut tracer = scene.tracer(sampler, stats);

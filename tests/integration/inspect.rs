@@ -195,35 +195,48 @@ fn a_replay_adds_what_the_render_added() {
     }
 }
 
-/// In a scene whose primitives are all in the BVH, a render traces each pixel's camera rays
-/// in packets of eight samples (`render::pixel_sum`); every sample still adds what its replay
-/// (one ray at a time) adds, whatever range of samples a pass starts and ends at, with the
-/// same ray counts.
+/// A render traces each pixel's camera rays in groups of up to `MAX_LANES` samples
+/// (`render::pixel_sum`): in packets where every primitive is in the BVH, in lanes where none
+/// is. Every sample still adds what its replay (one ray at a time) adds, whatever range of
+/// samples a pass starts and ends at, with the same ray counts.
 #[test]
-fn packets_of_camera_rays_add_what_each_sample_alone_adds() {
-    let text = std::fs::read_to_string(common::scenes_dir().join("mitsuba-cornell.ron")).unwrap();
-    let text = text
+fn groups_of_camera_rays_add_what_each_sample_alone_adds() {
+    let dir = common::scenes_dir();
+    let area = std::fs::read_to_string(dir.join("mitsuba-cornell.ron"))
+        .unwrap()
         .replace(
             "width: 128, height: 128, spp: 64",
             "width: 9, height: 7, spp: 19",
         )
         .replace("sampling: Brdf)", "sampling: Brdf, lights: Mis)");
-    let s = rtis::extract(&scene(&text));
-    assert!(
-        s.geometry.packets_pay(),
-        "a scene whose primitives are all in the BVH"
-    );
-    for (col, row) in [(0, 0), (4, 3), (8, 6), (2, 5)] {
-        for samples in [0..19, 3..19, 5..6, 0..8] {
-            let (mut packed, mut alone) = (RayStats::default(), RayStats::default());
-            let got = pixel_sum(&s, col, row, samples.clone(), &mut packed);
-            let mut want = RgbSum::default();
-            for k in samples.clone() {
-                want += render_sample(&s, col, row, k, &mut alone);
+    let boxed = std::fs::read_to_string(dir.join("cornell-physical.ron"))
+        .unwrap()
+        .replace(
+            "extends: \"cornell.ron\"",
+            &format!("extends: {:?}", dir.join("cornell.ron")),
+        )
+        .replace(
+            "width: 360, height: 288, spp: 64",
+            "width: 9, height: 7, spp: 19",
+        );
+    for text in [area, boxed] {
+        let s = rtis::extract(&scene(&text));
+        assert!(
+            s.geometry.groups_pay(),
+            "every primitive in the BVH, or none"
+        );
+        for (col, row) in [(0, 0), (4, 3), (8, 6), (2, 5)] {
+            for samples in [0..19, 3..19, 5..6, 0..16] {
+                let (mut grouped, mut alone) = (RayStats::default(), RayStats::default());
+                let got = pixel_sum(&s, col, row, samples.clone(), &mut grouped);
+                let mut want = RgbSum::default();
+                for k in samples.clone() {
+                    want += render_sample(&s, col, row, k, &mut alone);
+                }
+                assert_eq!(got, want, "{col},{row} {samples:?}");
+                assert_eq!(grouped.total(), alone.total(), "{col},{row} {samples:?}");
+                assert_eq!(grouped.camera, samples.len() as u64);
             }
-            assert_eq!(got, want, "{col},{row} {samples:?}");
-            assert_eq!(packed.total(), alone.total(), "{col},{row} {samples:?}");
-            assert_eq!(packed.camera, samples.len() as u64);
         }
     }
 }
