@@ -12,6 +12,7 @@ pub mod pass;
 pub mod progressive;
 mod scene;
 pub mod tev;
+pub mod waves;
 
 pub use scene::{Film, MAX_PIXELS, MAX_SIDE, MAX_SPP, RenderScene};
 
@@ -78,6 +79,11 @@ pub fn pixel_sum(
     samples: std::ops::Range<u32>,
     stats: &mut RayStats,
 ) -> RgbSum {
+    if let Shader::Path(p) = &scene.shader
+        && waves::applies(scene)
+    {
+        return waves::pixel_sum(scene, col, row, samples, p, stats);
+    }
     let mut sum = RgbSum::default();
     if let Shader::Path(p) = &scene.shader
         && scene.geometry.groups_pay()

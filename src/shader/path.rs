@@ -29,6 +29,8 @@ use super::surface::{
     specular_bounce,
 };
 pub use super::surface::{brdf_pdf as pdf, diffuse_probability};
+
+pub mod lanes;
 use crate::geometry::{Frame, Ray};
 use crate::material::{Material, Model, Phong, fresnel_dielectric, reflect};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampling, hemisphere, power_heuristic};
@@ -116,6 +118,49 @@ impl PathState {
             scattered: None,
             sampled: false,
         }
+    }
+
+    /// Throughput of the path up to the ray's origin.
+    #[inline]
+    pub fn beta(&self) -> Vec3A {
+        self.beta
+    }
+
+    /// Scattering vertices so far.
+    #[inline]
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// The end of [`step`] at a diffuse Phong vertex at `p` that sampled direction
+    /// `ray.d` with density `pdf` and throughput weight making `beta` the path's throughput
+    /// (`lanes` computes these): one more vertex, then Russian roulette from depth `rr_depth`
+    /// (drawing from `sampler`); false if the path ends there, else it goes on with `ray`.
+    #[inline]
+    pub fn scatter_diffuse(
+        &mut self,
+        ray: Ray,
+        p: Vec3A,
+        pdf: f32,
+        beta: Vec3A,
+        rr_depth: u32,
+        sampler: &mut crate::sampling::Sampler,
+    ) -> bool {
+        self.scattered = Some(Scattered { p, pdf });
+        self.sampled = true;
+        self.beta = beta;
+        self.depth += 1;
+        // Russian roulette: survive with probability q, divide by q to stay unbiased.
+        if self.depth >= rr_depth {
+            let q = (self.beta * self.eta_scale).max_element().min(0.95);
+            if q <= 0.0 || sampler.next_f32() >= q {
+                return false;
+            }
+            self.beta /= q;
+        }
+        self.ray = ray;
+        self.kind = RayKind::Indirect;
+        true
     }
 
     /// The technique of light the ray meets: emitted (seen by the camera or through mirrors

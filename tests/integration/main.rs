@@ -32,6 +32,7 @@ mod meshes;
 mod origins;
 mod output;
 mod passes;
+mod path_waves;
 mod physical;
 mod progressive;
 mod readme;

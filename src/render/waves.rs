@@ -1,0 +1,110 @@
+//! Path's samples in waves: the paths of up to [`WAVE`] samples of a pixel advance together,
+//! one vertex each per round, in a scene whose primitives are all packed (no BVH). Each round
+//! traces the paths' rays as one batch in SIMD lanes
+//! ([`crate::accel::Geometry::intersect_group`]); shades the diffuse vertices in lanes
+//! ([`crate::shader::path::lanes`]: the interaction, the point lights with their shadow rays in
+//! lanes, the next direction and Russian roulette) and every other vertex (mirrors, glass,
+//! glossy Phong, escapes) with the one-ray code ([`path::step`]); and gives the slots of the
+//! paths that ended to the pixel's next samples.
+//!
+//! Each sample draws from its own random stream in the one-ray order and adds the same
+//! contributions, each computed by the same operations, and its sum is exact
+//! ([`SampleSum`]), so the pixel is the one-ray render's to the bit
+//! (`tests/integration/inspect.rs`).
+
+use super::{SampleSum, camera_ray};
+use crate::RenderScene;
+use crate::sampling::Sampler;
+use crate::shader::Shader;
+use crate::shader::path::lanes::{self, PathSlot};
+use crate::shader::path::{self, Path, PathState};
+use crate::stats::{RayKind, RayStats};
+
+use super::exact::RgbSum;
+
+/// Paths in flight per pixel.
+pub const WAVE: usize = 64;
+
+/// True if `scene`'s samples go in waves: the path tracer in a scene without a BVH whose
+/// vertices the lanes can shade ([`lanes::applies`]).
+pub fn applies(scene: &RenderScene) -> bool {
+    let Shader::Path(p) = &scene.shader else {
+        return false;
+    };
+    let mut stats = RayStats::default();
+    let tr = scene.tracer(Sampler::new(0, 0, 0), &mut stats);
+    tr.geometry.bvh.is_empty() && lanes::applies(&tr, p)
+}
+
+/// The exact sum of the samples `samples` of pixel `(col, row)` under the path tracer `p`,
+/// traced in waves.
+pub fn pixel_sum(
+    scene: &RenderScene,
+    col: u32,
+    row: u32,
+    samples: std::ops::Range<u32>,
+    p: &Path,
+    stats: &mut RayStats,
+) -> RgbSum {
+    let mut sum = RgbSum::default();
+    let mut next = samples.start;
+    let mut slots: Vec<PathSlot<SampleSum>> = Vec::with_capacity(WAVE);
+    let (mut rays, mut hits, mut alive) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut ks, mut kd) = (Vec::new(), Vec::new());
+    // One tracer for the wave; a path shaded one ray at a time gets its stream swapped in.
+    let mut tr = scene.tracer(Sampler::new(0, 0, 0), stats);
+    loop {
+        // Free slots take the pixel's next samples, their camera rays first.
+        while slots.len() < WAVE && next < samples.end {
+            let (ray, sampler) = camera_ray(scene, col, row, next);
+            next += 1;
+            tr.count(&ray, RayKind::Camera);
+            slots.push(PathSlot {
+                st: PathState::new(&ray),
+                sampler,
+                rec: SampleSum::default(),
+            });
+        }
+        if slots.is_empty() {
+            return sum;
+        }
+        // The round's rays, as one batch.
+        rays.clear();
+        rays.extend(slots.iter().map(|s| s.st.ray));
+        tr.geometry.intersect_group(&rays, &mut hits);
+        // Diffuse vertices wait for the lanes; the others are shaded one at a time.
+        alive.clear();
+        alive.resize(slots.len(), false);
+        ks.clear();
+        kd.clear();
+        for (k, (slot, &hit)) in slots.iter_mut().zip(&hits).enumerate() {
+            if let Some(h) = &hit
+                && let Some(phong) = lanes::diffuse(&tr, p, &slot.st, h)
+            {
+                ks.push(k);
+                kd.push(phong.kd);
+                continue;
+            }
+            std::mem::swap(&mut tr.sampler, &mut slot.sampler);
+            alive[k] = path::step(&mut tr, p, &mut slot.st, hit, &mut slot.rec);
+            std::mem::swap(&mut tr.sampler, &mut slot.sampler);
+            if alive[k] {
+                tr.count(&slot.st.ray, slot.st.kind);
+            }
+        }
+        if !ks.is_empty() {
+            lanes::shade(&mut tr, p, &mut slots, &ks, &hits, &kd, &mut alive);
+        }
+        // The paths that ended give their sums to the pixel and their slots to new samples.
+        let mut k = 0;
+        while k < slots.len() {
+            if alive[k] {
+                k += 1;
+            } else {
+                let done = slots.swap_remove(k);
+                alive.swap_remove(k);
+                done.rec.keep_into(&mut sum, tr.stats);
+            }
+        }
+    }
+}

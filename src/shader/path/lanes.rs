@@ -1,0 +1,549 @@
+//! Path's diffuse vertices shaded in SIMD lanes: the vertices of a wave of paths
+//! (`render::waves`) that meet a diffuse Phong surface (no specular lobe) under the Physical
+//! model, a path per lane, from the hit to the next ray: the interaction, next-event estimation
+//! over point lights with the shadow rays tested in lanes ([`Geometry::occluded_lanes`]), the
+//! cosine-weighted direction, its weight, and Russian roulette.
+//!
+//! Every lane computes what [`super::step`] computes for its path, operation for operation
+//! (`Interaction::new`, `Origins`, `PointLight::incident`, `Phong::brdf`, `reflectance`,
+//! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
+//! draws its random numbers from its own stream in the same order (the draws, the light choice
+//! and `sin_cos` run lane by lane), so each path adds the same contributions and goes on with the
+//! same ray, to the bit (`tests/integration/inspect.rs`).
+
+use super::{Path, PathState};
+use crate::accel::lanes::{abs_max, dot};
+use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
+use crate::geometry::{Hit, Ray, UNIT_ROUNDOFF};
+use crate::light::{Chosen, Light};
+use crate::material::{Material, Model, Phong};
+use crate::sampling::{LightsPerVertex, Sampler, Sampling};
+use crate::shader::Tracer;
+use crate::shader::record::{Record, Technique};
+use crate::shader::surface::{SHADOW_END, diffuse_probability};
+use crate::stats::RayKind;
+use glam::Vec3A;
+use std::f32::consts::{FRAC_1_PI, PI, TAU};
+
+/// A path in a wave: its state, its random stream and what it has added.
+pub struct PathSlot<R> {
+    /// The path.
+    pub st: PathState,
+    /// Its sample's random numbers.
+    pub sampler: Sampler,
+    /// Its contributions.
+    pub rec: R,
+}
+
+/// True if `p`'s vertices can be shaded in lanes in `tr`'s scene: the Physical model, BRDF or
+/// cosine sampling, every point light or one chosen by power, point lights only (no emitter,
+/// no environment, no spot or directional light), no textures.
+pub fn applies(tr: &Tracer, p: &Path) -> bool {
+    tr.model == Model::Physical
+        && matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
+        && matches!(
+            p.lights_per_vertex,
+            LightsPerVertex::One | LightsPerVertex::All
+        )
+        && tr.emitters.is_empty()
+        && tr.emitters.environment.is_none()
+        && tr.textures.is_empty()
+        && tr.lights.iter().all(|l| matches!(l, Light::Point(_)))
+}
+
+/// The diffuse Phong material of `hit`, if the vertex it makes on path `st` is shaded in
+/// lanes: the surface reflects light diffusely only (its BRDF sampling always picks the
+/// cosine lobe), emits nothing, and the path may scatter there.
+#[inline]
+pub fn diffuse(tr: &Tracer, p: &Path, st: &PathState, hit: &Hit) -> Option<Phong> {
+    let prim = tr.geometry.prim(hit.prim);
+    let Material::Phong(phong) = tr.materials[prim.material as usize] else {
+        return None;
+    };
+    let max_depth = p
+        .max_depth
+        .unwrap_or(super::MAX_DEPTH)
+        .min(super::MAX_DEPTH);
+    (phong.ks == Vec3A::ZERO
+        && !phong.is_black()
+        && diffuse_probability(&phong) == 1.0
+        && prim.light == crate::light::NO_LIGHT
+        && st.depth < max_depth)
+        .then_some(phong)
+}
+
+/// Shade the vertices of `slots[k]` for each `k` of `ks` (their hits `hits[k]`, their
+/// materials `kd[j]` for the `j`-th of `ks`), in chunks of lanes: each adds its light to its
+/// slot's recorder and sets its next ray; `alive[k]` says whether the path goes on.
+pub fn shade<R: Record>(
+    tr: &mut Tracer,
+    p: &Path,
+    slots: &mut [PathSlot<R>],
+    ks: &[usize],
+    hits: &[Option<Hit>],
+    kd: &[Vec3A],
+    alive: &mut [bool],
+) {
+    for (chunk, kd) in ks.chunks(MAX_LANES).zip(kd.chunks(MAX_LANES)) {
+        match tr.geometry.bvh.isa() {
+            // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => unsafe { shade_avx512(tr, p, slots, chunk, hits, kd, alive) },
+            // SAFETY: as above.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => unsafe { shade_avx2(tr, p, slots, chunk, hits, kd, alive) },
+            // SAFETY: `Vec4` runs on every CPU.
+            _ => unsafe { shade_in::<glam::Vec4, R>(tr, p, slots, chunk, hits, kd, alive) },
+        }
+    }
+}
+
+/// [`shade`]'s chunk in sixteen AVX-512 lanes (or fewer).
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn shade_avx512<R: Record>(
+    tr: &mut Tracer,
+    p: &Path,
+    slots: &mut [PathSlot<R>],
+    ks: &[usize],
+    hits: &[Option<Hit>],
+    kd: &[Vec3A],
+    alive: &mut [bool],
+) {
+    for (ks, kd) in ks.chunks(16).zip(kd.chunks(16)) {
+        // SAFETY: this function runs only where AVX-512F was found.
+        unsafe { shade_in::<crate::accel::F16, R>(tr, p, slots, ks, hits, kd, alive) }
+    }
+}
+
+/// [`shade`]'s chunk in eight AVX2 lanes at a time.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn shade_avx2<R: Record>(
+    tr: &mut Tracer,
+    p: &Path,
+    slots: &mut [PathSlot<R>],
+    ks: &[usize],
+    hits: &[Option<Hit>],
+    kd: &[Vec3A],
+    alive: &mut [bool],
+) {
+    for (ks, kd) in ks.chunks(8).zip(kd.chunks(8)) {
+        // SAFETY: this function runs only where AVX2 was found.
+        unsafe { shade_in::<crate::accel::F8, R>(tr, p, slots, ks, hits, kd, alive) }
+    }
+}
+
+/// Rows of a chunk's gathered values.
+const P: usize = 0;
+const N: usize = 3;
+const D: usize = 6;
+const BETA: usize = 9;
+const KD: usize = 12;
+const ERR: usize = 15;
+const ERR_ALONG: usize = 16;
+const ROWS: usize = 17;
+
+/// The lanes of a vector as an array.
+#[inline(always)]
+fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
+    let mut a = [0.0f32; MAX_LANES];
+    x.write_to(&mut a);
+    a
+}
+
+/// Shade up to `L::LANES` vertices (`ks.len()`), as [`shade`] says. No closures that compute
+/// in lanes, so that this inlines whole into the AVX2 and AVX-512 copies.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn shade_in<L: Floats, R: Record>(
+    tr: &mut Tracer,
+    p: &Path,
+    slots: &mut [PathSlot<R>],
+    ks: &[usize],
+    hits: &[Option<Hit>],
+    kd: &[Vec3A],
+    alive: &mut [bool],
+) {
+    let count = ks.len();
+    debug_assert!(count <= L::LANES);
+    // Gather: each lane's hit, ray direction, throughput and `kd` (lanes past `count` repeat
+    // the first, and are dropped).
+    let mut v = [[0.0f32; MAX_LANES]; ROWS];
+    for i in 0..L::LANES {
+        let k = ks[i.min(count - 1)];
+        let (s, hit) = (&slots[k], hits[k].expect("a shaded vertex has a hit"));
+        let kd = kd[i.min(count - 1)];
+        for c in 0..3 {
+            v[P + c][i] = hit.p[c];
+            v[N + c][i] = hit.n[c];
+            v[D + c][i] = s.st.ray.d[c];
+            v[BETA + c][i] = s.st.beta[c];
+            v[KD + c][i] = kd[c];
+        }
+        v[ERR][i] = hit.err;
+        v[ERR_ALONG][i] = hit.err_along;
+    }
+    // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block below,
+    // each makes values of `L`.
+    let load = |row: usize| unsafe { L::from_slice(&v[row]) };
+    let (p_, nh, d) = (
+        [load(P), load(P + 1), load(P + 2)],
+        [load(N), load(N + 1), load(N + 2)],
+        [load(D), load(D + 1), load(D + 2)],
+    );
+    let (beta, kd_l) = (
+        [load(BETA), load(BETA + 1), load(BETA + 2)],
+        [load(KD), load(KD + 1), load(KD + 2)],
+    );
+    let (err, err_along) = (load(ERR), load(ERR_ALONG));
+    let (zero, one, two) = unsafe { (L::splat(0.0), L::splat(1.0), L::splat(2.0)) };
+    let (unit, two_unit) = unsafe { (L::splat(UNIT_ROUNDOFF), L::splat(2.0 * UNIT_ROUNDOFF)) };
+    let live = {
+        let mut f = [0.0f32; MAX_LANES];
+        f[..count].fill(1.0);
+        unsafe { L::from_array(f) }.cmpne(zero)
+    };
+    // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal), and
+    // `Origins::new`: the point moved off the surface by its error's projection on the
+    // normal, to either side, with the origins' error bound.
+    let wo = [-d[0], -d[1], -d[2]];
+    let flip = dot(nh, wo).cmplt(zero);
+    let n = [
+        L::select(flip, -nh[0], nh[0]),
+        L::select(flip, -nh[1], nh[1]),
+        L::select(flip, -nh[2], nh[2]),
+    ];
+    let n_sum = (nh[0].abs() + nh[1].abs()) + nh[2].abs();
+    let off = n_sum * err + two_unit * abs_max(p_);
+    let front = [
+        p_[0] + off * nh[0],
+        p_[1] + off * nh[1],
+        p_[2] + off * nh[2],
+    ];
+    let back = [
+        p_[0] - off * nh[0],
+        p_[1] - off * nh[1],
+        p_[2] - off * nh[2],
+    ];
+    let widest = [
+        front[0].abs().max(back[0].abs()),
+        front[1].abs().max(back[1].abs()),
+        front[2].abs().max(back[2].abs()),
+    ];
+    let o_err = err + off + two * err_along + unit * abs_max(widest);
+    // `Phong::brdf` of a diffuse surface: `kd / pi` where both directions are above it.
+    let inv_pi = unsafe { L::splat(1.0 / PI) };
+    let f = [kd_l[0] * inv_pi, kd_l[1] * inv_pi, kd_l[2] * inv_pi];
+    let wo_above = dot(wo, n).cmpgt(zero);
+    // Next-event estimation: every point light's term, or one light's, chosen by power.
+    let one_light = p.lights_per_vertex == LightsPerVertex::One;
+    let nee = if one_light {
+        // The choice, lane by lane: `u` picks the light; `one_light` draws two more numbers
+        // for an area light's point, which a point light does not read.
+        let (mut pos, mut intensity) = ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]);
+        let (mut pmf, mut room, mut chosen) = ([1.0f32; MAX_LANES], 0u32, 0u32);
+        for (i, &k) in ks.iter().enumerate() {
+            let s = &mut slots[k].sampler;
+            let u = s.next_f64();
+            let _ = s.next_2d();
+            if let Some(Chosen::Point(j, w)) = tr.emitters.choose_any(u)
+                && let Light::Point(l) = &tr.lights[j]
+            {
+                for c in 0..3 {
+                    pos[c][i] = l.position[c];
+                    intensity[c][i] = l.intensity[c];
+                }
+                pmf[i] = w;
+                room |= u32::from(l.in_room) << i;
+                chosen |= 1 << i;
+            }
+        }
+        let light = unsafe {
+            LightLanes {
+                pos: [
+                    L::from_array(pos[0]),
+                    L::from_array(pos[1]),
+                    L::from_array(pos[2]),
+                ],
+                intensity: [
+                    L::from_array(intensity[0]),
+                    L::from_array(intensity[1]),
+                    L::from_array(intensity[2]),
+                ],
+                room,
+                lanes: chosen,
+            }
+        };
+        let term =
+            unsafe { point_term(tr, &light, p_, nh, n, front, back, o_err, f, wo_above, live) };
+        let pmf = unsafe { L::from_array(pmf) };
+        [term[0] / pmf, term[1] / pmf, term[2] / pmf]
+    } else {
+        // `point_lights`: the terms summed from zero in the lights' order, then the area
+        // lights' share (none here) added.
+        let lights = tr.lights;
+        let mut sum = [zero; 3];
+        for l in lights {
+            let Light::Point(l) = l else { continue };
+            let light = unsafe {
+                LightLanes {
+                    pos: [
+                        L::splat(l.position.x),
+                        L::splat(l.position.y),
+                        L::splat(l.position.z),
+                    ],
+                    intensity: [
+                        L::splat(l.intensity.x),
+                        L::splat(l.intensity.y),
+                        L::splat(l.intensity.z),
+                    ],
+                    room: if l.in_room { u32::MAX } else { 0 },
+                    lanes: u32::MAX,
+                }
+            };
+            let term =
+                unsafe { point_term(tr, &light, p_, nh, n, front, back, o_err, f, wo_above, live) };
+            sum = [sum[0] + term[0], sum[1] + term[1], sum[2] + term[2]];
+        }
+        [sum[0] + zero, sum[1] + zero, sum[2] + zero]
+    };
+    // Each path adds `beta` times its vertex's light.
+    let l = [
+        array(beta[0] * nee[0]),
+        array(beta[1] * nee[1]),
+        array(beta[2] * nee[2]),
+    ];
+    for (i, &k) in ks.iter().enumerate() {
+        let l = Vec3A::new(l[0][i], l[1][i], l[2][i]);
+        if l != Vec3A::ZERO {
+            let s = &mut slots[k];
+            s.rec.add(l, Technique::Light, s.st.depth + 1);
+        }
+    }
+    if !tr.effects.indirect {
+        for &k in ks {
+            alive[k] = false;
+        }
+        return;
+    }
+    // The next direction: cosine-weighted about the shading normal (`hemisphere::cosine` in
+    // the frame of `Frame::from_normal`); its numbers, and `sin_cos`, lane by lane.
+    let brdf = p.sampling == Sampling::Brdf;
+    let (mut r, mut sin_p, mut cos_p) = (
+        [0.0f32; MAX_LANES],
+        [0.0f32; MAX_LANES],
+        [1.0f32; MAX_LANES],
+    );
+    for (i, &k) in ks.iter().enumerate() {
+        let s = &mut slots[k].sampler;
+        let (u1, u2) = s.next_2d();
+        if brdf {
+            // `sample_phong` compares a number with the diffuse share, 1 here: the cosine lobe.
+            let _ = s.next_f32();
+        }
+        r[i] = u1.sqrt();
+        (sin_p[i], cos_p[i]) = (TAU * u2).sin_cos();
+    }
+    let (r, sin_p, cos_p) =
+        unsafe { (L::from_array(r), L::from_array(sin_p), L::from_array(cos_p)) };
+    let (x, y) = (r * cos_p, r * sin_p);
+    let z = ((one - x * x) - y * y).max(zero).sqrt();
+    // glam's `any_orthonormal_pair` (Duff et al. 2017).
+    let sign = one.copysign(n[2]);
+    let a = -one / (sign + n[2]);
+    let b = n[0] * n[1] * a;
+    let s_axis = [one + sign * n[0] * n[0] * a, sign * b, -sign * n[0]];
+    let t_axis = [b, sign + n[1] * n[1] * a, -n[1]];
+    let wi = [
+        x * s_axis[0] + y * t_axis[0] + z * n[0],
+        x * s_axis[1] + y * t_axis[1] + z * n[1],
+        x * s_axis[2] + y * t_axis[2] + z * n[2],
+    ];
+    let cos_i = dot(wi, n);
+    let above = cos_i.cmpgt(zero);
+    // `brdf_pdf`: `cos / pi` for BRDF sampling of a diffuse surface, `max(cos, 0) / pi` (as a
+    // product) for cosine sampling.
+    let pdf = match brdf {
+        true => cos_i / unsafe { L::splat(PI) },
+        false => cos_i.max(zero) * unsafe { L::splat(FRAC_1_PI) },
+    };
+    let ok = above & pdf.cmpgt(zero);
+    // `reflectance`: `brdf(wi, wo) max(cos, 0)`, zero where `wo` is not above the surface.
+    let g = [
+        L::select(wo_above, f[0], zero) * cos_i.max(zero),
+        L::select(wo_above, f[1], zero) * cos_i.max(zero),
+        L::select(wo_above, f[2], zero) * cos_i.max(zero),
+    ];
+    let carries = g[0].cmpne(zero) | g[1].cmpne(zero) | g[2].cmpne(zero);
+    let go = L::bitmask(ok & carries);
+    let beta = [
+        beta[0] * (g[0] / pdf),
+        beta[1] * (g[1] / pdf),
+        beta[2] * (g[2] / pdf),
+    ];
+    // `Origins::ray`: the origin on the side of the geometric normal the direction leaves by.
+    let side = dot(nh, wi).cmpge(zero);
+    let o = [
+        L::select(side, front[0], back[0]),
+        L::select(side, front[1], back[1]),
+        L::select(side, front[2], back[2]),
+    ];
+    let (wi, o, beta, pdf, o_err) = (
+        [array(wi[0]), array(wi[1]), array(wi[2])],
+        [array(o[0]), array(o[1]), array(o[2])],
+        [array(beta[0]), array(beta[1]), array(beta[2])],
+        array(pdf),
+        array(o_err),
+    );
+    for (i, &k) in ks.iter().enumerate() {
+        let slot = &mut slots[k];
+        if go & (1 << i) == 0 {
+            alive[k] = false;
+            continue;
+        }
+        let ray = Ray {
+            o: Vec3A::new(o[0][i], o[1][i], o[2][i]),
+            d: Vec3A::new(wi[0][i], wi[1][i], wi[2][i]),
+            t_max: f32::INFINITY,
+            o_err: o_err[i],
+        };
+        let hit_p = Vec3A::new(v[P][i], v[P + 1][i], v[P + 2][i]);
+        let beta = Vec3A::new(beta[0][i], beta[1][i], beta[2][i]);
+        alive[k] = slot
+            .st
+            .scatter_diffuse(ray, hit_p, pdf[i], beta, p.rr_depth, &mut slot.sampler);
+        if alive[k] {
+            tr.count(&slot.st.ray, RayKind::Indirect);
+        }
+    }
+}
+
+/// A point light per lane (the same in every lane for `point_lights`): position, intensity,
+/// the lanes where it is in the planes' room, and the lanes that have one.
+struct LightLanes<L> {
+    pos: [L; 3],
+    intensity: [L; 3],
+    room: u32,
+    lanes: u32,
+}
+
+/// `point_light` in lanes: each lane's light's term `L_i r(wi, wo) V` at its vertex (zero where
+/// the light is behind the surface, at the point, or hidden), its shadow ray tested in lanes
+/// (`Tracer::unoccluded`, or `unoccluded_in_room` in the lanes of `light.room`) and counted.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+unsafe fn point_term<L: Floats>(
+    tr: &mut Tracer,
+    light: &LightLanes<L>,
+    p: [L; 3],
+    nh: [L; 3],
+    n: [L; 3],
+    front: [L; 3],
+    back: [L; 3],
+    o_err: L,
+    f: [L; 3],
+    wo_above: L::Mask,
+    live: L::Mask,
+) -> [L; 3] {
+    // SAFETY: the caller's.
+    let (zero, inf, end) =
+        unsafe { (L::splat(0.0), L::splat(f32::INFINITY), L::splat(SHADOW_END)) };
+    let lanes = live & unsafe { mask::<L>(light.lanes) };
+    // `PointLight::incident`: the unit direction, the distance and `I / d^2`.
+    let to = [
+        light.pos[0] - p[0],
+        light.pos[1] - p[1],
+        light.pos[2] - p[2],
+    ];
+    let d2 = dot(to, to);
+    let dist = d2.sqrt();
+    let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
+    let li = [
+        light.intensity[0] / d2,
+        light.intensity[1] / d2,
+        light.intensity[2] / d2,
+    ];
+    // `point_light_ray`: a light below the surface adds nothing.
+    let cos = dot(wi, n);
+    let lit = lanes & d2.cmpne(zero) & d2.cmplt(inf) & cos.cmpgt(zero);
+    let mut seen = lit;
+    if tr.effects.shadows && L::any(lit) {
+        let side = dot(nh, wi).cmpge(zero);
+        let o = [
+            L::select(side, front[0], back[0]),
+            L::select(side, front[1], back[1]),
+            L::select(side, front[2], back[2]),
+        ];
+        let t_max = dist * end;
+        let room = unsafe { mask::<L>(light.room) };
+        let geometry: &Geometry = tr.geometry;
+        let mut blocked = zero.cmpne(zero);
+        for (planes, part) in [(false, lit & room), (true, lit & !room)] {
+            if L::any(part) {
+                blocked =
+                    blocked | geometry.occluded_lanes((o, wi, o_err, t_max), planes, part, &());
+            }
+        }
+        seen = lit & !blocked;
+        let rays = L::bitmask(lit);
+        tr.stats.shadow += rays.count_ones() as u64;
+        if let Some(audit) = tr.audit {
+            let (o, wi, o_err, t_max) = (
+                [array(o[0]), array(o[1]), array(o[2])],
+                [array(wi[0]), array(wi[1]), array(wi[2])],
+                array(o_err),
+                array(t_max),
+            );
+            let mut bits = rays;
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let ray = Ray {
+                    o: Vec3A::new(o[0][i], o[1][i], o[2][i]),
+                    d: Vec3A::new(wi[0][i], wi[1][i], wi[2][i]),
+                    t_max: t_max[i],
+                    o_err: o_err[i],
+                };
+                audit(&ray, RayKind::Shadow);
+            }
+        }
+    }
+    // `L_i r(wi, wo)` with `r = brdf max(cos, 0)` (the BRDF zero where `wo` is below), where
+    // the light is seen.
+    let r = [
+        L::select(wo_above, f[0], zero) * cos.max(zero),
+        L::select(wo_above, f[1], zero) * cos.max(zero),
+        L::select(wo_above, f[2], zero) * cos.max(zero),
+    ];
+    [
+        L::select(seen, li[0] * r[0], zero),
+        L::select(seen, li[1] * r[1], zero),
+        L::select(seen, li[2] * r[2], zero),
+    ]
+}
+
+/// The lanes of `bits` as a mask.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn mask<L: Floats>(bits: u32) -> L::Mask {
+    let mut f = [0.0f32; MAX_LANES];
+    for (i, x) in f.iter_mut().enumerate() {
+        *x = if bits & (1 << i) != 0 { 1.0 } else { 0.0 };
+    }
+    // SAFETY: the caller's.
+    unsafe { L::from_array(f) }.cmpne(unsafe { L::splat(0.0) })
+}

@@ -1,0 +1,98 @@
+//! Path's samples in waves (src/render/waves.rs, src/shader/path/lanes.rs): where they apply,
+//! every pixel is the one-ray render's to the bit, with the same ray counts, over the
+//! strategies the lanes shade (one light or all, BRDF or cosine sampling), Russian roulette
+//! from the first bounce, a depth limit, the effects that end or skip work, lights inside and
+//! outside the planes' room, and the materials the lanes leave to the one-ray code (glossy
+//! Phong, mirror, glass, a black surface).
+
+use crate::common::{self, scene};
+use rtis::render::exact::RgbSum;
+use rtis::render::{pixel_sum, render_sample, waves};
+use rtis::stats::RayStats;
+
+/// A small room of planes and spheres (no BVH) with two point lights, under `shader`.
+fn room(shader: &str, effects: &str) -> String {
+    format!(
+        "Scene(film: (width: 8, height: 6, spp: 21), shader: {shader}, model: Physical,
+          camera: Perspective(position: (0, 0, 3.5), look_at: (0, 0, 0), fov: 55),
+          effects: ({effects}),
+          entities: [
+            (shape: InfinitePlane(point: (0, -1, 0), normal: (0, 1, 0)), material: Phong(kd: (0.6, 0.6, 0.6))),
+            (shape: InfinitePlane(point: (0, 0, -1.5), normal: (0, 0, 1)), material: Phong(kd: (0.5, 0.3, 0.2))),
+            (shape: InfinitePlane(point: (-1.6, 0, 0), normal: (1, 0, 0)), material: Phong(kd: (0.2, 0.6, 0.3), ks: (0.2, 0.2, 0.2), shininess: 20)),
+            (shape: InfinitePlane(point: (0, 1.4, 0), normal: (0, -1, 0)), material: Phong(kd: (0, 0, 0))),
+            (shape: Sphere(center: (-0.7, -0.5, 0), radius: 0.5), material: Transmissive(ior: 1.5)),
+            (shape: Sphere(center: (0.7, -0.6, 0.2), radius: 0.4), material: Mirror(color: (0.9, 0.9, 0.9))),
+            (shape: Sphere(center: (0.1, 0.3, -0.6), radius: 0.35), material: Phong(kd: (0.7, 0.7, 0.2))),
+            (light: Point(position: (0.5, 1.0, 1.0), intensity: (3, 3, 3))),
+            (light: Point(position: (-1.0, 0.6, 0.5), intensity: (1, 2, 1))),
+          ])"
+    )
+}
+
+/// Each pixel's sum in waves against its samples' one-ray sums, and the ray counts.
+fn agrees(s: &rtis::RenderScene, what: &str) {
+    assert!(waves::applies(s), "{what}: the waves apply");
+    let (mut waved, mut alone) = (RayStats::default(), RayStats::default());
+    for row in 0..s.film.height {
+        for col in 0..s.film.width {
+            for samples in [0..s.film.spp, 5..17] {
+                let got = pixel_sum(s, col, row, samples.clone(), &mut waved);
+                let mut want = RgbSum::default();
+                for k in samples {
+                    want += render_sample(s, col, row, k, &mut alone);
+                }
+                assert_eq!(got, want, "{what}: pixel {col},{row}");
+            }
+        }
+    }
+    assert_eq!(waved, alone, "{what}: ray counts");
+    assert!(
+        alone.shadow > 0 || !what.contains("shadows: true"),
+        "{what}"
+    );
+}
+
+#[test]
+fn waves_give_the_one_ray_pixels() {
+    let _limit = common::deadline(120);
+    for per_vertex in ["One", "All"] {
+        for sampling in ["Brdf", "Cosine"] {
+            for depth in ["rr_depth: 1", "rr_depth: 5", "max_depth: 2, rr_depth: 1"] {
+                let shader =
+                    format!("Path({depth}, sampling: {sampling}, lights_per_vertex: {per_vertex})");
+                let text = room(&shader, "");
+                let what = shader.clone();
+                agrees(&rtis::extract(&scene(&text)), &what);
+                // Shadow rays that test the planes too.
+                let mut s = rtis::extract(&scene(&text));
+                common::lights_out_of_room(&mut s);
+                agrees(&s, &format!("{what}, lights out of the room"));
+            }
+        }
+    }
+    // Effects that end paths at their first vertex, or skip the shadow rays.
+    for effects in [
+        "indirect: false",
+        "shadows: false",
+        "reflection: false, refraction: false",
+    ] {
+        let text = room(
+            "Path(rr_depth: 2, sampling: Brdf, lights_per_vertex: One)",
+            effects,
+        );
+        agrees(&rtis::extract(&scene(&text)), effects);
+    }
+}
+
+/// The waves are for the scenes whose vertices the lanes shade: not under the Course model,
+/// with area lights, or with a BVH.
+#[test]
+fn waves_apply_only_where_the_lanes_shade() {
+    let course = room("Path(sampling: Brdf)", "").replace("model: Physical", "model: Course");
+    assert!(!waves::applies(&rtis::extract(&scene(&course))));
+    let uniform = room("Path(sampling: Uniform)", "");
+    assert!(!waves::applies(&rtis::extract(&scene(&uniform))));
+    let area = std::fs::read_to_string(common::scenes_dir().join("mitsuba-cornell.ron")).unwrap();
+    assert!(!waves::applies(&rtis::extract(&scene(&area))));
+}
