@@ -17,7 +17,7 @@ use crate::RenderScene;
 use crate::sampling::Sampler;
 use crate::shader::Shader;
 use crate::shader::path::lanes::{self, PathSlot};
-use crate::shader::path::{self, Path, PathState};
+use crate::shader::path::{Path, PathState};
 use crate::stats::{RayKind, RayStats};
 
 use super::exact::RgbSum;
@@ -49,10 +49,10 @@ pub fn pixel_sum(
     let mut sum = RgbSum::default();
     let mut next = samples.start;
     let mut slots: Vec<PathSlot<SampleSum>> = Vec::with_capacity(WAVE);
-    let (mut rays, mut hits, mut alive) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut ks, mut kd) = (Vec::new(), Vec::new());
+    let mut alive = Vec::new();
     // One tracer for the wave; a path shaded one ray at a time gets its stream swapped in.
     let mut tr = scene.tracer(Sampler::new(0, 0, 0), stats);
+    let diffuse = lanes::Diffuse::table(&tr);
     loop {
         // Free slots take the pixel's next samples, their camera rays first.
         while slots.len() < WAVE && next < samples.end {
@@ -68,33 +68,10 @@ pub fn pixel_sum(
         if slots.is_empty() {
             return sum;
         }
-        // The round's rays, as one batch.
-        rays.clear();
-        rays.extend(slots.iter().map(|s| s.st.ray));
-        tr.geometry.intersect_group(&rays, &mut hits);
-        // Diffuse vertices wait for the lanes; the others are shaded one at a time.
+        // The round: each path's ray traced and its vertex shaded.
         alive.clear();
         alive.resize(slots.len(), false);
-        ks.clear();
-        kd.clear();
-        for (k, (slot, &hit)) in slots.iter_mut().zip(&hits).enumerate() {
-            if let Some(h) = &hit
-                && let Some(phong) = lanes::diffuse(&tr, p, &slot.st, h)
-            {
-                ks.push(k);
-                kd.push(phong.kd);
-                continue;
-            }
-            std::mem::swap(&mut tr.sampler, &mut slot.sampler);
-            alive[k] = path::step(&mut tr, p, &mut slot.st, hit, &mut slot.rec);
-            std::mem::swap(&mut tr.sampler, &mut slot.sampler);
-            if alive[k] {
-                tr.count(&slot.st.ray, slot.st.kind);
-            }
-        }
-        if !ks.is_empty() {
-            lanes::shade(&mut tr, p, &mut slots, &ks, &hits, &kd, &mut alive);
-        }
+        lanes::round(&mut tr, p, &diffuse, &mut slots, &mut alive);
         // The paths that ended give their sums to the pixel and their slots to new samples.
         let mut k = 0;
         while k < slots.len() {

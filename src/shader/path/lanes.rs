@@ -12,7 +12,8 @@
 //! same ray, to the bit (`tests/integration/inspect.rs`).
 
 use super::{Path, PathState};
-use crate::accel::lanes::{abs_max, dot};
+use crate::accel::Tally;
+use crate::accel::lanes::{RayLanes, abs_max, dot};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray, UNIT_ROUNDOFF};
 use crate::light::{Chosen, Light};
@@ -51,104 +52,124 @@ pub fn applies(tr: &Tracer, p: &Path) -> bool {
         && tr.lights.iter().all(|l| matches!(l, Light::Point(_)))
 }
 
-/// The diffuse Phong material of `hit`, if the vertex it makes on path `st` is shaded in
-/// lanes: the surface reflects light diffusely only (its BRDF sampling always picks the
-/// cosine lobe), emits nothing, and the path may scatter there.
-#[inline]
-pub fn diffuse(tr: &Tracer, p: &Path, st: &PathState, hit: &Hit) -> Option<Phong> {
-    let prim = tr.geometry.prim(hit.prim);
-    let Material::Phong(phong) = tr.materials[prim.material as usize] else {
-        return None;
-    };
-    let max_depth = p
-        .max_depth
-        .unwrap_or(super::MAX_DEPTH)
-        .min(super::MAX_DEPTH);
-    (phong.ks == Vec3A::ZERO
-        && !phong.is_black()
-        && diffuse_probability(&phong) == 1.0
-        && prim.light == crate::light::NO_LIGHT
-        && st.depth < max_depth)
-        .then_some(phong)
-}
+/// Each primitive's diffuse Phong material, where the lanes shade its vertices: it reflects
+/// light diffusely only (so its BRDF sampling always picks the cosine lobe) and emits nothing.
+pub struct Diffuse(Vec<Option<Phong>>);
 
-/// Shade the vertices of `slots[k]` for each `k` of `ks` (their hits `hits[k]`, their
-/// materials `kd[j]` for the `j`-th of `ks`), in chunks of lanes: each adds its light to its
-/// slot's recorder and sets its next ray; `alive[k]` says whether the path goes on.
-pub fn shade<R: Record>(
-    tr: &mut Tracer,
-    p: &Path,
-    slots: &mut [PathSlot<R>],
-    ks: &[usize],
-    hits: &[Option<Hit>],
-    kd: &[Vec3A],
-    alive: &mut [bool],
-) {
-    for (chunk, kd) in ks.chunks(MAX_LANES).zip(kd.chunks(MAX_LANES)) {
-        match tr.geometry.bvh.isa() {
-            // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => unsafe { shade_avx512(tr, p, slots, chunk, hits, kd, alive) },
-            // SAFETY: as above.
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => unsafe { shade_avx2(tr, p, slots, chunk, hits, kd, alive) },
-            // SAFETY: `Vec4` runs on every CPU.
-            _ => unsafe { shade_in::<glam::Vec4, R>(tr, p, slots, chunk, hits, kd, alive) },
+impl Diffuse {
+    /// The table of `tr`'s primitives (by index; a render in waves makes it once per pixel,
+    /// from the primitives of a scene without a BVH, which are few).
+    pub fn table(tr: &Tracer) -> Diffuse {
+        let g = tr.geometry;
+        let mut table = Vec::new();
+        for i in g.indices() {
+            let prim = g.prim(i);
+            let i = i as usize;
+            if table.len() <= i {
+                table.resize(i + 1, None);
+            }
+            table[i] = match tr.materials[prim.material as usize] {
+                Material::Phong(phong)
+                    if phong.ks == Vec3A::ZERO
+                        && !phong.is_black()
+                        && diffuse_probability(&phong) == 1.0
+                        && prim.light == crate::light::NO_LIGHT =>
+                {
+                    Some(phong)
+                }
+                _ => None,
+            };
         }
+        Diffuse(table)
+    }
+
+    /// The diffuse material of `hit`, if the vertex it makes on path `st` is shaded in lanes:
+    /// its primitive's, if the path may scatter there.
+    #[inline]
+    pub fn at(&self, p: &Path, st: &PathState, hit: &Hit) -> Option<Phong> {
+        let max_depth = p
+            .max_depth
+            .unwrap_or(super::MAX_DEPTH)
+            .min(super::MAX_DEPTH);
+        if st.depth >= max_depth {
+            return None;
+        }
+        self.0.get(hit.prim as usize).copied().flatten()
     }
 }
 
-/// [`shade`]'s chunk in sixteen AVX-512 lanes (or fewer).
+/// One round of a wave: trace each path's ray of `slots` and shade the vertex it meets, the
+/// rays in chunks of lanes ([`Geometry::nearest_lanes`]; a scene without a BVH), the diffuse
+/// vertices ([`Diffuse`]) in those lanes, the others with the one-ray [`super::step`] (its
+/// random stream swapped into `tr`). Each path adds its vertex's light to its recorder and
+/// takes its next ray (counted); `alive[k]` (one per slot) says whether path `k` goes on.
+pub fn round<R: Record>(
+    tr: &mut Tracer,
+    p: &Path,
+    diffuse: &Diffuse,
+    slots: &mut [PathSlot<R>],
+    alive: &mut [bool],
+) {
+    match tr.geometry.bvh.isa() {
+        // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { round_avx512(tr, p, diffuse, slots, alive) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { round_avx2(tr, p, diffuse, slots, alive) },
+        // SAFETY: `Vec4` runs on every CPU.
+        _ => unsafe { round_in::<glam::Vec4, R>(tr, p, diffuse, slots, alive) },
+    }
+}
+
+/// [`round`] in sixteen AVX-512 lanes.
 ///
 /// # Safety
 /// The CPU must have AVX-512F.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn shade_avx512<R: Record>(
+unsafe fn round_avx512<R: Record>(
     tr: &mut Tracer,
     p: &Path,
+    diffuse: &Diffuse,
     slots: &mut [PathSlot<R>],
-    ks: &[usize],
-    hits: &[Option<Hit>],
-    kd: &[Vec3A],
     alive: &mut [bool],
 ) {
-    for (ks, kd) in ks.chunks(16).zip(kd.chunks(16)) {
-        // SAFETY: this function runs only where AVX-512F was found.
-        unsafe { shade_in::<crate::accel::F16, R>(tr, p, slots, ks, hits, kd, alive) }
-    }
+    // SAFETY: this function runs only where AVX-512F was found.
+    unsafe { round_in::<crate::accel::F16, R>(tr, p, diffuse, slots, alive) }
 }
 
-/// [`shade`]'s chunk in eight AVX2 lanes at a time.
+/// [`round`] in eight AVX2 lanes.
 ///
 /// # Safety
 /// The CPU must have AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn shade_avx2<R: Record>(
+unsafe fn round_avx2<R: Record>(
     tr: &mut Tracer,
     p: &Path,
+    diffuse: &Diffuse,
     slots: &mut [PathSlot<R>],
-    ks: &[usize],
-    hits: &[Option<Hit>],
-    kd: &[Vec3A],
     alive: &mut [bool],
 ) {
-    for (ks, kd) in ks.chunks(8).zip(kd.chunks(8)) {
-        // SAFETY: this function runs only where AVX2 was found.
-        unsafe { shade_in::<crate::accel::F8, R>(tr, p, slots, ks, hits, kd, alive) }
-    }
+    // SAFETY: this function runs only where AVX2 was found.
+    unsafe { round_in::<crate::accel::F8, R>(tr, p, diffuse, slots, alive) }
 }
 
-/// Rows of a chunk's gathered values.
-const P: usize = 0;
-const N: usize = 3;
-const D: usize = 6;
-const BETA: usize = 9;
-const KD: usize = 12;
-const ERR: usize = 15;
-const ERR_ALONG: usize = 16;
-const ROWS: usize = 17;
+/// Rows of a chunk's gathered rays and throughputs, and of its hits.
+const O: usize = 0;
+const D: usize = 3;
+const O_ERR: usize = 6;
+const T_MAX: usize = 7;
+const BETA: usize = 8;
+const ROWS: usize = 11;
+const HIT_T: usize = 0;
+const HIT_SLOT: usize = 1;
+const HIT_P: usize = 2;
+const HIT_N: usize = 5;
+const HIT_ERR: usize = 8;
+const HIT_ERR_ALONG: usize = 9;
+const HIT_ROWS: usize = 10;
 
 /// The lanes of a vector as an array.
 #[inline(always)]
@@ -158,8 +179,141 @@ fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
     a
 }
 
-/// Shade up to `L::LANES` vertices (`ks.len()`), as [`shade`] says. No closures that compute
-/// in lanes, so that this inlines whole into the AVX2 and AVX-512 copies.
+/// [`round`] in lanes `L`. No closures that compute in lanes, so that this inlines whole into
+/// the AVX2 and AVX-512 copies.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn round_in<L: Floats, R: Record>(
+    tr: &mut Tracer,
+    p: &Path,
+    diffuse: &Diffuse,
+    slots: &mut [PathSlot<R>],
+    alive: &mut [bool],
+) {
+    let geometry: &Geometry = tr.geometry;
+    for c in (0..slots.len()).step_by(L::LANES) {
+        let count = (slots.len() - c).min(L::LANES);
+        // The chunk's rays and throughputs in lanes (lanes past `count` repeat the last).
+        let mut v = [[0.0f32; MAX_LANES]; ROWS];
+        for i in 0..L::LANES {
+            let s = &slots[c + i.min(count - 1)].st;
+            for x in 0..3 {
+                v[O + x][i] = s.ray.o[x];
+                v[D + x][i] = s.ray.d[x];
+                v[BETA + x][i] = s.beta[x];
+            }
+            v[O_ERR][i] = s.ray.o_err;
+            v[T_MAX][i] = s.ray.t_max;
+        }
+        // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block
+        // below, each makes values of `L`.
+        let load = |row: usize| unsafe { L::from_slice(&v[row]) };
+        let (o, d) = (
+            [load(O), load(O + 1), load(O + 2)],
+            [load(D), load(D + 1), load(D + 2)],
+        );
+        let beta = [load(BETA), load(BETA + 1), load(BETA + 2)];
+        // The nearest hits, with their records, in the lanes.
+        let lanes = RayLanes::from_parts(o, d, load(O_ERR));
+        let near = unsafe { geometry.nearest_lanes(&lanes, load(T_MAX)) };
+        tr.traversal.prims(count as u64 * geometry.lane_prims());
+        let h = near.hit;
+        let mut w = [[0.0f32; MAX_LANES]; HIT_ROWS];
+        for (row, x) in [
+            near.t,
+            near.slot,
+            h.p[0],
+            h.p[1],
+            h.p[2],
+            h.n[0],
+            h.n[1],
+            h.n[2],
+            h.err,
+            h.err_along,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            x.write_to(&mut w[row]);
+        }
+        // Diffuse vertices stay in the lanes; the others go one at a time.
+        let (mut shaded, mut kd) = (0u32, [[0.0f32; MAX_LANES]; 3]);
+        for i in 0..count {
+            let k = c + i;
+            let hit = geometry
+                .slot_prim(w[HIT_SLOT][i].to_bits())
+                .map(|prim| Hit {
+                    t: w[HIT_T][i],
+                    p: Vec3A::new(w[HIT_P][i], w[HIT_P + 1][i], w[HIT_P + 2][i]),
+                    n: Vec3A::new(w[HIT_N][i], w[HIT_N + 1][i], w[HIT_N + 2][i]),
+                    err: w[HIT_ERR][i],
+                    err_along: w[HIT_ERR_ALONG][i],
+                    prim,
+                });
+            let slot = &mut slots[k];
+            if let Some(h) = &hit
+                && let Some(phong) = diffuse.at(p, &slot.st, h)
+            {
+                shaded |= 1 << i;
+                for x in 0..3 {
+                    kd[x][i] = phong.kd[x];
+                }
+                continue;
+            }
+            std::mem::swap(&mut tr.sampler, &mut slot.sampler);
+            alive[k] = super::step(tr, p, &mut slot.st, hit, &mut slot.rec);
+            std::mem::swap(&mut tr.sampler, &mut slot.sampler);
+            if alive[k] {
+                tr.count(&slot.st.ray, slot.st.kind);
+            }
+        }
+        if shaded != 0 {
+            let kd = unsafe {
+                [
+                    L::from_array(kd[0]),
+                    L::from_array(kd[1]),
+                    L::from_array(kd[2]),
+                ]
+            };
+            let at = Vertices {
+                p: h.p,
+                nh: h.n,
+                err: h.err,
+                err_along: h.err_along,
+                d,
+                beta,
+                kd,
+            };
+            unsafe {
+                shade_in::<L, R>(
+                    tr,
+                    p,
+                    &mut slots[c..c + count],
+                    shaded,
+                    &at,
+                    &mut alive[c..],
+                )
+            };
+        }
+    }
+}
+
+/// A chunk's vertices in lanes: the hit's point, geometric normal and error bounds, the ray's
+/// direction, the path's throughput, and the surface's `kd`.
+struct Vertices<L> {
+    p: [L; 3],
+    nh: [L; 3],
+    err: L,
+    err_along: L,
+    d: [L; 3],
+    beta: [L; 3],
+    kd: [L; 3],
+}
+
+/// Shade the vertices of `at` in the lanes of `shaded` (lane `i` is path `slots[i]`, which
+/// adds its light to its recorder and takes its next ray; `alive[i]` says whether it goes on).
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.
@@ -168,50 +322,17 @@ unsafe fn shade_in<L: Floats, R: Record>(
     tr: &mut Tracer,
     p: &Path,
     slots: &mut [PathSlot<R>],
-    ks: &[usize],
-    hits: &[Option<Hit>],
-    kd: &[Vec3A],
+    shaded: u32,
+    at: &Vertices<L>,
     alive: &mut [bool],
 ) {
-    let count = ks.len();
-    debug_assert!(count <= L::LANES);
-    // Gather: each lane's hit, ray direction, throughput and `kd` (lanes past `count` repeat
-    // the first, and are dropped).
-    let mut v = [[0.0f32; MAX_LANES]; ROWS];
-    for i in 0..L::LANES {
-        let k = ks[i.min(count - 1)];
-        let (s, hit) = (&slots[k], hits[k].expect("a shaded vertex has a hit"));
-        let kd = kd[i.min(count - 1)];
-        for c in 0..3 {
-            v[P + c][i] = hit.p[c];
-            v[N + c][i] = hit.n[c];
-            v[D + c][i] = s.st.ray.d[c];
-            v[BETA + c][i] = s.st.beta[c];
-            v[KD + c][i] = kd[c];
-        }
-        v[ERR][i] = hit.err;
-        v[ERR_ALONG][i] = hit.err_along;
-    }
+    let (p_, nh, d, beta, kd_l) = (at.p, at.nh, at.d, at.beta, at.kd);
+    let (err, err_along) = (at.err, at.err_along);
     // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block below,
     // each makes values of `L`.
-    let load = |row: usize| unsafe { L::from_slice(&v[row]) };
-    let (p_, nh, d) = (
-        [load(P), load(P + 1), load(P + 2)],
-        [load(N), load(N + 1), load(N + 2)],
-        [load(D), load(D + 1), load(D + 2)],
-    );
-    let (beta, kd_l) = (
-        [load(BETA), load(BETA + 1), load(BETA + 2)],
-        [load(KD), load(KD + 1), load(KD + 2)],
-    );
-    let (err, err_along) = (load(ERR), load(ERR_ALONG));
     let (zero, one, two) = unsafe { (L::splat(0.0), L::splat(1.0), L::splat(2.0)) };
     let (unit, two_unit) = unsafe { (L::splat(UNIT_ROUNDOFF), L::splat(2.0 * UNIT_ROUNDOFF)) };
-    let live = {
-        let mut f = [0.0f32; MAX_LANES];
-        f[..count].fill(1.0);
-        unsafe { L::from_array(f) }.cmpne(zero)
-    };
+    let live = unsafe { mask::<L>(shaded) };
     // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal), and
     // `Origins::new`: the point moved off the surface by its error's projection on the
     // normal, to either side, with the origins' error bound.
@@ -244,15 +365,25 @@ unsafe fn shade_in<L: Floats, R: Record>(
     let inv_pi = unsafe { L::splat(1.0 / PI) };
     let f = [kd_l[0] * inv_pi, kd_l[1] * inv_pi, kd_l[2] * inv_pi];
     let wo_above = dot(wo, n).cmpgt(zero);
+    let surface = Surface {
+        p: p_,
+        nh,
+        n,
+        front,
+        back,
+        o_err,
+        f,
+        wo_above,
+        live,
+    };
     // Next-event estimation: every point light's term, or one light's, chosen by power.
-    let one_light = p.lights_per_vertex == LightsPerVertex::One;
-    let nee = if one_light {
+    let nee = if p.lights_per_vertex == LightsPerVertex::One {
         // The choice, lane by lane: `u` picks the light; `one_light` draws two more numbers
         // for an area light's point, which a point light does not read.
         let (mut pos, mut intensity) = ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]);
         let (mut pmf, mut room, mut chosen) = ([1.0f32; MAX_LANES], 0u32, 0u32);
-        for (i, &k) in ks.iter().enumerate() {
-            let s = &mut slots[k].sampler;
+        for i in Bits(shaded) {
+            let s = &mut slots[i].sampler;
             let u = s.next_f64();
             let _ = s.next_2d();
             if let Some(Chosen::Point(j, w)) = tr.emitters.choose_any(u)
@@ -283,16 +414,14 @@ unsafe fn shade_in<L: Floats, R: Record>(
                 lanes: chosen,
             }
         };
-        let term =
-            unsafe { point_term(tr, &light, p_, nh, n, front, back, o_err, f, wo_above, live) };
+        let term = unsafe { point_term(tr, &light, &surface) };
         let pmf = unsafe { L::from_array(pmf) };
         [term[0] / pmf, term[1] / pmf, term[2] / pmf]
     } else {
         // `point_lights`: the terms summed from zero in the lights' order, then the area
         // lights' share (none here) added.
-        let lights = tr.lights;
         let mut sum = [zero; 3];
-        for l in lights {
+        for l in tr.lights {
             let Light::Point(l) = l else { continue };
             let light = unsafe {
                 LightLanes {
@@ -310,8 +439,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
                     lanes: u32::MAX,
                 }
             };
-            let term =
-                unsafe { point_term(tr, &light, p_, nh, n, front, back, o_err, f, wo_above, live) };
+            let term = unsafe { point_term(tr, &light, &surface) };
             sum = [sum[0] + term[0], sum[1] + term[1], sum[2] + term[2]];
         }
         [sum[0] + zero, sum[1] + zero, sum[2] + zero]
@@ -322,16 +450,16 @@ unsafe fn shade_in<L: Floats, R: Record>(
         array(beta[1] * nee[1]),
         array(beta[2] * nee[2]),
     ];
-    for (i, &k) in ks.iter().enumerate() {
+    for i in Bits(shaded) {
         let l = Vec3A::new(l[0][i], l[1][i], l[2][i]);
         if l != Vec3A::ZERO {
-            let s = &mut slots[k];
+            let s = &mut slots[i];
             s.rec.add(l, Technique::Light, s.st.depth + 1);
         }
     }
     if !tr.effects.indirect {
-        for &k in ks {
-            alive[k] = false;
+        for i in Bits(shaded) {
+            alive[i] = false;
         }
         return;
     }
@@ -343,8 +471,8 @@ unsafe fn shade_in<L: Floats, R: Record>(
         [0.0f32; MAX_LANES],
         [1.0f32; MAX_LANES],
     );
-    for (i, &k) in ks.iter().enumerate() {
-        let s = &mut slots[k].sampler;
+    for i in Bits(shaded) {
+        let s = &mut slots[i].sampler;
         let (u1, u2) = s.next_2d();
         if brdf {
             // `sample_phong` compares a number with the diffuse share, 1 here: the cosine lobe.
@@ -397,17 +525,18 @@ unsafe fn shade_in<L: Floats, R: Record>(
         L::select(side, front[1], back[1]),
         L::select(side, front[2], back[2]),
     ];
-    let (wi, o, beta, pdf, o_err) = (
+    let (wi, o, beta, pdf, o_err, hit_p) = (
         [array(wi[0]), array(wi[1]), array(wi[2])],
         [array(o[0]), array(o[1]), array(o[2])],
         [array(beta[0]), array(beta[1]), array(beta[2])],
         array(pdf),
         array(o_err),
+        [array(p_[0]), array(p_[1]), array(p_[2])],
     );
-    for (i, &k) in ks.iter().enumerate() {
-        let slot = &mut slots[k];
+    for i in Bits(shaded) {
+        let slot = &mut slots[i];
         if go & (1 << i) == 0 {
-            alive[k] = false;
+            alive[i] = false;
             continue;
         }
         let ray = Ray {
@@ -416,15 +545,45 @@ unsafe fn shade_in<L: Floats, R: Record>(
             t_max: f32::INFINITY,
             o_err: o_err[i],
         };
-        let hit_p = Vec3A::new(v[P][i], v[P + 1][i], v[P + 2][i]);
+        let hit_p = Vec3A::new(hit_p[0][i], hit_p[1][i], hit_p[2][i]);
         let beta = Vec3A::new(beta[0][i], beta[1][i], beta[2][i]);
-        alive[k] = slot
+        alive[i] = slot
             .st
             .scatter_diffuse(ray, hit_p, pdf[i], beta, p.rr_depth, &mut slot.sampler);
-        if alive[k] {
+        if alive[i] {
             tr.count(&slot.st.ray, RayKind::Indirect);
         }
     }
+}
+
+/// The set bits of a lane mask, lowest first.
+struct Bits(u32);
+
+impl Iterator for Bits {
+    type Item = usize;
+    #[inline(always)]
+    fn next(&mut self) -> Option<usize> {
+        (self.0 != 0).then(|| {
+            let i = self.0.trailing_zeros() as usize;
+            self.0 &= self.0 - 1;
+            i
+        })
+    }
+}
+
+/// What the light terms read of a chunk's vertices: the hit points, geometric and shading
+/// normals, the two origins and their error bound, the BRDF `kd / pi`, the lanes where `wo`
+/// is above the surface, and the lanes shaded.
+struct Surface<L: Floats> {
+    p: [L; 3],
+    nh: [L; 3],
+    n: [L; 3],
+    front: [L; 3],
+    back: [L; 3],
+    o_err: L,
+    f: [L; 3],
+    wo_above: L::Mask,
+    live: L::Mask,
 }
 
 /// A point light per lane (the same in every lane for `point_lights`): position, intensity,
@@ -443,24 +602,12 @@ struct LightLanes<L> {
 /// # Safety
 /// The CPU must run `L`'s instruction set.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-unsafe fn point_term<L: Floats>(
-    tr: &mut Tracer,
-    light: &LightLanes<L>,
-    p: [L; 3],
-    nh: [L; 3],
-    n: [L; 3],
-    front: [L; 3],
-    back: [L; 3],
-    o_err: L,
-    f: [L; 3],
-    wo_above: L::Mask,
-    live: L::Mask,
-) -> [L; 3] {
+unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Surface<L>) -> [L; 3] {
     // SAFETY: the caller's.
     let (zero, inf, end) =
         unsafe { (L::splat(0.0), L::splat(f32::INFINITY), L::splat(SHADOW_END)) };
-    let lanes = live & unsafe { mask::<L>(light.lanes) };
+    let (p, nh, n, front, back, o_err, f) = (at.p, at.nh, at.n, at.front, at.back, at.o_err, at.f);
+    let lanes = at.live & unsafe { mask::<L>(light.lanes) };
     // `PointLight::incident`: the unit direction, the distance and `I / d^2`.
     let to = [
         light.pos[0] - p[0],
@@ -523,9 +670,9 @@ unsafe fn point_term<L: Floats>(
     // `L_i r(wi, wo)` with `r = brdf max(cos, 0)` (the BRDF zero where `wo` is below), where
     // the light is seen.
     let r = [
-        L::select(wo_above, f[0], zero) * cos.max(zero),
-        L::select(wo_above, f[1], zero) * cos.max(zero),
-        L::select(wo_above, f[2], zero) * cos.max(zero),
+        L::select(at.wo_above, f[0], zero) * cos.max(zero),
+        L::select(at.wo_above, f[1], zero) * cos.max(zero),
+        L::select(at.wo_above, f[2], zero) * cos.max(zero),
     ];
     [
         L::select(seen, li[0] * r[0], zero),
