@@ -257,8 +257,8 @@ unsafe fn round_in<L: Floats, R: Record>(
                 && let Some(phong) = diffuse.at(p, &slot.st, h)
             {
                 shaded |= 1 << i;
-                for x in 0..3 {
-                    kd[x][i] = phong.kd[x];
+                for (row, x) in kd.iter_mut().zip(phong.kd.to_array()) {
+                    row[i] = x;
                 }
                 continue;
             }
