@@ -1,6 +1,7 @@
 //! Path's samples in waves (src/render/waves.rs, src/shader/path/lanes.rs): where they apply,
 //! every pixel is the one-ray render's to the bit, with the same ray counts, over the
-//! strategies the lanes shade (one light or all, BRDF or cosine sampling), Russian roulette
+//! strategies the lanes shade (one light by power or by importance, or all; BRDF or cosine
+//! sampling), Russian roulette
 //! from the first bounce, a depth limit, the effects that end or skip work, lights inside and
 //! outside the planes' room, and the materials the lanes leave to the one-ray code (glossy
 //! Phong, mirror, glass, a black surface).
@@ -56,7 +57,7 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
 #[test]
 fn waves_give_the_one_ray_pixels() {
     let _limit = common::deadline(120);
-    for per_vertex in ["One", "All"] {
+    for per_vertex in ["One", "All", "Importance"] {
         for sampling in ["Brdf", "Cosine"] {
             for depth in ["rr_depth: 1", "rr_depth: 5", "max_depth: 2, rr_depth: 1"] {
                 let shader =

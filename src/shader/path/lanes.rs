@@ -16,7 +16,7 @@ use crate::accel::Tally;
 use crate::accel::lanes::{RayLanes, abs_max, dot};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray, UNIT_ROUNDOFF};
-use crate::light::{Chosen, Light};
+use crate::light::{Chosen, Light, choose_by_importance};
 use crate::material::{Material, Model, Phong};
 use crate::sampling::{LightsPerVertex, Sampler, Sampling};
 use crate::shader::Tracer;
@@ -37,15 +37,11 @@ pub struct PathSlot<R> {
 }
 
 /// True if `p`'s vertices can be shaded in lanes in `tr`'s scene: the Physical model, BRDF or
-/// cosine sampling, every point light or one chosen by power, point lights only (no emitter,
-/// no environment, no spot or directional light), no textures.
+/// cosine sampling, point lights only (no emitter, no environment, no spot or directional
+/// light; every one per vertex, or one chosen by power or by importance), no textures.
 pub fn applies(tr: &Tracer, p: &Path) -> bool {
     tr.model == Model::Physical
         && matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
-        && matches!(
-            p.lights_per_vertex,
-            LightsPerVertex::One | LightsPerVertex::All
-        )
         && tr.emitters.is_empty()
         && tr.emitters.environment.is_none()
         && tr.textures.is_empty()
@@ -376,17 +372,42 @@ unsafe fn shade_in<L: Floats, R: Record>(
         wo_above,
         live,
     };
-    // Next-event estimation: every point light's term, or one light's, chosen by power.
-    let nee = if p.lights_per_vertex == LightsPerVertex::One {
-        // The choice, lane by lane: `u` picks the light; `one_light` draws two more numbers
-        // for an area light's point, which a point light does not read.
+    // Next-event estimation: every point light's term, or one light's, chosen by power or by
+    // importance (`one_light`).
+    let by_importance = p.lights_per_vertex == LightsPerVertex::Importance;
+    let nee = if p.lights_per_vertex != LightsPerVertex::All {
+        // The choice, lane by lane: `u` picks the light (by importance: `u`'s place within
+        // the point lights' share, with the point and normal of the lane's vertex);
+        // `one_light` draws two more numbers for an area light's point, which a point light
+        // does not read.
         let (mut pos, mut intensity) = ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]);
         let (mut pmf, mut room, mut chosen) = ([1.0f32; MAX_LANES], 0u32, 0u32);
+        let (at_p, at_n) = match by_importance {
+            true => (
+                [array(p_[0]), array(p_[1]), array(p_[2])],
+                [array(n[0]), array(n[1]), array(n[2])],
+            ),
+            false => ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]),
+        };
         for i in Bits(shaded) {
             let s = &mut slots[i].sampler;
             let u = s.next_f64();
             let _ = s.next_2d();
-            if let Some(Chosen::Point(j, w)) = tr.emitters.choose_any(u)
+            // The light and the factor of its term: `1 / pmf` by power, `1 / (share p)` by
+            // importance (a light chosen with a chance below f32's range adds nothing).
+            let pick = match tr.emitters.choose_any(u) {
+                Some(Chosen::Point(..)) if by_importance => {
+                    let (start, share) = tr.emitters.point_share();
+                    let v = ((u - start) / share).clamp(0.0, 1.0 - f64::EPSILON / 2.0);
+                    let at = |a: &[[f32; MAX_LANES]; 3]| Vec3A::new(a[0][i], a[1][i], a[2][i]);
+                    choose_by_importance(tr.lights, at(&at_p), at(&at_n), false, v)
+                        .map(|(j, p)| (j, (1.0 / (share * p)) as f32))
+                        .filter(|(_, w)| w.is_finite())
+                }
+                Some(Chosen::Point(j, w)) => Some((j, w)),
+                _ => None,
+            };
+            if let Some((j, w)) = pick
                 && let Light::Point(l) = &tr.lights[j]
             {
                 for c in 0..3 {
@@ -415,8 +436,11 @@ unsafe fn shade_in<L: Floats, R: Record>(
             }
         };
         let term = unsafe { point_term(tr, &light, &surface) };
-        let pmf = unsafe { L::from_array(pmf) };
-        [term[0] / pmf, term[1] / pmf, term[2] / pmf]
+        let w = unsafe { L::from_array(pmf) };
+        match by_importance {
+            true => [term[0] * w, term[1] * w, term[2] * w],
+            false => [term[0] / w, term[1] / w, term[2] / w],
+        }
     } else {
         // `point_lights`: the terms summed from zero in the lights' order, then the area
         // lights' share (none here) added.
