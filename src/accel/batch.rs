@@ -36,6 +36,37 @@ pub struct Nearest<L> {
     pub hit: SurfaceLanes<L>,
 }
 
+/// The records of a [`Nearest`] lane by lane: the distance, the slot's bits, the point, the
+/// normal and the two error bounds, a row each.
+pub struct NearestRows([[f32; MAX_LANES]; 10]);
+
+impl<L: Floats> Nearest<L> {
+    /// The lanes' records as rows, to be read lane by lane ([`Geometry::lane_hit`]).
+    #[inline(always)]
+    pub fn rows(&self) -> NearestRows {
+        let h = &self.hit;
+        let mut v = [[0.0f32; MAX_LANES]; 10];
+        for (row, x) in [
+            self.t,
+            self.slot,
+            h.p[0],
+            h.p[1],
+            h.p[2],
+            h.n[0],
+            h.n[1],
+            h.n[2],
+            h.err,
+            h.err_along,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            x.write_to(&mut v[row]);
+        }
+        NearestRows(v)
+    }
+}
+
 /// Where `ok`, the lanes take `x` (a primitive's vector and number: a centre and radius, a
 /// normal and offset) into `into`.
 #[inline(always)]
@@ -114,7 +145,7 @@ impl Geometry {
     /// The nearest hit of each ray of `rays`, as [`Geometry::intersect`] finds it, into `hits`
     /// (cleared first, then one entry per ray), for rays that run close together, as a camera's
     /// do: in a scene whose only primitives are in the BVH, eight rays in a row that run into
-    /// the same octant walk the tree together ([`WideBvh::closest_packet`]); the others, and
+    /// the same octant walk the tree together ([`super::WideBvh::closest_packet`]); the others, and
     /// every ray of other scenes, are traced alone. The answers are the same to the bit.
     pub fn intersect_coherent(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
         hits.clear();
@@ -374,37 +405,8 @@ impl Geometry {
             // SAFETY: the caller vouches for the instruction set.
             let (eight, t_max) = unsafe { chunk::<L>(rays, k) };
             let lanes = unsafe { RayLanes::<L>::gather(&eight) };
-            let near = unsafe { self.nearest_lanes(&lanes, t_max) };
-            let h = near.hit;
-            let mut v = [[0.0f32; MAX_LANES]; 10];
-            for (row, x) in [
-                near.t,
-                near.slot,
-                h.p[0],
-                h.p[1],
-                h.p[2],
-                h.n[0],
-                h.n[1],
-                h.n[2],
-                h.err,
-                h.err_along,
-            ]
-            .into_iter()
-            .enumerate()
-            {
-                x.write_to(&mut v[row]);
-            }
-            let hit = |i: usize| {
-                self.slot_prim(v[1][i].to_bits()).map(|prim| Hit {
-                    t: v[0][i],
-                    p: glam::Vec3A::new(v[2][i], v[3][i], v[4][i]),
-                    n: glam::Vec3A::new(v[5][i], v[6][i], v[7][i]),
-                    err: v[8][i],
-                    err_along: v[9][i],
-                    prim,
-                })
-            };
-            hits.extend((0..(rays.len() - k).min(L::LANES)).map(hit));
+            let rows = unsafe { self.nearest_lanes(&lanes, t_max) }.rows();
+            hits.extend((0..(rays.len() - k).min(L::LANES)).map(|i| self.lane_hit(&rows, i)));
         }
     }
 
@@ -476,6 +478,20 @@ impl Geometry {
             slot,
             hit,
         }
+    }
+
+    /// Lane `i`'s nearest hit in `rows` ([`Nearest::rows`]), or `None` if it hit nothing.
+    #[inline(always)]
+    pub fn lane_hit(&self, rows: &NearestRows, i: usize) -> Option<Hit> {
+        let v = &rows.0;
+        self.slot_prim(v[1][i].to_bits()).map(|prim| Hit {
+            t: v[0][i],
+            p: glam::Vec3A::new(v[2][i], v[3][i], v[4][i]),
+            n: glam::Vec3A::new(v[5][i], v[6][i], v[7][i]),
+            err: v[8][i],
+            err_along: v[9][i],
+            prim,
+        })
     }
 
     /// The primitive of a slot of [`Geometry::nearest_lanes`] (the packed spheres in order,

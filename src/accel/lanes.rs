@@ -11,7 +11,7 @@
 //! gives the same bits.
 
 use super::simd::{Floats, MAX_LANES};
-use crate::geometry::{Ray, gamma};
+use crate::geometry::{Ray, UNIT_ROUNDOFF, gamma};
 use crate::shape::{Plane, Sphere};
 use glam::{BVec4A, Vec4};
 
@@ -84,6 +84,45 @@ impl<L: Floats> RayLanes<L> {
 pub fn abs_max<L: Floats>(v: [L; 3]) -> L {
     let [x, y, z] = [v[0].abs(), v[1].abs(), v[2].abs()];
     x.max(z).max(y.max(z))
+}
+
+/// The lanes of a vector as an array.
+#[inline(always)]
+pub fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
+    let mut a = [0.0f32; MAX_LANES];
+    x.write_to(&mut a);
+    a
+}
+
+/// Where rays leave the hits of the lanes, `crate::geometry::Origins::new` lane by lane: the
+/// hit points `p` moved off their surfaces (unit geometric normals `n`) by the error bound
+/// `err` projected on the normal, to the front and to the back, and the origins' error bound
+/// (with the hits' error along the surface, `err_along`), each the scalar code's operations in
+/// its order.
+#[inline(always)]
+pub fn origins<L: Floats>(p: [L; 3], n: [L; 3], err: L, err_along: L) -> ([L; 3], [L; 3], L) {
+    // SAFETY: a value of `L` (`err`) exists, so the CPU runs its instruction set.
+    let (two, unit, two_unit) = unsafe {
+        (
+            L::splat(2.0),
+            L::splat(UNIT_ROUNDOFF),
+            L::splat(2.0 * UNIT_ROUNDOFF),
+        )
+    };
+    let n_sum = (n[0].abs() + n[1].abs()) + n[2].abs();
+    let off = n_sum * err + two_unit * abs_max(p);
+    let front = [p[0] + off * n[0], p[1] + off * n[1], p[2] + off * n[2]];
+    let back = [p[0] - off * n[0], p[1] - off * n[1], p[2] - off * n[2]];
+    let widest = [
+        front[0].abs().max(back[0].abs()),
+        front[1].abs().max(back[1].abs()),
+        front[2].abs().max(back[2].abs()),
+    ];
+    (
+        front,
+        back,
+        err + off + two * err_along + unit * abs_max(widest),
+    )
 }
 
 /// Hit records of a ray per lane, each as its shape's `surface` computes it

@@ -10,7 +10,7 @@ mod simd;
 pub mod tally;
 pub mod wide;
 
-pub use batch::Segments;
+pub use batch::{Nearest, NearestRows, Segments};
 pub use bvh::{Bvh, Node};
 pub use prim::{FLAT, Prim};
 #[cfg(target_arch = "x86_64")]

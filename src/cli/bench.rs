@@ -258,9 +258,7 @@ fn case(name: &str, scene: &RenderScene, runs: u32, json: bool) {
 }
 
 /// Mrays/s and hits of `query` over `rays` (in parallel, chunks of 4096 rays) on the BVH in
-/// each of `isas`, each the median of `runs` passes. The instruction sets' passes take turns,
-/// in reverse order every other round, so that the machine's drift falls on all of them; every
-/// pass must find the same hits.
+/// each of `isas`, each the median of `runs` passes ([`rates_by`]).
 fn rates(
     g: &mut Geometry,
     isas: &[Isa],
@@ -269,48 +267,38 @@ fn rates(
     query: impl Fn(&Geometry, &Ray) -> bool + Sync + Copy,
 ) -> Vec<(f64, usize)> {
     use rayon::prelude::*;
-    let mut passes: Vec<Vec<(f64, usize)>> = vec![Vec::new(); isas.len()];
-    for round in 0..runs.max(1) {
-        let mut order: Vec<usize> = (0..isas.len()).collect();
-        if round % 2 == 1 {
-            order.reverse();
-        }
-        for k in order {
-            let isa = isas[k];
-            assert!(g.bvh.set_isa(isa), "checked by IsaArg::isas");
-            let g = &*g;
-            let start = Instant::now();
-            let hits: usize = rays
-                .par_chunks(4096)
-                .map(|c| c.iter().filter(|r| query(g, r)).count())
-                .sum();
-            passes[k].push((start.elapsed().as_secs_f64(), hits));
-        }
-    }
-    rates_of(passes, rays.len())
-}
-
-/// Each instruction set's median rate (Mrays/s) over its passes of `rays` rays, and its hit
-/// count, which every set must agree on.
-fn rates_of(passes: Vec<Vec<(f64, usize)>>, rays: usize) -> Vec<(f64, usize)> {
-    let out: Vec<(f64, usize)> = passes
-        .into_iter()
-        .map(|p| {
-            let (seconds, hits) = median(p);
-            (rays as f64 / seconds / 1e6, hits)
-        })
-        .collect();
-    assert!(
-        out.iter().all(|r| r.1 == out[0].1),
-        "the instruction sets found different hits"
-    );
-    out
+    rates_by(g, isas, rays, runs, |g, rays| {
+        rays.par_chunks(4096)
+            .map(|c| c.iter().filter(|r| query(g, r)).count())
+            .sum()
+    })
 }
 
 /// [`rates`] of nearest-hit queries made in batches of consecutive rays
 /// ([`Geometry::intersect_coherent`]).
 fn rates_in_batches(g: &mut Geometry, isas: &[Isa], rays: &[Ray], runs: u32) -> Vec<(f64, usize)> {
     use rayon::prelude::*;
+    rates_by(g, isas, rays, runs, |g, rays| {
+        rays.par_chunks(4096)
+            .map_init(Vec::new, |out, c| {
+                g.intersect_coherent(c, out);
+                out.iter().filter(|h| h.is_some()).count()
+            })
+            .sum()
+    })
+}
+
+/// Mrays/s and hits of `pass` (which traces all of `rays` and counts the hits) on the BVH in
+/// each of `isas`, each the median of `runs` passes. The instruction sets' passes take turns,
+/// in reverse order every other round, so that the machine's drift falls on all of them; every
+/// pass must find the same hits.
+fn rates_by(
+    g: &mut Geometry,
+    isas: &[Isa],
+    rays: &[Ray],
+    runs: u32,
+    pass: impl Fn(&Geometry, &[Ray]) -> usize,
+) -> Vec<(f64, usize)> {
     let mut passes: Vec<Vec<(f64, usize)>> = vec![Vec::new(); isas.len()];
     for round in 0..runs.max(1) {
         let mut order: Vec<usize> = (0..isas.len()).collect();
@@ -319,19 +307,23 @@ fn rates_in_batches(g: &mut Geometry, isas: &[Isa], rays: &[Ray], runs: u32) -> 
         }
         for k in order {
             assert!(g.bvh.set_isa(isas[k]), "checked by IsaArg::isas");
-            let g = &*g;
             let start = Instant::now();
-            let hits: usize = rays
-                .par_chunks(4096)
-                .map_init(Vec::new, |out, c| {
-                    g.intersect_coherent(c, out);
-                    out.iter().filter(|h| h.is_some()).count()
-                })
-                .sum();
+            let hits = pass(g, rays);
             passes[k].push((start.elapsed().as_secs_f64(), hits));
         }
     }
-    rates_of(passes, rays.len())
+    let out: Vec<(f64, usize)> = passes
+        .into_iter()
+        .map(|p| {
+            let (seconds, hits) = median(p);
+            (rays.len() as f64 / seconds / 1e6, hits)
+        })
+        .collect();
+    assert!(
+        out.iter().all(|r| r.1 == out[0].1),
+        "the instruction sets found different hits"
+    );
+    out
 }
 
 /// The median time of `runs` (at least 1) calls of `f`, which return a time and a result that

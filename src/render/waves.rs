@@ -1,19 +1,18 @@
 //! Path's samples in waves: the paths of up to [`WAVE`] samples of a pixel advance together,
 //! one vertex each per round, in a scene whose primitives are all packed (no BVH). Each round
-//! traces the paths' rays as one batch in SIMD lanes
-//! ([`crate::accel::Geometry::intersect_group`]); shades the diffuse vertices in lanes
+//! traces the paths' rays in chunks of SIMD lanes
+//! ([`crate::accel::Geometry::nearest_lanes`]) and shades the diffuse vertices in those lanes
 //! ([`crate::shader::path::lanes`]: the interaction, the point lights with their shadow rays in
 //! lanes, the next direction and Russian roulette) and every other vertex (mirrors, glass,
-//! glossy Phong, escapes) with the one-ray code ([`path::step`]); and gives the slots of the
-//! paths that ended to the pixel's next samples.
+//! glossy Phong, escapes) with the one-ray code ([`crate::shader::path::step`]); the slots of
+//! the paths that ended go to the pixel's next samples.
 //!
 //! Each sample draws from its own random stream in the one-ray order and adds the same
 //! contributions, each computed by the same operations, and its sum is exact
 //! ([`SampleSum`]), so the pixel is the one-ray render's to the bit
-//! (`tests/integration/inspect.rs`).
+//! (`tests/integration/path_waves.rs`).
 
-use super::{SampleSum, camera_ray};
-use crate::RenderScene;
+use super::{RenderScene, SampleSum, camera_ray};
 use crate::sampling::Sampler;
 use crate::shader::Shader;
 use crate::shader::path::lanes::{self, PathSlot};

@@ -113,6 +113,39 @@ impl Tracer<'_> {
         }
     }
 
+    /// Count the shadow rays in the lanes of `mask` (origins `o`, directions `d`), made and
+    /// tested in lanes, and show them to the audit if there is one, one by one.
+    #[inline(always)]
+    pub fn count_shadow_lanes<L: crate::accel::Floats>(
+        &mut self,
+        (o, d, o_err, t_max): crate::accel::Segments<L>,
+        mask: u32,
+    ) {
+        self.stats.shadow += u64::from(mask.count_ones());
+        let Some(audit) = self.audit else {
+            return;
+        };
+        let column = |x: L| {
+            let mut v = [0.0f32; crate::accel::MAX_LANES];
+            x.write_to(&mut v);
+            v
+        };
+        let (o, d) = (o.map(column), d.map(column));
+        let (o_err, t_max) = (column(o_err), column(t_max));
+        let mut bits = mask;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let ray = Ray {
+                o: glam::Vec3A::new(o[0][i], o[1][i], o[2][i]),
+                d: glam::Vec3A::new(d[0][i], d[1][i], d[2][i]),
+                t_max: t_max[i],
+                o_err: o_err[i],
+            };
+            audit(&ray, RayKind::Shadow);
+        }
+    }
+
     /// Nearest hit of a ray of the given kind (counted).
     #[inline]
     pub fn trace(&mut self, ray: &Ray, kind: RayKind) -> Option<Hit> {

@@ -120,18 +120,6 @@ impl PathState {
         }
     }
 
-    /// Throughput of the path up to the ray's origin.
-    #[inline]
-    pub fn beta(&self) -> Vec3A {
-        self.beta
-    }
-
-    /// Scattering vertices so far.
-    #[inline]
-    pub fn depth(&self) -> u32 {
-        self.depth
-    }
-
     /// The end of [`step`] at a diffuse Phong vertex at `p` that sampled direction
     /// `ray.d` with density `pdf` and throughput weight making `beta` the path's throughput
     /// (`lanes` computes these): one more vertex, then Russian roulette from depth `rr_depth`

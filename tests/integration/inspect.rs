@@ -218,9 +218,12 @@ fn groups_of_camera_rays_add_what_each_sample_alone_adds() {
         .replace(
             "width: 360, height: 288, spp: 64",
             "width: 9, height: 7, spp: 19",
-        );
+        )
+        // (Uniform sampling: not in waves, `render::waves`, whose test is path_waves.rs.)
+        .replace("sampling: Brdf)", "sampling: Uniform)");
     for text in [area, boxed] {
         let s = rtis::extract(&scene(&text));
+        assert!(!rtis::render::waves::applies(&s));
         assert!(
             s.geometry.groups_pay(),
             "every primitive in the BVH, or none"

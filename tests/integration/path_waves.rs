@@ -14,7 +14,7 @@ use rtis::stats::RayStats;
 /// A small room of planes and spheres (no BVH) with two point lights, under `shader`.
 fn room(shader: &str, effects: &str) -> String {
     format!(
-        "Scene(film: (width: 8, height: 6, spp: 21), shader: {shader}, model: Physical,
+        "Scene(film: (width: 8, height: 6, spp: 150), shader: {shader}, model: Physical,
           camera: Perspective(position: (0, 0, 3.5), look_at: (0, 0, 0), fov: 55),
           effects: ({effects}),
           entities: [
@@ -31,27 +31,40 @@ fn room(shader: &str, effects: &str) -> String {
     )
 }
 
-/// Each pixel's sum in waves against its samples' one-ray sums, and the ray counts.
+/// Each pixel's sum in waves against its samples' one-ray sums, and the ray counts, in every
+/// instruction set this CPU runs (the lanes' widths: 4, 8, 16); a few pixels with more samples
+/// than a wave holds, so that the slots of ended paths take new samples.
 fn agrees(s: &rtis::RenderScene, what: &str) {
     assert!(waves::applies(s), "{what}: the waves apply");
-    let (mut waved, mut alone) = (RayStats::default(), RayStats::default());
-    for row in 0..s.film.height {
-        for col in 0..s.film.width {
-            for samples in [0..s.film.spp, 5..17] {
-                let got = pixel_sum(s, col, row, samples.clone(), &mut waved);
-                let mut want = RgbSum::default();
-                for k in samples {
-                    want += render_sample(s, col, row, k, &mut alone);
+    rtis::accel::require_all_isas();
+    for isa in rtis::accel::Isa::all_available() {
+        let mut s = s.clone();
+        assert!(s.geometry.bvh.set_isa(isa));
+        let s = &s;
+        assert!(s.film.spp as usize > 2 * waves::WAVE);
+        let (mut waved, mut alone) = (RayStats::default(), RayStats::default());
+        for row in 0..s.film.height {
+            for col in 0..s.film.width {
+                let mut ranges = vec![0..21, 5..17];
+                if (col + row) % 7 == 0 {
+                    ranges.push(3..s.film.spp);
                 }
-                assert_eq!(got, want, "{what}: pixel {col},{row}");
+                for samples in ranges {
+                    let got = pixel_sum(s, col, row, samples.clone(), &mut waved);
+                    let mut want = RgbSum::default();
+                    for k in samples {
+                        want += render_sample(s, col, row, k, &mut alone);
+                    }
+                    assert_eq!(got, want, "{what} ({isa:?}): pixel {col},{row}");
+                }
             }
         }
+        assert_eq!(waved, alone, "{what} ({isa:?}): ray counts");
+        assert!(
+            alone.shadow > 0 || what.contains("shadows: false"),
+            "{what}"
+        );
     }
-    assert_eq!(waved, alone, "{what}: ray counts");
-    assert!(
-        alone.shadow > 0 || !what.contains("shadows: true"),
-        "{what}"
-    );
 }
 
 #[test]
@@ -86,14 +99,38 @@ fn waves_give_the_one_ray_pixels() {
     }
 }
 
-/// The waves are for the scenes whose vertices the lanes shade: not under the Course model,
-/// with area lights, or with a BVH.
+/// The waves are for the scenes whose vertices the lanes shade: not under the Course model or
+/// with uniform sampling, not with a light other than point lights (spot, directional, an
+/// emitting shape, the environment), a texture, or a BVH; each alone keeps them off.
 #[test]
 fn waves_apply_only_where_the_lanes_shade() {
-    let course = room("Path(sampling: Brdf)", "").replace("model: Physical", "model: Course");
-    assert!(!waves::applies(&rtis::extract(&scene(&course))));
-    let uniform = room("Path(sampling: Uniform)", "");
-    assert!(!waves::applies(&rtis::extract(&scene(&uniform))));
-    let area = std::fs::read_to_string(common::scenes_dir().join("mitsuba-cornell.ron")).unwrap();
-    assert!(!waves::applies(&rtis::extract(&scene(&area))));
+    let path = "Path(sampling: Brdf)";
+    assert!(waves::applies(&rtis::extract(&scene(&room(path, "")))));
+    let with = |entity: &str| {
+        let text = room(path, "").replace(
+            "(light: Point(position: (0.5, 1.0, 1.0)",
+            &format!("{entity},\n            (light: Point(position: (0.5, 1.0, 1.0)"),
+        );
+        assert!(text.contains(entity), "{entity}");
+        rtis::extract(&scene(&text))
+    };
+    for (what, text) in [
+        (
+            "the Course model",
+            room(path, "").replace("model: Physical", "model: Course"),
+        ),
+        ("uniform sampling", room("Path(sampling: Uniform)", "")),
+    ] {
+        assert!(!waves::applies(&rtis::extract(&scene(&text))), "{what}");
+    }
+    for entity in [
+        "(light: Spot(position: (-1, 1.2, 1), direction: (0.5, -1, -0.5), intensity: (3, 3, 3)))",
+        "(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))",
+        "(shape: Sphere(center: (0, 1.2, 0), radius: 0.1), emitter: Emitter(radiance: (8, 7, 6)))",
+        "(light: Environment(radiance: (0.3, 0.35, 0.4)))",
+        "(shape: Sphere(center: (1, 1, -1), radius: 0.2), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))",
+        "(shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, -0.9, -0.5)], faces: [(0, 1, 2)]), material: Phong(kd: (0.5, 0.5, 0.5)))",
+    ] {
+        assert!(!waves::applies(&with(entity)), "{entity}");
+    }
 }

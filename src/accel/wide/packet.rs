@@ -1,20 +1,23 @@
 //! Coherent rays traced together: a packet of up to eight rays, one per lane, walks the wide
 //! BVH once (Wald et al. 2001, "Interactive Rendering with Coherent Ray Tracing"; Embree's
-//! packet traversal). At each node the eight rays are tested against one child box at a time,
-//! the box splatted across the lanes, instead of each ray testing the eight boxes apart: for
-//! rays that go through the same nodes (a camera's neighbouring pixels) a node's data is read
-//! once per packet and its test costs an eighth as many instructions per ray.
+//! packet traversal). An interior node's children are culled for the whole packet at once, in
+//! one node test over the interval of the rays' origins and reciprocal directions (bounds on
+//! every ray's own distances, so it is conservative); a leaf child's box is tested ray by ray,
+//! the box splatted across the lanes; and each leaf is tested with each ray's own reach. For
+//! rays that go through the same nodes (a camera's neighbouring pixels) a node is read and
+//! tested once per packet instead of once per ray.
 //!
-//! The answers are the one-ray traversal's ([`WideBvh::closest`]) to the bit. Each lane runs
-//! that traversal's box arithmetic for its ray (the same decoded planes, the same four
-//! operations per side, the same margins), so a ray enters every box it would enter alone, and
-//! each leaf is tested with the caller's one-ray test and the ray's own reach. The nearest
-//! distance found is then the same; which primitive holds it is too, except where two leaves
-//! hold primitives at exactly that distance (a ray through a shared edge): the one-ray rule
-//! keeps the one visited last, so the answer depends on the order of visits, which a packet
-//! changes. Such a tie is always seen (the second leaf reports a hit at the reach the first
-//! set, and no box holding a hit at the reach is culled), and the packet reports the ray as
-//! tied for its caller to trace alone.
+//! The answers are the one-ray traversal's ([`WideBvh::closest`]) to the bit. A ray enters every
+//! leaf whose box its own test would enter (the interval test keeps a superset of the
+//! interior nodes; a leaf's rays are chosen by the one-ray arithmetic), and each leaf is tested
+//! with the caller's one-ray test, so the nearest distance found is the same; which primitive
+//! holds it is too, except where two leaves hold primitives at exactly that distance (a ray
+//! through two coincident surfaces): the one-ray rule keeps the one visited last, so the answer
+//! depends on the order of visits, which a packet changes. Such a tie is seen, as long as a
+//! leaf's entry distance is never computed above its hits' distances by more than the
+//! traversal's margin (`grown`), which the one-ray traversal assumes as well: then the second
+//! leaf is visited and reports a hit at the reach the first set. The packet reports the ray as
+//! tied, for its caller to trace it alone.
 
 use super::{ChildRef, EMPTY, LEAF, Planes, STACK, TOP, WideBvh, exit_origin, grown};
 use crate::accel::Tally;
@@ -206,6 +209,10 @@ impl WideBvh {
         tally: &impl Tally,
     ) -> PacketHits {
         debug_assert!(self.isa.available());
+        debug_assert!(
+            (0..PACKET).all(|i| live & (1 << i) == 0 || octant(rays[i]) == back),
+            "the live rays share the octant `back`"
+        );
         match self.isa {
             // SAFETY: as in `closest_tallied`.
             #[cfg(target_arch = "x86_64")]

@@ -22,8 +22,8 @@ use crate::accel::{Floats, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
 use crate::light::Light;
 use crate::material::{Material, Model, Phong, reflect};
+use crate::shader::Tracer;
 use crate::shader::surface::{Interaction, SHADOW_END, emitted, reflectance, specular_bounce};
-use crate::shader::{RayAudit, Tracer};
 use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::PI;
@@ -639,10 +639,7 @@ unsafe fn point_sums<L: Floats>(
             L::select(on_front, front[2], back[2]),
         ];
         let seen = if shadows {
-            tr.stats.shadow += u64::from(L::bitmask(valid).count_ones());
-            if let Some(audit) = tr.audit {
-                audit_lanes(audit, o, wi, o_err, dist * end, L::bitmask(valid));
-            }
+            tr.count_shadow_lanes((o, wi, o_err, dist * end), L::bitmask(valid));
             let planes = !in_room;
             // Counted only in an inspected render; a render's queries have no counters.
             let segments = (o, wi, o_err, dist * end);
@@ -699,29 +696,4 @@ unsafe fn point_sums<L: Floats>(
         sum[c].write_to(&mut out[c]);
     }
     out
-}
-
-/// Show the rays in the lanes of `mask` (origins `o`, directions `d`) to `audit` as shadow
-/// rays ([`RayAudit`]), one by one.
-#[inline(always)]
-fn audit_lanes<L: Floats>(audit: RayAudit, o: [L; 3], d: [L; 3], o_err: L, t_max: L, mask: u32) {
-    let column = |x: L| {
-        let mut v = [0.0f32; MAX_LANES];
-        x.write_to(&mut v);
-        v
-    };
-    let (o, d) = (o.map(column), d.map(column));
-    let (o_err, t_max) = (column(o_err), column(t_max));
-    let mut bits = mask;
-    while bits != 0 {
-        let i = bits.trailing_zeros() as usize;
-        bits &= bits - 1;
-        let ray = Ray {
-            o: Vec3A::new(o[0][i], o[1][i], o[2][i]),
-            d: Vec3A::new(d[0][i], d[1][i], d[2][i]),
-            t_max: t_max[i],
-            o_err: o_err[i],
-        };
-        audit(&ray, RayKind::Shadow);
-    }
 }

@@ -9,13 +9,12 @@
 //! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
 //! draws its random numbers from its own stream in the same order (the draws, the light choice
 //! and `sin_cos` run lane by lane), so each path adds the same contributions and goes on with the
-//! same ray, to the bit (`tests/integration/inspect.rs`).
+//! same ray, to the bit (`tests/integration/path_waves.rs`).
 
 use super::{Path, PathState};
-use crate::accel::Tally;
-use crate::accel::lanes::{RayLanes, abs_max, dot};
+use crate::accel::lanes::{RayLanes, array, dot, origins};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
-use crate::geometry::{Hit, Ray, UNIT_ROUNDOFF};
+use crate::geometry::{Hit, Ray};
 use crate::light::{Chosen, Light, choose_by_importance};
 use crate::material::{Material, Model, Phong};
 use crate::sampling::{LightsPerVertex, Sampler, Sampling};
@@ -43,7 +42,6 @@ pub fn applies(tr: &Tracer, p: &Path) -> bool {
     tr.model == Model::Physical
         && matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
         && tr.emitters.is_empty()
-        && tr.emitters.environment.is_none()
         && tr.textures.is_empty()
         && tr.lights.iter().all(|l| matches!(l, Light::Point(_)))
 }
@@ -53,8 +51,8 @@ pub fn applies(tr: &Tracer, p: &Path) -> bool {
 pub struct Diffuse(Vec<Option<Phong>>);
 
 impl Diffuse {
-    /// The table of `tr`'s primitives (by index; a render in waves makes it once per pixel,
-    /// from the primitives of a scene without a BVH, which are few).
+    /// The table of `tr`'s primitives, by index (a render in waves makes it for each pixel
+    /// it traces, from the primitives of a scene without a BVH, which are few).
     pub fn table(tr: &Tracer) -> Diffuse {
         let g = tr.geometry;
         let mut table = Vec::new();
@@ -152,28 +150,13 @@ unsafe fn round_avx2<R: Record>(
     unsafe { round_in::<crate::accel::F8, R>(tr, p, diffuse, slots, alive) }
 }
 
-/// Rows of a chunk's gathered rays and throughputs, and of its hits.
+/// Rows of a chunk's gathered rays and throughputs.
 const O: usize = 0;
 const D: usize = 3;
 const O_ERR: usize = 6;
 const T_MAX: usize = 7;
 const BETA: usize = 8;
 const ROWS: usize = 11;
-const HIT_T: usize = 0;
-const HIT_SLOT: usize = 1;
-const HIT_P: usize = 2;
-const HIT_N: usize = 5;
-const HIT_ERR: usize = 8;
-const HIT_ERR_ALONG: usize = 9;
-const HIT_ROWS: usize = 10;
-
-/// The lanes of a vector as an array.
-#[inline(always)]
-fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
-    let mut a = [0.0f32; MAX_LANES];
-    x.write_to(&mut a);
-    a
-}
 
 /// [`round`] in lanes `L`. No closures that compute in lanes, so that this inlines whole into
 /// the AVX2 and AVX-512 copies.
@@ -189,6 +172,8 @@ unsafe fn round_in<L: Floats, R: Record>(
     alive: &mut [bool],
 ) {
     let geometry: &Geometry = tr.geometry;
+    // `nearest_lanes` tests the packed primitives only.
+    debug_assert!(geometry.bvh.is_empty(), "a scene without a BVH");
     for c in (0..slots.len()).step_by(L::LANES) {
         let count = (slots.len() - c).min(L::LANES);
         // The chunk's rays and throughputs in lanes (lanes past `count` repeat the last).
@@ -214,40 +199,12 @@ unsafe fn round_in<L: Floats, R: Record>(
         // The nearest hits, with their records, in the lanes.
         let lanes = RayLanes::from_parts(o, d, load(O_ERR));
         let near = unsafe { geometry.nearest_lanes(&lanes, load(T_MAX)) };
-        tr.traversal.prims(count as u64 * geometry.lane_prims());
-        let h = near.hit;
-        let mut w = [[0.0f32; MAX_LANES]; HIT_ROWS];
-        for (row, x) in [
-            near.t,
-            near.slot,
-            h.p[0],
-            h.p[1],
-            h.p[2],
-            h.n[0],
-            h.n[1],
-            h.n[2],
-            h.err,
-            h.err_along,
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            x.write_to(&mut w[row]);
-        }
+        let (h, rows) = (near.hit, near.rows());
         // Diffuse vertices stay in the lanes; the others go one at a time.
         let (mut shaded, mut kd) = (0u32, [[0.0f32; MAX_LANES]; 3]);
         for i in 0..count {
             let k = c + i;
-            let hit = geometry
-                .slot_prim(w[HIT_SLOT][i].to_bits())
-                .map(|prim| Hit {
-                    t: w[HIT_T][i],
-                    p: Vec3A::new(w[HIT_P][i], w[HIT_P + 1][i], w[HIT_P + 2][i]),
-                    n: Vec3A::new(w[HIT_N][i], w[HIT_N + 1][i], w[HIT_N + 2][i]),
-                    err: w[HIT_ERR][i],
-                    err_along: w[HIT_ERR_ALONG][i],
-                    prim,
-                });
+            let hit = geometry.lane_hit(&rows, i);
             let slot = &mut slots[k];
             if let Some(h) = &hit
                 && let Some(phong) = diffuse.at(p, &slot.st, h)
@@ -326,8 +283,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
     let (err, err_along) = (at.err, at.err_along);
     // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block below,
     // each makes values of `L`.
-    let (zero, one, two) = unsafe { (L::splat(0.0), L::splat(1.0), L::splat(2.0)) };
-    let (unit, two_unit) = unsafe { (L::splat(UNIT_ROUNDOFF), L::splat(2.0 * UNIT_ROUNDOFF)) };
+    let (zero, one) = unsafe { (L::splat(0.0), L::splat(1.0)) };
     let live = unsafe { mask::<L>(shaded) };
     // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal), and
     // `Origins::new`: the point moved off the surface by its error's projection on the
@@ -339,24 +295,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
         L::select(flip, -nh[1], nh[1]),
         L::select(flip, -nh[2], nh[2]),
     ];
-    let n_sum = (nh[0].abs() + nh[1].abs()) + nh[2].abs();
-    let off = n_sum * err + two_unit * abs_max(p_);
-    let front = [
-        p_[0] + off * nh[0],
-        p_[1] + off * nh[1],
-        p_[2] + off * nh[2],
-    ];
-    let back = [
-        p_[0] - off * nh[0],
-        p_[1] - off * nh[1],
-        p_[2] - off * nh[2],
-    ];
-    let widest = [
-        front[0].abs().max(back[0].abs()),
-        front[1].abs().max(back[1].abs()),
-        front[2].abs().max(back[2].abs()),
-    ];
-    let o_err = err + off + two * err_along + unit * abs_max(widest);
+    let (front, back, o_err) = origins(p_, nh, err, err_along);
     // `Phong::brdf` of a diffuse surface: `kd / pi` where both directions are above it.
     let inv_pi = unsafe { L::splat(1.0 / PI) };
     let f = [kd_l[0] * inv_pi, kd_l[1] * inv_pi, kd_l[2] * inv_pi];
@@ -668,28 +607,7 @@ unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Sur
             }
         }
         seen = lit & !blocked;
-        let rays = L::bitmask(lit);
-        tr.stats.shadow += rays.count_ones() as u64;
-        if let Some(audit) = tr.audit {
-            let (o, wi, o_err, t_max) = (
-                [array(o[0]), array(o[1]), array(o[2])],
-                [array(wi[0]), array(wi[1]), array(wi[2])],
-                array(o_err),
-                array(t_max),
-            );
-            let mut bits = rays;
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let ray = Ray {
-                    o: Vec3A::new(o[0][i], o[1][i], o[2][i]),
-                    d: Vec3A::new(wi[0][i], wi[1][i], wi[2][i]),
-                    t_max: t_max[i],
-                    o_err: o_err[i],
-                };
-                audit(&ray, RayKind::Shadow);
-            }
-        }
+        tr.count_shadow_lanes((o, wi, o_err, t_max), L::bitmask(lit));
     }
     // `L_i r(wi, wo)` with `r = brdf max(cos, 0)` (the BRDF zero where `wo` is below), where
     // the light is seen.

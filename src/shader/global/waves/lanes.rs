@@ -20,9 +20,9 @@
 
 use super::{LightLanes, Scratch, point_sums};
 use crate::accel::Tally;
-use crate::accel::lanes::{RayLanes, abs_max, dot};
+use crate::accel::lanes::{RayLanes, array, dot, origins};
 use crate::accel::{Floats, Isa, MAX_LANES};
-use crate::geometry::{Hit, Origins, Ray, UNIT_ROUNDOFF};
+use crate::geometry::{Hit, Origins, Ray};
 use crate::light::NO_LIGHT;
 use crate::material::{Material, Model, Phong};
 use crate::shader::Tracer;
@@ -247,14 +247,6 @@ const ERR: usize = 17;
 const ERR_ALONG: usize = 18;
 const ROWS: usize = 19;
 
-/// The lanes of a vector as an array.
-#[inline(always)]
-fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
-    let mut a = [0.0f32; MAX_LANES];
-    x.write_to(&mut a);
-    a
-}
-
 /// Trace and shade the queue's rays from `k` on, `L::LANES` of them at most, at depth `depth`:
 /// their nodes' sums into `s.nodes`, bounces into `s.queue`, children into `s.next`. Returns
 /// how many rays it took. No closures that compute in lanes, so that this inlines whole into
@@ -274,7 +266,6 @@ unsafe fn chunk<L: Floats>(
     // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block below,
     // each makes values of `L`.
     let (zero, two) = unsafe { (L::splat(0.0), L::splat(2.0)) };
-    let (unit, two_unit) = unsafe { (L::splat(UNIT_ROUNDOFF), L::splat(2.0 * UNIT_ROUNDOFF)) };
     let end = depth >= g.max_depth || !tr.effects.indirect;
     let q = &s.queue;
     let count = (q.len - k).min(L::LANES);
@@ -305,16 +296,7 @@ unsafe fn chunk<L: Floats>(
         L::select(flip, -nh[1], nh[1]),
         L::select(flip, -nh[2], nh[2]),
     ];
-    let n_sum = (nh[0].abs() + nh[1].abs()) + nh[2].abs();
-    let off = n_sum * hit.err + two_unit * abs_max(p);
-    let front = [p[0] + off * nh[0], p[1] + off * nh[1], p[2] + off * nh[2]];
-    let back = [p[0] - off * nh[0], p[1] - off * nh[1], p[2] - off * nh[2]];
-    let widest = [
-        front[0].abs().max(back[0].abs()),
-        front[1].abs().max(back[1].abs()),
-        front[2].abs().max(back[2].abs()),
-    ];
-    let o_err = hit.err + off + two * hit.err_along + unit * abs_max(widest);
+    let (front, back, o_err) = origins(p, nh, hit.err, hit.err_along);
     // The tree's bookkeeping, lane by lane (`shade`): misses end at the background; a chain's
     // ray adds what its surface emits; Phong hits gather their weights and `kd`; the rest
     // (mirror and glass, emitters) wait for their whole interaction below.
