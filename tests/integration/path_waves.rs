@@ -85,6 +85,15 @@ fn waves_give_the_one_ray_pixels() {
             }
         }
     }
+    // The Course model: every point light at every vertex, the course's reflectance, the
+    // indirect weights over (2 pi)^2.
+    for sampling in ["Brdf", "Cosine"] {
+        for depth in ["rr_depth: 1", "max_depth: 3, rr_depth: 2"] {
+            let shader = format!("Path({depth}, sampling: {sampling})");
+            let text = room(&shader, "").replace("model: Physical", "model: Course");
+            agrees(&rtis::extract(&scene(&text)), &format!("{shader}, Course"));
+        }
+    }
     // Effects that end paths at their first vertex, or skip the shadow rays.
     for effects in [
         "indirect: false",
@@ -99,8 +108,8 @@ fn waves_give_the_one_ray_pixels() {
     }
 }
 
-/// The waves are for the scenes whose vertices the lanes shade: not under the Course model or
-/// with uniform sampling, not with a light other than point lights (spot, directional, an
+/// The waves are for the scenes whose vertices the lanes shade: not with uniform sampling (under
+/// either model), not with a light other than point lights (spot, directional, an
 /// emitting shape, the environment), a texture, or a BVH; each alone keeps them off.
 #[test]
 fn waves_apply_only_where_the_lanes_shade() {
@@ -115,11 +124,11 @@ fn waves_apply_only_where_the_lanes_shade() {
         rtis::extract(&scene(&text))
     };
     for (what, text) in [
-        (
-            "the Course model",
-            room(path, "").replace("model: Physical", "model: Course"),
-        ),
         ("uniform sampling", room("Path(sampling: Uniform)", "")),
+        (
+            "uniform sampling, Course",
+            room("Path(sampling: Uniform)", "").replace("model: Physical", "model: Course"),
+        ),
     ] {
         assert!(!waves::applies(&rtis::extract(&scene(&text))), "{what}");
     }

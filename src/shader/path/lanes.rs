@@ -1,5 +1,5 @@
 //! Path's diffuse vertices shaded in SIMD lanes: the vertices of a wave of paths
-//! (`render::waves`) that meet a diffuse Phong surface (no specular lobe) under the Physical
+//! (`render::waves`) that meet a diffuse Phong surface (no specular lobe) under either model
 //! model, a path per lane, from the hit to the next ray: the interaction, next-event estimation
 //! over point lights with the shadow rays tested in lanes ([`Geometry::occluded_lanes`]), the
 //! cosine-weighted direction, its weight, and Russian roulette.
@@ -35,12 +35,12 @@ pub struct PathSlot<R> {
     pub rec: R,
 }
 
-/// True if `p`'s vertices can be shaded in lanes in `tr`'s scene: the Physical model, BRDF or
-/// cosine sampling, point lights only (no emitter, no environment, no spot or directional
-/// light; every one per vertex, or one chosen by power or by importance), no textures.
+/// True if `p`'s vertices can be shaded in lanes in `tr`'s scene: BRDF or cosine sampling (under
+/// either model), point lights only (no emitter, no environment, no spot or directional light;
+/// every one per vertex, or under the Physical model one chosen by power or by importance), no
+/// textures.
 pub fn applies(tr: &Tracer, p: &Path) -> bool {
-    tr.model == Model::Physical
-        && matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
+    matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
         && tr.emitters.is_empty()
         && tr.textures.is_empty()
         && tr.lights.iter().all(|l| matches!(l, Light::Point(_)))
@@ -296,10 +296,18 @@ unsafe fn shade_in<L: Floats, R: Record>(
         L::select(flip, -nh[2], nh[2]),
     ];
     let (front, back, o_err) = origins(p_, nh, err, err_along);
-    // `Phong::brdf` of a diffuse surface: `kd / pi` where both directions are above it.
+    // The reflectance is `f max(cos, 0)` where `wo` is above the surface: `Phong::brdf` of a
+    // diffuse surface, `kd / pi`, under the Physical model; the course's `kd`, whatever `wo`,
+    // under the Course model (`Phong::course_reflectance`).
+    let course = tr.model == Model::Course;
     let inv_pi = unsafe { L::splat(1.0 / PI) };
-    let f = [kd_l[0] * inv_pi, kd_l[1] * inv_pi, kd_l[2] * inv_pi];
-    let wo_above = dot(wo, n).cmpgt(zero);
+    let (f, wo_above) = match course {
+        true => (kd_l, zero.cmpge(zero)),
+        false => (
+            [kd_l[0] * inv_pi, kd_l[1] * inv_pi, kd_l[2] * inv_pi],
+            dot(wo, n).cmpgt(zero),
+        ),
+    };
     let surface = Surface {
         p: p_,
         nh,
@@ -314,7 +322,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
     // Next-event estimation: every point light's term, or one light's, chosen by power or by
     // importance (`one_light`).
     let by_importance = p.lights_per_vertex == LightsPerVertex::Importance;
-    let nee = if p.lights_per_vertex != LightsPerVertex::All {
+    let nee = if p.one_light_under(tr.model) {
         // The choice, lane by lane: `u` picks the light (by importance: `u`'s place within
         // the point lights' share, with the point and normal of the lane's vertex);
         // `one_light` draws two more numbers for an area light's point, which a point light
@@ -468,12 +476,20 @@ unsafe fn shade_in<L: Floats, R: Record>(
         false => cos_i.max(zero) * unsafe { L::splat(FRAC_1_PI) },
     };
     let ok = above & pdf.cmpgt(zero);
-    // `reflectance`: `brdf(wi, wo) max(cos, 0)`, zero where `wo` is not above the surface.
+    // `g`: the reflectance, `f max(cos, 0)` (zero where `wo` is not above the surface), over
+    // `(2 pi)^2` under the Course model (`sample_phong`).
     let g = [
         L::select(wo_above, f[0], zero) * cos_i.max(zero),
         L::select(wo_above, f[1], zero) * cos_i.max(zero),
         L::select(wo_above, f[2], zero) * cos_i.max(zero),
     ];
+    let g = match course {
+        true => {
+            let tt = unsafe { L::splat(TAU * TAU) };
+            [g[0] / tt, g[1] / tt, g[2] / tt]
+        }
+        false => g,
+    };
     let carries = g[0].cmpne(zero) | g[1].cmpne(zero) | g[2].cmpne(zero);
     let go = L::bitmask(ok & carries);
     let beta = [
