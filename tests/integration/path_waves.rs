@@ -87,11 +87,19 @@ fn waves_give_the_one_ray_pixels() {
     }
     // The Course model: every point light at every vertex, the course's reflectance, the
     // indirect weights over (2 pi)^2.
-    for sampling in ["Brdf", "Cosine"] {
-        for depth in ["rr_depth: 1", "max_depth: 3, rr_depth: 2"] {
-            let shader = format!("Path({depth}, sampling: {sampling})");
-            let text = room(&shader, "").replace("model: Physical", "model: Course");
-            agrees(&rtis::extract(&scene(&text)), &format!("{shader}, Course"));
+    // (`lights_per_vertex` is the Physical model's: the Course model sums every light.)
+    for per_vertex in ["One", "All", "Importance"] {
+        for sampling in ["Brdf", "Cosine"] {
+            for depth in ["rr_depth: 1", "max_depth: 3, rr_depth: 2"] {
+                let shader =
+                    format!("Path({depth}, sampling: {sampling}, lights_per_vertex: {per_vertex})");
+                let text = room(&shader, "").replace("model: Physical", "model: Course");
+                let what = format!("{shader}, Course");
+                agrees(&rtis::extract(&scene(&text)), &what);
+                let mut s = rtis::extract(&scene(&text));
+                common::lights_out_of_room(&mut s);
+                agrees(&s, &format!("{what}, lights out of the room"));
+            }
         }
     }
     // Effects that end paths at their first vertex, or skip the shadow rays.

@@ -1,11 +1,12 @@
 //! Path's diffuse vertices shaded in SIMD lanes: the vertices of a wave of paths
-//! (`render::waves`) that meet a diffuse Phong surface (no specular lobe) under either model
-//! model, a path per lane, from the hit to the next ray: the interaction, next-event estimation
+//! (`render::waves`) that meet a diffuse Phong surface (no specular lobe), under either model,
+//! a path per lane, from the hit to the next ray: the interaction, next-event estimation
 //! over point lights with the shadow rays tested in lanes ([`Geometry::occluded_lanes`]), the
 //! cosine-weighted direction, its weight, and Russian roulette.
 //!
 //! Every lane computes what [`super::step`] computes for its path, operation for operation
-//! (`Interaction::new`, `Origins`, `PointLight::incident`, `Phong::brdf`, `reflectance`,
+//! (`Interaction::new`, `Origins`, `PointLight::incident`, `Phong::brdf` and
+//! `Phong::course_reflectance`, `reflectance`,
 //! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
 //! draws its random numbers from its own stream in the same order (the draws, the light choice
 //! and `sin_cos` run lane by lane), so each path adds the same contributions and goes on with the
@@ -551,8 +552,9 @@ impl Iterator for Bits {
 }
 
 /// What the light terms read of a chunk's vertices: the hit points, geometric and shading
-/// normals, the two origins and their error bound, the BRDF `kd / pi`, the lanes where `wo`
-/// is above the surface, and the lanes shaded.
+/// normals, the two origins and their error bound, the reflectance's factor `f` (the BRDF
+/// `kd / pi` under the Physical model, the course's `kd`), the lanes where `wo` counts as
+/// above the surface (all of them under the Course model), and the lanes shaded.
 struct Surface<L: Floats> {
     p: [L; 3],
     nh: [L; 3],
@@ -625,8 +627,8 @@ unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Sur
         seen = lit & !blocked;
         tr.count_shadow_lanes((o, wi, o_err, t_max), L::bitmask(lit));
     }
-    // `L_i r(wi, wo)` with `r = brdf max(cos, 0)` (the BRDF zero where `wo` is below), where
-    // the light is seen.
+    // `L_i r(wi, wo)` with `r = f max(cos, 0)` (the BRDF, or the course's reflectance; zero
+    // where `wo` is below under the Physical model), where the light is seen.
     let r = [
         L::select(at.wo_above, f[0], zero) * cos.max(zero),
         L::select(at.wo_above, f[1], zero) * cos.max(zero),
