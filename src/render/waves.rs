@@ -30,9 +30,8 @@ pub fn applies(scene: &RenderScene) -> bool {
     let Shader::Path(p) = &scene.shader else {
         return false;
     };
-    let mut stats = RayStats::default();
-    let tr = scene.tracer(Sampler::new(0, 0, 0), &mut stats);
-    tr.geometry.bvh.is_empty() && lanes::applies(&tr, p)
+    scene.geometry.bvh.is_empty()
+        && lanes::applies(p, &scene.lights, &scene.emitters, &scene.textures)
 }
 
 /// The exact sum of the samples `samples` of pixel `(col, row)` under the path tracer `p`,

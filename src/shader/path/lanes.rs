@@ -16,13 +16,14 @@ use super::{Path, PathState};
 use crate::accel::lanes::{RayLanes, array, dot, origins};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
-use crate::light::{Chosen, Light, choose_by_importance};
+use crate::light::{Chosen, Emitters, Light, choose_by_importance};
 use crate::material::{Material, Model, Phong};
 use crate::sampling::{LightsPerVertex, Sampler, Sampling};
 use crate::shader::Tracer;
 use crate::shader::record::{Record, Technique};
 use crate::shader::surface::{SHADOW_END, diffuse_probability};
 use crate::stats::RayKind;
+use crate::texture::MaterialTextures;
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
@@ -36,15 +37,20 @@ pub struct PathSlot<R> {
     pub rec: R,
 }
 
-/// True if `p`'s vertices can be shaded in lanes in `tr`'s scene: BRDF or cosine sampling (under
-/// either model), point lights only (no emitter, no environment, no spot or directional light;
-/// every one per vertex, or under the Physical model one chosen by power or by importance), no
-/// textures.
-pub fn applies(tr: &Tracer, p: &Path) -> bool {
+/// True if `p`'s vertices can be shaded in lanes in a scene of these lights, emitters and
+/// textures: BRDF or cosine sampling (under either model), point lights only (no emitter, no
+/// environment, no spot or directional light; every one per vertex, or under the Physical
+/// model one chosen by power or by importance), no textures.
+pub fn applies(
+    p: &Path,
+    lights: &[Light],
+    emitters: &Emitters,
+    textures: &[MaterialTextures],
+) -> bool {
     matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
-        && tr.emitters.is_empty()
-        && tr.textures.is_empty()
-        && tr.lights.iter().all(|l| matches!(l, Light::Point(_)))
+        && emitters.is_empty()
+        && textures.is_empty()
+        && lights.iter().all(|l| matches!(l, Light::Point(_)))
 }
 
 /// Each primitive's diffuse Phong material, where the lanes shade its vertices: it reflects
