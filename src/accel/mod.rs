@@ -4,6 +4,7 @@
 mod batch;
 pub mod block;
 mod bvh;
+pub mod few;
 pub mod lanes;
 mod prim;
 mod simd;
@@ -136,6 +137,8 @@ pub struct Geometry {
     /// True if the BVH holds triangles: its rays then need the watertight test's shear
     /// constants.
     pub has_triangles: bool,
+    /// A small scene's triangles, for batches of rays in lanes ([`few`]).
+    pub few: few::Few,
 }
 
 impl Geometry {
@@ -308,7 +311,9 @@ impl Geometry {
         let plane_items = append(&mut others, slots, planes);
         let spheres = lanes::pack(&sphere_items, SphereLanes::pack);
         let planes = lanes::pack(&plane_items, PlaneLanes::pack);
+        let few = few::Few::of(&blocks, in_bvh, sphere_items.len() + plane_items.len());
         Geometry {
+            few,
             others,
             in_bvh,
             bvh,
@@ -412,6 +417,24 @@ impl Geometry {
                 }
             }
             None => self.others[block.other_index(lane as u32)],
+        }
+    }
+
+    /// What shades primitive `index` (as [`Geometry::prim`] gives it, without its shape): its
+    /// material, whether it is a smooth triangle (with vertex normals), and its area light.
+    #[inline]
+    pub fn shading_of(&self, index: u32) -> (u32, bool, u32) {
+        let i = index as usize;
+        let other = |p: &Prim| (p.material, p.smooth != FLAT, p.light);
+        if i >= self.attrs.len() {
+            return other(&self.others[i - self.attrs.len()]);
+        }
+        let (block, lane) = (&self.blocks[i / 4], i % 4);
+        if block.has_triangle(lane) {
+            let a = self.attrs[i];
+            (a.material & !SMOOTH, a.material & SMOOTH != 0, a.light)
+        } else {
+            other(&self.others[block.other_index(lane as u32)])
         }
     }
 

@@ -290,9 +290,20 @@ pub fn render_until(
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
 ) -> Rendered {
-    let t = by_tiles(scene, on_tile, stop, |col, row, stats| {
-        render_pixel(scene, col, row, stats)
-    });
+    let t = match &scene.shader {
+        // The paths of a tile's pixels in waves.
+        Shader::Path(p) if waves::applies(scene) => {
+            let tile = |pixels: &[(u32, u32)], stats: &mut RayStats, _: &mut ()| {
+                let (spp, mut sums) = (scene.film.spp, vec![RgbSum::default(); pixels.len()]);
+                waves::sums(scene, pixels, 0..spp, p, stats, &mut sums);
+                sums.iter().map(|s| s.mean(spp as u64)).collect()
+            };
+            by_tile_pixels(scene, on_tile, stop, tile, |()| {})
+        }
+        _ => by_tiles(scene, on_tile, stop, |col, row, stats| {
+            render_pixel(scene, col, row, stats)
+        }),
+    };
     Rendered {
         image: Image {
             width: scene.film.width,
@@ -325,6 +336,17 @@ pub fn render_pass(
         samples.end,
         scene.film.spp
     );
+    if let Shader::Path(p) = &scene.shader
+        && waves::applies(scene)
+    {
+        // The paths of a tile's pixels in waves.
+        let tile = |pixels: &[(u32, u32)], stats: &mut RayStats, _: &mut ()| {
+            let mut sums = vec![RgbSum::default(); pixels.len()];
+            waves::sums(scene, pixels, samples.clone(), p, stats, &mut sums);
+            sums
+        };
+        return by_tile_pixels(scene, on_tile, stop, tile, |()| {});
+    }
     by_tiles(scene, on_tile, stop, |col, row, stats| {
         pixel_sum(scene, col, row, samples.clone(), stats)
     })
@@ -371,6 +393,24 @@ fn by_tiles_with<T: Clone + Default + Send, S: Default + Send>(
     pixel: impl Fn(u32, u32, &mut RayStats, &mut S) -> T + Sync,
     finished: impl Fn(S) + Sync,
 ) -> Tiled<T> {
+    let tile = |pixels: &[(u32, u32)], stats: &mut RayStats, state: &mut S| {
+        pixels
+            .iter()
+            .map(|&(col, row)| pixel(col, row, stats, state))
+            .collect()
+    };
+    by_tile_pixels(scene, on_tile, stop, tile, finished)
+}
+
+/// [`by_tiles_with`] with a function of all of a tile's pixels (in rows, top to bottom) that
+/// gives their values in that order.
+fn by_tile_pixels<T: Clone + Default + Send, S: Default + Send>(
+    scene: &RenderScene,
+    on_tile: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+    tile: impl Fn(&[(u32, u32)], &mut RayStats, &mut S) -> Vec<T> + Sync,
+    finished: impl Fn(S) + Sync,
+) -> Tiled<T> {
     let start = Instant::now();
     let (w, h) = (scene.film.width, scene.film.height);
     let tiles_x = w.div_ceil(TILE);
@@ -385,12 +425,13 @@ fn by_tiles_with<T: Clone + Default + Send, S: Default + Send>(
             }
             let mut stats = RayStats::default();
             let mut state = S::default();
-            let mut px = Vec::with_capacity((TILE * TILE) as usize);
+            let mut pixels = Vec::with_capacity((TILE * TILE) as usize);
             for row in y0..(y0 + TILE).min(h) {
                 for col in x0..(x0 + TILE).min(w) {
-                    px.push(pixel(col, row, &mut stats, &mut state));
+                    pixels.push((col, row));
                 }
             }
+            let px = tile(&pixels, &mut stats, &mut state);
             finished(state);
             on_tile();
             Some((px, stats))

@@ -30,7 +30,7 @@ pub fn applies(scene: &RenderScene) -> bool {
     let Shader::Path(p) = &scene.shader else {
         return false;
     };
-    scene.geometry.bvh.is_empty()
+    (scene.geometry.bvh.is_empty() || scene.geometry.few())
         && lanes::applies(p, &scene.lights, &scene.emitters, &scene.textures)
 }
 
@@ -45,15 +45,47 @@ pub fn pixel_sum(
     stats: &mut RayStats,
 ) -> RgbSum {
     let mut sum = RgbSum::default();
-    let mut next = samples.start;
+    sums(
+        scene,
+        &[(col, row)],
+        samples,
+        p,
+        stats,
+        std::slice::from_mut(&mut sum),
+    );
+    sum
+}
+
+/// The exact sums of the samples `samples` of each pixel `(col, row)` of `pixels` into `out`
+/// (one per pixel, added to) under the path tracer `p`, traced in waves: the wave takes the
+/// pixels' samples in order, a pixel's after another's, so that it stays full until the last
+/// pixel's samples (a pixel's sum is exact, whatever the order of its samples).
+pub fn sums(
+    scene: &RenderScene,
+    pixels: &[(u32, u32)],
+    samples: std::ops::Range<u32>,
+    p: &Path,
+    stats: &mut RayStats,
+    out: &mut [RgbSum],
+) {
+    assert_eq!(pixels.len(), out.len(), "a sum per pixel");
+    // The next sample to start: its pixel's place in `pixels`, and its index.
+    let (mut pixel, mut next) = (0, samples.start);
+    // The paths in flight and each one's pixel.
     let mut slots: Vec<PathSlot<SampleSum>> = Vec::with_capacity(WAVE);
+    let mut of = Vec::with_capacity(WAVE);
     let mut alive = Vec::new();
     // One tracer for the wave; a path shaded one ray at a time gets its stream swapped in.
     let mut tr = scene.tracer(Sampler::new(0, 0, 0), stats);
     let diffuse = lanes::Diffuse::table(&tr);
     loop {
-        // Free slots take the pixel's next samples, their camera rays first.
-        while slots.len() < WAVE && next < samples.end {
+        // Free slots take the next samples, their camera rays first.
+        while slots.len() < WAVE && pixel < pixels.len() {
+            if next >= samples.end {
+                (pixel, next) = (pixel + 1, samples.start);
+                continue;
+            }
+            let (col, row) = pixels[pixel];
             let (ray, sampler) = camera_ray(scene, col, row, next);
             next += 1;
             tr.count(&ray, RayKind::Camera);
@@ -62,15 +94,17 @@ pub fn pixel_sum(
                 sampler,
                 rec: SampleSum::default(),
             });
+            of.push(pixel);
         }
         if slots.is_empty() {
-            return sum;
+            return;
         }
         // The round: each path's ray traced and its vertex shaded.
         alive.clear();
         alive.resize(slots.len(), false);
         lanes::round(&mut tr, p, &diffuse, &mut slots, &mut alive);
-        // The paths that ended give their sums to the pixel and their slots to new samples.
+        // The paths that ended give their sums to their pixels and their slots to new
+        // samples.
         let mut k = 0;
         while k < slots.len() {
             if alive[k] {
@@ -78,7 +112,7 @@ pub fn pixel_sum(
             } else {
                 let done = slots.swap_remove(k);
                 alive.swap_remove(k);
-                done.rec.keep_into(&mut sum, tr.stats);
+                done.rec.keep_into(&mut out[of.swap_remove(k)], tr.stats);
             }
         }
     }

@@ -7,7 +7,7 @@ use super::Tracer;
 use crate::effects::Effects;
 use crate::geometry::{Frame, Hit, Origins, Ray};
 use crate::light::{
-    AreaLight, Chosen, EnvironmentLight, Incident, Light, LightSample, NO_LIGHT,
+    AreaLight, Chosen, Emitters, EnvironmentLight, Incident, Light, LightSample, NO_LIGHT,
     choose_by_importance,
 };
 use crate::material::{Bsdf, Material, Model, Phong, reflect};
@@ -78,6 +78,26 @@ impl<'a> Interaction<'a> {
             bent,
             origins: Origins::new(&hit),
             light: prim.light,
+        }
+    }
+
+    /// The interaction of a ray of direction `d` with its nearest hit, `hit`, on a flat
+    /// primitive of untextured `material` that emits nothing: what [`Interaction::new`] makes
+    /// there (its shading normal the geometric one on the viewer's side), without looking the
+    /// primitive up.
+    #[inline]
+    pub fn flat(hit: Hit, d: Vec3A, material: &'a Material) -> Self {
+        let wo = -d;
+        let n = if hit.n.dot(wo) < 0.0 { -hit.n } else { hit.n };
+        Interaction {
+            hit,
+            wo,
+            n,
+            material,
+            textured: None,
+            bent: false,
+            origins: Origins::new(&hit),
+            light: NO_LIGHT,
         }
     }
 
@@ -535,12 +555,24 @@ fn area_sample<L: Lobe>(
     (u1, u2): (f32, f32),
     mis: Option<Sampling>,
 ) -> Vec3A {
-    let Some(mut ls) = light.sample(si.hit.p, u1, u2) else {
+    let Some(ls) = sample_area_light(tr.emitters, light, si.hit.p, (u1, u2)) else {
         return Vec3A::ZERO;
     };
-    // A textured light's radiance at the sampled point (its finest texels).
-    ls.le = tr.emitters.textured(light, ls.le, ls.uv, 0.0);
     light_term(tr, si, lobe, &ls, pmf, mis)
+}
+
+/// A sample of area light `light` (of `emitters`) seen from `p`, from the random numbers `u`,
+/// with a textured light's radiance at the sampled point (its finest texels).
+#[inline]
+pub fn sample_area_light(
+    emitters: &Emitters,
+    light: &AreaLight,
+    p: Vec3A,
+    (u1, u2): (f32, f32),
+) -> Option<LightSample> {
+    let mut ls = light.sample(p, u1, u2)?;
+    ls.le = emitters.textured(light, ls.le, ls.uv, 0.0);
+    Some(ls)
 }
 
 /// One sample of the environment light `env`, chosen with probability `pmf`, from two more
@@ -573,25 +605,56 @@ fn light_term<L: Lobe>(
     pmf: f32,
     mis: Option<Sampling>,
 ) -> Vec3A {
-    if ls.le == Vec3A::ZERO || (!lobe.transmits() && ls.wi.dot(si.n) <= 0.0) || si.leaks(ls.wi) {
+    let Some((shadow, pdf)) = light_ray(si, lobe, ls, pmf) else {
         return Vec3A::ZERO;
+    };
+    // Shadow ray V: stop just short of the sampled point.
+    let visible = !tr.effects.shadows || tr.unoccluded(&shadow);
+    if !visible {
+        return Vec3A::ZERO;
+    }
+    light_weighted(tr.model, (si.wo, si.n), lobe, (ls.wi, ls.le, pdf), mis)
+}
+
+/// The first half of [`light_term`]: the shadow ray of light sample `ls` (chosen with
+/// probability `pmf`), which stops just short of the sampled point, and the sample's density
+/// `pmf pdf`; `None` where the term is zero whatever the ray meets (no radiance, a direction
+/// below a surface that does not transmit, no density).
+#[inline]
+pub fn light_ray<L: Lobe>(
+    si: &Interaction,
+    lobe: &L,
+    ls: &LightSample,
+    pmf: f32,
+) -> Option<(Ray, f32)> {
+    if ls.le == Vec3A::ZERO || (!lobe.transmits() && ls.wi.dot(si.n) <= 0.0) || si.leaks(ls.wi) {
+        return None;
     }
     let pdf = pmf * ls.pdf;
     // A density of zero (or NaN) cannot weigh a sample.
     if pdf.is_nan() || pdf <= 0.0 {
-        return Vec3A::ZERO;
+        return None;
     }
-    // Shadow ray V: stop just short of the sampled point.
-    let visible =
-        !tr.effects.shadows || tr.unoccluded(&si.origins.ray(ls.wi, ls.dist * SHADOW_END));
-    if !visible {
-        return Vec3A::ZERO;
-    }
+    Some((si.origins.ray(ls.wi, ls.dist * SHADOW_END), pdf))
+}
+
+/// The second half of [`light_term`], for a sample whose shadow ray met nothing, at a vertex
+/// seen from `wo` with shading normal `n`: `L_e r w / pdf` for the sample's direction `wi`,
+/// radiance `le` and density `pdf` ([`light_ray`]'s), `w` the power heuristic's weight against
+/// BRDF sampling under `mis` (else 1).
+#[inline]
+pub fn light_weighted<L: Lobe>(
+    model: Model,
+    (wo, n): (Vec3A, Vec3A),
+    lobe: &L,
+    (wi, le, pdf): (Vec3A, Vec3A, f32),
+    mis: Option<Sampling>,
+) -> Vec3A {
     let w = match mis {
-        Some(sampling) => power_heuristic(pdf, lobe.pdf(si.wo, si.n, ls.wi, sampling)),
+        Some(sampling) => power_heuristic(pdf, lobe.pdf(wo, n, wi, sampling)),
         None => 1.0,
     };
-    ls.le * lobe.reflectance(tr.model, ls.wi, si.wo, si.n) * (w / pdf)
+    le * lobe.reflectance(model, wi, wo, n) * (w / pdf)
 }
 
 /// Probability of picking the diffuse lobe in BRDF sampling: the lobes' share of `kd + ks`.

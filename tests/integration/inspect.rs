@@ -208,7 +208,8 @@ fn groups_of_camera_rays_add_what_each_sample_alone_adds() {
             "width: 128, height: 128, spp: 64",
             "width: 9, height: 7, spp: 19",
         )
-        .replace("sampling: Brdf)", "sampling: Brdf, lights: Mis)");
+        // (Uniform sampling here too: not in waves.)
+        .replace("sampling: Brdf)", "sampling: Uniform, lights: Mis)");
     let boxed = std::fs::read_to_string(dir.join("cornell-physical.ron"))
         .unwrap()
         .replace(

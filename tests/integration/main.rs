@@ -19,6 +19,7 @@ mod cpu_dispatch;
 mod effects;
 mod environment;
 mod estimate;
+mod few;
 mod global_waves;
 mod global_weights;
 mod golden;

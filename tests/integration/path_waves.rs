@@ -9,6 +9,7 @@
 use crate::common::{self, scene};
 use rtis::render::exact::RgbSum;
 use rtis::render::{pixel_sum, render_sample, waves};
+use rtis::shader::Shader;
 use rtis::stats::RayStats;
 
 /// A small room of planes and spheres (no BVH) with two point lights, under `shader`.
@@ -31,6 +32,42 @@ fn room(shader: &str, effects: &str) -> String {
     )
 }
 
+/// [`room`] with an emitting sphere under the ceiling too (an area light among the packed
+/// primitives).
+fn lit_room(shader: &str, effects: &str) -> String {
+    room(shader, effects).replace(
+        "(light: Point(position: (0.5, 1.0, 1.0)",
+        "(shape: Sphere(center: (-0.2, 1.1, 0.4), radius: 0.15), material: Phong(kd: (0.5, 0.5, 0.5)), emitter: Emitter(radiance: (6, 5, 4))),
+            (light: Point(position: (0.5, 1.0, 1.0)",
+    )
+}
+
+/// Mitsuba's Cornell box (scenes/mitsuba-cornell.ron: 36 triangles, whose rays go in lanes,
+/// and a rectangle light) on a small film, under `shader`, with a point light too if `point`.
+fn triangle_box(shader: &str, effects: &str, point: bool) -> String {
+    let text = std::fs::read_to_string(common::scenes_dir().join("mitsuba-cornell.ron")).unwrap();
+    let mut text = text
+        .replace(
+            "film: (width: 128, height: 128, spp: 64)",
+            "film: (width: 6, height: 5, spp: 150)",
+        )
+        .replace(
+            "shader: Path(rr_depth: 5, sampling: Brdf)",
+            &format!("shader: {shader}, effects: ({effects})"),
+        );
+    if point {
+        text = text.replace(
+            "entities: [",
+            "entities: [\n        (light: Point(position: (0.3, 0.5, 0.2), intensity: (0.6, 0.5, 0.4))),",
+        );
+    }
+    assert!(
+        text.contains(shader) && text.contains("spp: 150"),
+        "mitsuba-cornell.ron changed"
+    );
+    text
+}
+
 /// Each pixel's sum in waves against its samples' one-ray sums, and the ray counts, in every
 /// instruction set this CPU runs (the lanes' widths: 4, 8, 16); a few pixels with more samples
 /// than a wave holds, so that the slots of ended paths take new samples.
@@ -43,6 +80,8 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
         let s = &s;
         assert!(s.film.spp as usize > 2 * waves::WAVE);
         let (mut waved, mut alone) = (RayStats::default(), RayStats::default());
+        let mut pixels = Vec::new();
+        let mut first = Vec::new();
         for row in 0..s.film.height {
             for col in 0..s.film.width {
                 let mut ranges = vec![0..21, 5..17];
@@ -52,18 +91,29 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
                 for samples in ranges {
                     let got = pixel_sum(s, col, row, samples.clone(), &mut waved);
                     let mut want = RgbSum::default();
-                    for k in samples {
+                    for k in samples.clone() {
                         want += render_sample(s, col, row, k, &mut alone);
                     }
                     assert_eq!(got, want, "{what} ({isa:?}): pixel {col},{row}");
+                    if samples == (0..21) {
+                        pixels.push((col, row));
+                        first.push(want);
+                    }
                 }
             }
         }
         assert_eq!(waved, alone, "{what} ({isa:?}): ray counts");
-        assert!(
-            alone.shadow > 0 || what.contains("shadows: false"),
-            "{what}"
-        );
+        // The pixels together, as a tile's: a wave of the samples of one pixel after another.
+        let Shader::Path(p) = &s.shader else {
+            panic!("{what}: the waves are the path tracer's")
+        };
+        let (mut tiled, mut sums) = (RayStats::default(), vec![RgbSum::default(); pixels.len()]);
+        waves::sums(s, &pixels, 0..21, p, &mut tiled, &mut sums);
+        assert_eq!(sums, first, "{what} ({isa:?}): a tile's pixels");
+        // (Without point lights, BRDF sampling alone traces no shadow ray.)
+        let no_shadows = what.contains("shadows: false")
+            || (what.contains("lights: Brdf") && what.contains("point light false"));
+        assert!(alone.shadow > 0 || no_shadows, "{what}");
     }
 }
 
@@ -116,9 +166,55 @@ fn waves_give_the_one_ray_pixels() {
     }
 }
 
+/// Area lights in the waves: an emitting sphere among packed primitives, and a rectangle light
+/// in a small scene of triangles (whose rays go in lanes), with point lights or without, over
+/// the strategies (light sampling, BRDF sampling, MIS; one light by power or by importance, or
+/// all), both samplings, both models, and the effects that skip work.
+#[test]
+fn waves_give_the_one_ray_pixels_with_area_lights() {
+    let _limit = common::deadline(240);
+    for lights in ["Mis", "Light", "Brdf"] {
+        for per_vertex in ["One", "All", "Importance"] {
+            for (sampling, depth) in [
+                ("Brdf", "rr_depth: 1"),
+                ("Cosine", "max_depth: 3, rr_depth: 2"),
+            ] {
+                let shader = format!(
+                    "Path({depth}, sampling: {sampling}, lights: {lights}, lights_per_vertex: {per_vertex})"
+                );
+                agrees(
+                    &rtis::extract(&scene(&lit_room(&shader, ""))),
+                    &format!("{shader}, sphere light"),
+                );
+                for point in [false, true] {
+                    let text = triangle_box(&shader, "", point);
+                    agrees(
+                        &rtis::extract(&scene(&text)),
+                        &format!("{shader}, box, point light {point}"),
+                    );
+                }
+            }
+        }
+    }
+    let shader = "Path(rr_depth: 1, sampling: Brdf, lights: Mis, lights_per_vertex: All)";
+    let course = lit_room(shader, "").replace("model: Physical", "model: Course");
+    agrees(&rtis::extract(&scene(&course)), "sphere light, Course");
+    let course = triangle_box(shader, "", true).replace("model: Physical", "model: Course");
+    agrees(&rtis::extract(&scene(&course)), "box, Course");
+    for effects in ["indirect: false", "shadows: false", "emission: false"] {
+        let shader = "Path(rr_depth: 2, sampling: Brdf, lights: Mis, lights_per_vertex: One)";
+        agrees(&rtis::extract(&scene(&lit_room(shader, effects))), effects);
+        agrees(
+            &rtis::extract(&scene(&triangle_box(shader, effects, true))),
+            effects,
+        );
+    }
+}
+
 /// The waves are for the scenes whose vertices the lanes shade: not with uniform sampling (under
-/// either model), not with a light other than point lights (spot, directional, an
-/// emitting shape, the environment), a texture, or a BVH; each alone keeps them off.
+/// either model), not with a light other than point lights and area lights (spot, directional,
+/// the environment), a texture, or a BVH beyond a small scene's triangles; each alone keeps
+/// them off.
 #[test]
 fn waves_apply_only_where_the_lanes_shade() {
     let path = "Path(sampling: Brdf)";
@@ -143,11 +239,17 @@ fn waves_apply_only_where_the_lanes_shade() {
     for entity in [
         "(light: Spot(position: (-1, 1.2, 1), direction: (0.5, -1, -0.5), intensity: (3, 3, 3)))",
         "(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))",
-        "(shape: Sphere(center: (0, 1.2, 0), radius: 0.1), emitter: Emitter(radiance: (8, 7, 6)))",
         "(light: Environment(radiance: (0.3, 0.35, 0.4)))",
         "(shape: Sphere(center: (1, 1, -1), radius: 0.2), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))",
         "(shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, -0.9, -0.5)], faces: [(0, 1, 2)]), material: Phong(kd: (0.5, 0.5, 0.5)))",
     ] {
         assert!(!waves::applies(&with(entity)), "{entity}");
     }
+    // An emitting shape, and a small scene of triangles, take the waves.
+    let sphere =
+        "(shape: Sphere(center: (0, 1.2, 0), radius: 0.1), emitter: Emitter(radiance: (8, 7, 6)))";
+    assert!(waves::applies(&with(sphere)), "{sphere}");
+    assert!(waves::applies(&rtis::extract(&scene(&triangle_box(
+        path, "", false
+    )))));
 }

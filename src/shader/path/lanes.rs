@@ -13,15 +13,18 @@
 //! same ray, to the bit (`tests/integration/path_waves.rs`).
 
 use super::{Path, PathState};
+use crate::accel::lanes::SurfaceLanes;
 use crate::accel::lanes::{RayLanes, array, dot, origins};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
-use crate::light::{Chosen, Emitters, Light, choose_by_importance};
+use crate::light::{AreaLight, Chosen, Emitters, Light, NO_LIGHT, choose_by_importance};
 use crate::material::{Material, Model, Phong};
-use crate::sampling::{LightsPerVertex, Sampler, Sampling};
+use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling};
 use crate::shader::Tracer;
 use crate::shader::record::{Record, Technique};
-use crate::shader::surface::{SHADOW_END, diffuse_probability};
+use crate::shader::surface::{
+    Interaction, SHADOW_END, diffuse_probability, light_ray, light_weighted, sample_area_light,
+};
 use crate::stats::RayKind;
 use crate::texture::MaterialTextures;
 use glam::Vec3A;
@@ -38,9 +41,10 @@ pub struct PathSlot<R> {
 }
 
 /// True if `p`'s vertices can be shaded in lanes in a scene of these lights, emitters and
-/// textures: BRDF or cosine sampling (under either model), point lights only (no emitter, no
-/// environment, no spot or directional light; every one per vertex, or under the Physical
-/// model one chosen by power or by importance), no textures.
+/// textures: BRDF or cosine sampling (under either model), point lights and area lights (no
+/// environment, no spot or directional light; every point light and one area-light sample per
+/// vertex, or under the Physical model one light chosen by power or by importance), no
+/// textures.
 pub fn applies(
     p: &Path,
     lights: &[Light],
@@ -48,46 +52,42 @@ pub fn applies(
     textures: &[MaterialTextures],
 ) -> bool {
     matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
-        && emitters.is_empty()
+        && emitters.environment.is_none()
         && textures.is_empty()
         && lights.iter().all(|l| matches!(l, Light::Point(_)))
 }
 
-/// Each primitive's diffuse Phong material, where the lanes shade its vertices: it reflects
-/// light diffusely only (so its BRDF sampling always picks the cosine lobe) and emits nothing.
+/// Each material that the lanes shade: a Phong material that reflects light diffusely only
+/// (so its BRDF sampling always picks the cosine lobe), by index.
 pub struct Diffuse(Vec<Option<Phong>>);
 
 impl Diffuse {
-    /// The table of `tr`'s primitives, by index (a render in waves makes it for each pixel
-    /// it traces, from the primitives of a scene without a BVH, which are few).
+    /// The table of `tr`'s materials.
     pub fn table(tr: &Tracer) -> Diffuse {
-        let g = tr.geometry;
-        let mut table = Vec::new();
-        for i in g.indices() {
-            let prim = g.prim(i);
-            let i = i as usize;
-            if table.len() <= i {
-                table.resize(i + 1, None);
+        let diffuse = |m: &Material| match m {
+            Material::Phong(phong)
+                if phong.ks == Vec3A::ZERO
+                    && !phong.is_black()
+                    && diffuse_probability(phong) == 1.0 =>
+            {
+                Some(*phong)
             }
-            table[i] = match tr.materials[prim.material as usize] {
-                Material::Phong(phong)
-                    if phong.ks == Vec3A::ZERO
-                        && !phong.is_black()
-                        && diffuse_probability(&phong) == 1.0
-                        && prim.light == crate::light::NO_LIGHT =>
-                {
-                    Some(phong)
-                }
-                _ => None,
-            };
-        }
-        Diffuse(table)
+            _ => None,
+        };
+        Diffuse(tr.materials.iter().map(diffuse).collect())
     }
 
-    /// The diffuse material of `hit`, if the vertex it makes on path `st` is shaded in lanes:
-    /// its primitive's, if the path may scatter there.
+    /// The material (index and parameters) of `hit`, if the vertex it makes on path `st` is
+    /// shaded in lanes: a flat primitive of a diffuse material that emits nothing, where the
+    /// path may scatter.
     #[inline]
-    pub fn at(&self, p: &Path, st: &PathState, hit: &Hit) -> Option<Phong> {
+    pub fn at(
+        &self,
+        geometry: &Geometry,
+        p: &Path,
+        st: &PathState,
+        hit: &Hit,
+    ) -> Option<(u32, Phong)> {
         let max_depth = p
             .max_depth
             .unwrap_or(super::MAX_DEPTH)
@@ -95,7 +95,12 @@ impl Diffuse {
         if st.depth >= max_depth {
             return None;
         }
-        self.0.get(hit.prim as usize).copied().flatten()
+        let (material, smooth, light) = geometry.shading_of(hit.prim);
+        if smooth || light != NO_LIGHT {
+            return None;
+        }
+        let phong = self.0.get(material as usize).copied().flatten()?;
+        Some((material, phong))
     }
 }
 
@@ -179,8 +184,6 @@ unsafe fn round_in<L: Floats, R: Record>(
     alive: &mut [bool],
 ) {
     let geometry: &Geometry = tr.geometry;
-    // `nearest_lanes` tests the packed primitives only.
-    debug_assert!(geometry.bvh.is_empty(), "a scene without a BVH");
     for c in (0..slots.len()).step_by(L::LANES) {
         let count = (slots.len() - c).min(L::LANES);
         // The chunk's rays and throughputs in lanes (lanes past `count` repeat the last).
@@ -203,27 +206,68 @@ unsafe fn round_in<L: Floats, R: Record>(
             [load(D), load(D + 1), load(D + 2)],
         );
         let beta = [load(BETA), load(BETA + 1), load(BETA + 2)];
-        // The nearest hits, with their records, in the lanes.
-        let lanes = RayLanes::from_parts(o, d, load(O_ERR));
-        let near = unsafe { geometry.nearest_lanes(&lanes, load(T_MAX)) };
-        let (h, rows) = (near.hit, near.rows());
+        // The nearest hits, with their records, in the lanes: the packed primitives tested
+        // in lanes, or each ray through the BVH with the one-ray query.
+        let mut hits = [None; MAX_LANES];
+        let h = if geometry.bvh.is_empty() {
+            let lanes = RayLanes::from_parts(o, d, load(O_ERR));
+            let near = unsafe { geometry.nearest_lanes(&lanes, load(T_MAX)) };
+            let rows = near.rows();
+            for (i, hit) in hits.iter_mut().enumerate().take(count) {
+                *hit = geometry.lane_hit(&rows, i);
+            }
+            near.hit
+        } else {
+            let mut rows = [[0.0f32; MAX_LANES]; 8];
+            if geometry.few() && tr.traversal.is_none() {
+                // A small scene's triangles, in lanes.
+                let rays: [Ray; MAX_LANES] =
+                    std::array::from_fn(|i| slots[c + i.min(count - 1)].st.ray);
+                unsafe { geometry.nearest_few::<L>(&rays[..count], &mut hits[..count]) };
+            } else {
+                for (i, hit) in hits.iter_mut().enumerate().take(count) {
+                    let ray = &slots[c + i].st.ray;
+                    *hit = match tr.traversal {
+                        None => geometry.intersect(ray),
+                        Some(t) => geometry.intersect_tallied(ray, t),
+                    };
+                }
+            }
+            for (i, hit) in hits.iter().enumerate().take(count) {
+                if let Some(h) = hit {
+                    for x in 0..3 {
+                        rows[x][i] = h.p[x];
+                        rows[3 + x][i] = h.n[x];
+                    }
+                    (rows[6][i], rows[7][i]) = (h.err, h.err_along);
+                }
+            }
+            let load = |row: usize| unsafe { L::from_slice(&rows[row]) };
+            SurfaceLanes {
+                p: [load(0), load(1), load(2)],
+                n: [load(3), load(4), load(5)],
+                err: load(6),
+                err_along: load(7),
+            }
+        };
         // Diffuse vertices stay in the lanes; the others go one at a time.
         let (mut shaded, mut kd) = (0u32, [[0.0f32; MAX_LANES]; 3]);
-        for i in 0..count {
+        let mut materials = [None; MAX_LANES];
+        for (i, hit) in hits.iter().enumerate().take(count) {
             let k = c + i;
-            let hit = geometry.lane_hit(&rows, i);
             let slot = &mut slots[k];
-            if let Some(h) = &hit
-                && let Some(phong) = diffuse.at(p, &slot.st, h)
+            if let Some(h) = hit
+                && let Some((m, phong)) = diffuse.at(geometry, p, &slot.st, h)
             {
                 shaded |= 1 << i;
+                materials[i] = Some((m, phong));
                 for (row, x) in kd.iter_mut().zip(phong.kd.to_array()) {
                     row[i] = x;
                 }
                 continue;
             }
             std::mem::swap(&mut tr.sampler, &mut slot.sampler);
-            alive[k] = super::step(tr, p, &mut slot.st, hit, &mut slot.rec);
+            alive[k] = super::step(tr, p, &mut slot.st, *hit, &mut slot.rec);
             std::mem::swap(&mut tr.sampler, &mut slot.sampler);
             if alive[k] {
                 tr.count(&slot.st.ray, slot.st.kind);
@@ -245,6 +289,8 @@ unsafe fn round_in<L: Floats, R: Record>(
                 d,
                 beta,
                 kd,
+                hits: &hits,
+                materials: &materials,
             };
             unsafe {
                 shade_in::<L, R>(
@@ -262,7 +308,7 @@ unsafe fn round_in<L: Floats, R: Record>(
 
 /// A chunk's vertices in lanes: the hit's point, geometric normal and error bounds, the ray's
 /// direction, the path's throughput, and the surface's `kd`.
-struct Vertices<L> {
+struct Vertices<'h, L> {
     p: [L; 3],
     nh: [L; 3],
     err: L,
@@ -270,6 +316,10 @@ struct Vertices<L> {
     d: [L; 3],
     beta: [L; 3],
     kd: [L; 3],
+    /// The same hits lane by lane, for the area lights' samples.
+    hits: &'h [Option<Hit>; MAX_LANES],
+    /// Each shaded lane's material, index and parameters.
+    materials: &'h [Option<(u32, Phong)>; MAX_LANES],
 }
 
 /// Shade the vertices of `at` in the lanes of `shaded` (lane `i` is path `slots[i]`, which
@@ -329,6 +379,13 @@ unsafe fn shade_in<L: Floats, R: Record>(
     // Next-event estimation: every point light's term, or one light's, chosen by power or by
     // importance (`one_light`).
     let by_importance = p.lights_per_vertex == LightsPerVertex::Importance;
+    // `next_event`'s strategy for the area lights: sampled unless left to BRDF-sampled rays,
+    // and weighted against those under MIS.
+    let lights = p.lights_under(tr.model);
+    let mis = (lights == LightSampling::Mis && tr.effects.indirect).then_some(p.sampling);
+    let sample_area = lights != LightSampling::Brdf || !tr.effects.indirect;
+    // Each lane's area-light sample and the chance of its light, if it drew one.
+    let mut area = AreaRays::new();
     let nee = if p.one_light_under(tr.model) {
         // The choice, lane by lane: `u` picks the light (by importance: `u`'s place within
         // the point lights' share, with the point and normal of the lane's vertex);
@@ -346,7 +403,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
         for i in Bits(shaded) {
             let s = &mut slots[i].sampler;
             let u = s.next_f64();
-            let _ = s.next_2d();
+            let u12 = s.next_2d();
             // The light and the factor of its term: `1 / pmf` by power, `1 / (share p)` by
             // importance (a light chosen with a chance below f32's range adds nothing).
             let pick = match tr.emitters.choose_any(u) {
@@ -359,6 +416,14 @@ unsafe fn shade_in<L: Floats, R: Record>(
                         .filter(|(_, w)| w.is_finite())
                 }
                 Some(Chosen::Point(j, w)) => Some((j, w)),
+                // An area light: its sample, for the shadow rays of the lanes' area lights.
+                Some(Chosen::Area(light, pmf)) if sample_area && tr.effects.emission => {
+                    if let (Some(hit), Some((m, phong))) = (&at.hits[i], &at.materials[i]) {
+                        let vertex = (hit, slots[i].st.ray.d);
+                        area.sample(tr, i, vertex, (*m, phong), (light, pmf), u12);
+                    }
+                    None
+                }
                 _ => None,
             };
             if let Some((j, w)) = pick
@@ -391,10 +456,18 @@ unsafe fn shade_in<L: Floats, R: Record>(
         };
         let term = unsafe { point_term(tr, &light, &surface) };
         let w = unsafe { L::from_array(pmf) };
-        match by_importance {
+        let point = match by_importance {
             true => [term[0] * w, term[1] * w, term[2] * w],
             false => [term[0] / w, term[1] / w, term[2] / w],
-        }
+        };
+        // The lanes that chose an area light take its term.
+        let term = unsafe { area.terms(tr, at, (wo, n), mis, false) };
+        let lanes = unsafe { mask::<L>(area.lanes) };
+        [
+            L::select(lanes, term[0], point[0]),
+            L::select(lanes, term[1], point[1]),
+            L::select(lanes, term[2], point[2]),
+        ]
     } else {
         // `point_lights`: the terms summed from zero in the lights' order, then the area
         // lights' share (none here) added.
@@ -420,7 +493,25 @@ unsafe fn shade_in<L: Floats, R: Record>(
             let term = unsafe { point_term(tr, &light, &surface) };
             sum = [sum[0] + term[0], sum[1] + term[1], sum[2] + term[2]];
         }
-        [sum[0] + zero, sum[1] + zero, sum[2] + zero]
+        // `area_lights` with one sample: the light chosen by power (`u`), a point on it
+        // (`u1`, `u2`), its term (zero where none is drawn).
+        if sample_area && tr.effects.emission && !tr.emitters.is_empty() {
+            for i in Bits(shaded) {
+                let s = &mut slots[i].sampler;
+                let u = s.next_f64();
+                let u12 = s.next_2d();
+                // (No environment light in the waves' scenes, and the point lights take no
+                // part in this choice.)
+                if let Some(Chosen::Area(light, pmf)) = tr.emitters.choose_any(u)
+                    && let (Some(hit), Some((m, phong))) = (&at.hits[i], &at.materials[i])
+                {
+                    let vertex = (hit, slots[i].st.ray.d);
+                    area.sample(tr, i, vertex, (*m, phong), (light, pmf), u12);
+                }
+            }
+        }
+        let area = unsafe { area.terms(tr, at, (wo, n), mis, true) };
+        [sum[0] + area[0], sum[1] + area[1], sum[2] + area[2]]
     };
     // Each path adds `beta` times its vertex's light.
     let l = [
@@ -538,6 +629,130 @@ unsafe fn shade_in<L: Floats, R: Record>(
             .scatter_diffuse(ray, hit_p, pdf[i], beta, p.rr_depth, &mut slot.sampler);
         if alive[i] {
             tr.count(&slot.st.ray, RayKind::Indirect);
+        }
+    }
+}
+
+/// The lanes' area-light samples, a column per coordinate: the lanes that drew one, those
+/// whose sample has a shadow ray to test (`light_ray`), the rays, and each sample's direction,
+/// radiance and density.
+struct AreaRays {
+    lanes: u32,
+    tested: u32,
+    ray: [[f32; MAX_LANES]; 8],
+    wi: [[f32; MAX_LANES]; 3],
+    le: [[f32; MAX_LANES]; 3],
+    pdf: [f32; MAX_LANES],
+}
+
+impl AreaRays {
+    /// No samples.
+    fn new() -> Self {
+        AreaRays {
+            lanes: 0,
+            tested: 0,
+            ray: [[0.0; MAX_LANES]; 8],
+            wi: [[0.0; MAX_LANES]; 3],
+            le: [[0.0; MAX_LANES]; 3],
+            pdf: [0.0; MAX_LANES],
+        }
+    }
+
+    /// Lane `i` samples area light `light`, chosen with probability `pmf`, from the random
+    /// numbers `u` (`area_sample`) at its vertex `hit`, met by a ray of direction `d`, on a
+    /// surface of diffuse `material` (number `m` of `tr`'s).
+    #[inline(always)]
+    fn sample(
+        &mut self,
+        tr: &Tracer,
+        i: usize,
+        (hit, d): (&Hit, Vec3A),
+        (m, material): (u32, &Phong),
+        (light, pmf): (&AreaLight, f32),
+        u: (f32, f32),
+    ) {
+        self.lanes |= 1 << i;
+        let Some(ls) = sample_area_light(tr.emitters, light, hit.p, u) else {
+            return;
+        };
+        let si = Interaction::flat(*hit, d, &tr.materials[m as usize]);
+        let Some((r, pdf)) = light_ray(&si, material, &ls, pmf) else {
+            return;
+        };
+        for x in 0..3 {
+            self.ray[x][i] = r.o[x];
+            self.ray[3 + x][i] = r.d[x];
+            self.wi[x][i] = ls.wi[x];
+            self.le[x][i] = ls.le[x];
+        }
+        (self.ray[6][i], self.ray[7][i], self.pdf[i]) = (r.o_err, r.t_max, pdf);
+        self.tested |= 1 << i;
+    }
+
+    /// The samples' terms `L_e r V w / (pmf pdf)` at the vertices of `at` seen from `wo` with
+    /// shading normals `n` (`light_term`: the shadow rays tested in lanes, then each visible
+    /// sample weighted lane by lane), zero in the lanes without a sample. With `summed`, each
+    /// term as `area_lights` returns it for one sample: added to zero and divided by one.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn terms<L: Floats>(
+        &self,
+        tr: &mut Tracer,
+        at: &Vertices<L>,
+        (wo, n): ([L; 3], [L; 3]),
+        mis: Option<Sampling>,
+        summed: bool,
+    ) -> [L; 3] {
+        // SAFETY: the caller's; so for every `unsafe` block below, each makes values of `L`.
+        let zero = unsafe { L::splat(0.0) };
+        if self.lanes == 0 {
+            return [zero; 3];
+        }
+        // The shadow rays, in lanes.
+        let mut blocked = 0u32;
+        if tr.effects.shadows && self.tested != 0 {
+            let load = |row: usize| unsafe { L::from_slice(&self.ray[row]) };
+            let segments = (
+                [load(0), load(1), load(2)],
+                [load(3), load(4), load(5)],
+                load(6),
+                load(7),
+            );
+            let live = unsafe { mask::<L>(self.tested) };
+            let hidden = match tr.traversal {
+                None => tr.geometry.occluded_lanes(segments, true, live, &()),
+                Some(t) => tr.geometry.occluded_lanes(segments, true, live, t),
+            };
+            blocked = L::bitmask(hidden);
+            tr.count_shadow_lanes(segments, self.tested);
+        }
+        // The visible samples' weights.
+        let (wo, n) = (wo.map(|x| array(x)), n.map(|x| array(x)));
+        let mut term = [[0.0f32; MAX_LANES]; 3];
+        for i in Bits(self.lanes) {
+            let mut l = Vec3A::ZERO;
+            if let Some((_, phong)) = &at.materials[i]
+                && self.tested & !blocked & (1 << i) != 0
+            {
+                let at = |c: &[[f32; MAX_LANES]; 3]| Vec3A::new(c[0][i], c[1][i], c[2][i]);
+                let sample = (at(&self.wi), at(&self.le), self.pdf[i]);
+                l = light_weighted(tr.model, (at(&wo), at(&n)), phong, sample, mis);
+            }
+            if summed {
+                l = (Vec3A::ZERO + l) / 1.0;
+            }
+            for (row, x) in term.iter_mut().zip(l.to_array()) {
+                row[i] = x;
+            }
+        }
+        unsafe {
+            [
+                L::from_array(term[0]),
+                L::from_array(term[1]),
+                L::from_array(term[2]),
+            ]
         }
     }
 }
