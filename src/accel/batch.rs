@@ -121,7 +121,7 @@ impl Geometry {
         tally: Option<&Traversal>,
     ) {
         hits.clear();
-        if !self.in_lanes(tally.is_some()) {
+        if !self.all_packed() {
             // Ray by ray, the BVH's loop compiled with the counters or without them.
             match tally {
                 Some(t) => hits.extend(rays.iter().map(|r| self.intersect_tallied(r, t))),
@@ -256,7 +256,7 @@ impl Geometry {
         tally: Option<&Traversal>,
     ) {
         blocked.clear();
-        if !self.in_lanes(tally.is_some()) {
+        if !self.all_packed() {
             match tally {
                 Some(t) => blocked.extend(rays.iter().map(|r| self.occluded_tallied(r, planes, t))),
                 None => blocked.extend(rays.iter().map(|r| self.occluded_tallied(r, planes, &()))),
@@ -273,14 +273,6 @@ impl Geometry {
             // SAFETY: `Vec4` runs on every CPU.
             _ => unsafe { self.occluded_in::<Vec4>(rays, planes, blocked, &tally) },
         }
-    }
-
-    /// True if batches of rays are tested in lanes: against the packed primitives of a scene
-    /// without a BVH, or against a small scene's triangles ([`Geometry::few`]) unless the
-    /// traversal is `counted` (its BVH's work is then what is counted).
-    #[inline]
-    fn in_lanes(&self, counted: bool) -> bool {
-        self.all_packed() || (self.few() && !counted)
     }
 
     /// Primitives each ray in lanes tests for its nearest hit: every packed sphere and plane.
@@ -368,23 +360,17 @@ impl Geometry {
                 x.write_to(&mut v[k]);
             }
             let live = L::bitmask(live);
-            let rays: [Ray; MAX_LANES] = std::array::from_fn(|i| Ray {
-                o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
-                d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
-                t_max: v[7][i],
-                o_err: v[6][i],
-            });
-            if self.few() && !tally.counting() {
-                // A small scene's triangles, in lanes.
-                // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
-                let blocked = unsafe { self.occluded_few::<L>(&rays[..L::LANES], live) };
-                return unsafe { super::lanes::lane_mask::<L>(blocked) };
-            }
             for (i, blocked) in lane.iter_mut().enumerate().take(L::LANES) {
                 if live & (1 << i) == 0 {
                     continue;
                 }
-                let hit = self.occluded_tallied(&rays[i], planes, tally);
+                let ray = Ray {
+                    o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
+                    d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
+                    t_max: v[7][i],
+                    o_err: v[6][i],
+                };
+                let hit = self.occluded_tallied(&ray, planes, tally);
                 *blocked = if hit { 1.0 } else { 0.0 };
             }
             // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
@@ -415,16 +401,6 @@ impl Geometry {
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
     unsafe fn intersect_in<L: Floats>(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
-        if !self.all_packed() {
-            // A small scene's triangles.
-            for chunk in rays.chunks(L::LANES) {
-                let mut found = [None; MAX_LANES];
-                // SAFETY: the caller vouches for the instruction set.
-                unsafe { self.nearest_few::<L>(chunk, &mut found[..chunk.len()]) };
-                hits.extend_from_slice(&found[..chunk.len()]);
-            }
-            return;
-        }
         for k in (0..rays.len()).step_by(L::LANES) {
             // SAFETY: the caller vouches for the instruction set.
             let (eight, t_max) = unsafe { chunk::<L>(rays, k) };

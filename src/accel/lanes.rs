@@ -519,29 +519,3 @@ where
     }
     out
 }
-
-/// The set bits of a lane mask, lowest first.
-#[inline(always)]
-pub fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (mask != 0).then(|| {
-            let i = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            i
-        })
-    })
-}
-
-/// The lanes of `bits` as a mask.
-///
-/// # Safety
-/// The CPU must run `L`'s instruction set.
-#[inline(always)]
-pub unsafe fn lane_mask<L: Floats>(bits: u32) -> L::Mask {
-    let mut f = [0.0f32; MAX_LANES];
-    for (i, x) in f.iter_mut().enumerate() {
-        *x = if bits & (1 << i) != 0 { 1.0 } else { 0.0 };
-    }
-    // SAFETY: the caller's.
-    unsafe { L::from_array(f) }.cmpne(unsafe { L::splat(0.0) })
-}

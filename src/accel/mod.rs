@@ -4,7 +4,6 @@
 mod batch;
 pub mod block;
 mod bvh;
-pub mod few;
 pub mod lanes;
 mod prim;
 mod simd;
@@ -137,8 +136,6 @@ pub struct Geometry {
     /// True if the BVH holds triangles: its rays then need the watertight test's shear
     /// constants.
     pub has_triangles: bool,
-    /// A small scene's triangles, for batches of rays in lanes ([`few`]).
-    pub few: few::Few,
 }
 
 impl Geometry {
@@ -311,9 +308,7 @@ impl Geometry {
         let plane_items = append(&mut others, slots, planes);
         let spheres = lanes::pack(&sphere_items, SphereLanes::pack);
         let planes = lanes::pack(&plane_items, PlaneLanes::pack);
-        let few = few::Few::of(&blocks, in_bvh, sphere_items.len() + plane_items.len());
         Geometry {
-            few,
             others,
             in_bvh,
             bvh,

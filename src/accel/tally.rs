@@ -12,9 +12,6 @@ pub trait Tally {
     fn nodes(&self, n: u64);
     /// `n` primitives were tested (a leaf block's primitives, a packet's shapes).
     fn prims(&self, n: u64);
-    /// True if the counts are kept: the queries then take the paths whose work they count
-    /// (a small scene's rays walk its BVH rather than its triangles in lanes).
-    fn counting(&self) -> bool;
 }
 
 impl Tally for () {
@@ -22,10 +19,6 @@ impl Tally for () {
     fn nodes(&self, _: u64) {}
     #[inline(always)]
     fn prims(&self, _: u64) {}
-    #[inline(always)]
-    fn counting(&self) -> bool {
-        false
-    }
 }
 
 /// Counts of nodes and primitives tested, kept in cells so that the traversal's closures can
@@ -47,10 +40,6 @@ impl Tally for Traversal {
     fn prims(&self, n: u64) {
         self.prims.set(self.prims.get() + n);
     }
-    #[inline]
-    fn counting(&self) -> bool {
-        true
-    }
 }
 
 /// A traversal counted or not: for code that runs once per ray batch, where one branch per
@@ -67,9 +56,5 @@ impl Tally for Option<&Traversal> {
         if let Some(t) = self {
             t.prims(n);
         }
-    }
-    #[inline]
-    fn counting(&self) -> bool {
-        self.is_some()
     }
 }

@@ -1,16 +1,19 @@
-//! Path's samples in waves: the paths of up to [`WAVE`] samples of a pixel advance together,
-//! one vertex each per round, in a scene whose primitives are all packed (no BVH). Each round
-//! traces the paths' rays in chunks of SIMD lanes
-//! ([`crate::accel::Geometry::nearest_lanes`]) and shades the diffuse vertices in those lanes
-//! ([`crate::shader::path::lanes`]: the interaction, the point lights with their shadow rays in
-//! lanes, the next direction and Russian roulette) and every other vertex (mirrors, glass,
-//! glossy Phong, escapes) with the one-ray code ([`crate::shader::path::step`]); the slots of
-//! the paths that ended go to the pixel's next samples.
+//! Path's samples in waves: the paths of up to [`WAVE`] samples advance together, one vertex
+//! each per round, the samples of a tile's pixels taken one pixel after another, so that the
+//! wave stays full while the tile has samples left (a progressive render's first rounds hold
+//! one or two samples per pixel). Each round traces the paths' rays in chunks of SIMD lanes
+//! ([`crate::accel::Geometry::nearest_lanes`] in a scene whose primitives are all packed, each
+//! ray through the BVH with the one-ray query in others) and shades the diffuse vertices in
+//! those lanes ([`crate::shader::path::lanes`]: the interaction, the point lights and one
+//! area-light sample with their shadow rays in lanes, the next direction and Russian roulette)
+//! and every other vertex (mirrors, glass, glossy Phong, emitters, escapes) with the one-ray
+//! code ([`crate::shader::path::step`]); the slots of the paths that ended go to the next
+//! samples.
 //!
 //! Each sample draws from its own random stream in the one-ray order and adds the same
-//! contributions, each computed by the same operations, and its sum is exact
-//! ([`SampleSum`]), so the pixel is the one-ray render's to the bit
-//! (`tests/integration/path_waves.rs`).
+//! contributions, each computed by the same operations, and its pixel's sum is exact
+//! ([`SampleSum`]), so each pixel is the one-ray render's to the bit, whatever the order of its
+//! samples (`tests/integration/path_waves.rs`).
 
 use super::{RenderScene, SampleSum, camera_ray};
 use crate::sampling::Sampler;
@@ -21,17 +24,16 @@ use crate::stats::{RayKind, RayStats};
 
 use super::exact::RgbSum;
 
-/// Paths in flight per pixel.
+/// Paths in flight in a wave.
 pub const WAVE: usize = 64;
 
-/// True if `scene`'s samples go in waves: the path tracer in a scene without a BVH whose
-/// vertices the lanes can shade ([`lanes::applies`]).
+/// True if `scene`'s samples go in waves: the path tracer in a scene whose vertices the lanes
+/// can shade ([`lanes::applies`]).
 pub fn applies(scene: &RenderScene) -> bool {
     let Shader::Path(p) = &scene.shader else {
         return false;
     };
-    (scene.geometry.bvh.is_empty() || scene.geometry.few())
-        && lanes::applies(p, &scene.lights, &scene.emitters, &scene.textures)
+    lanes::applies(p, &scene.lights, &scene.emitters, &scene.textures)
 }
 
 /// The exact sum of the samples `samples` of pixel `(col, row)` under the path tracer `p`,

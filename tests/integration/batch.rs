@@ -12,13 +12,13 @@ use rtis::accel::{Geometry, Isa, Prim, require_all_isas};
 use rtis::geometry::{Hit, Ray};
 use rtis::shape::{Plane, Shape, Sphere, Triangle};
 
-pub(crate) fn unit() -> impl Strategy<Value = Vec3A> {
+fn unit() -> impl Strategy<Value = Vec3A> {
     (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0)
         .prop_filter("non-degenerate", |(x, y, z)| x * x + y * y + z * z > 1e-3)
         .prop_map(|(x, y, z)| Vec3A::new(x, y, z).normalize())
 }
 
-pub(crate) fn point(s: f32) -> impl Strategy<Value = Vec3A> {
+fn point(s: f32) -> impl Strategy<Value = Vec3A> {
     (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0).prop_map(move |(x, y, z)| Vec3A::new(x, y, z) * s)
 }
 
@@ -54,13 +54,13 @@ fn scene(s: f32, triangles: bool) -> impl Strategy<Value = Vec<Prim>> {
         })
 }
 
-pub(crate) fn scale() -> impl Strategy<Value = f32> {
+fn scale() -> impl Strategy<Value = f32> {
     prop_oneof![Just(1e-3f32), Just(1.0), Just(1e3), Just(1e5)]
 }
 
 /// Rays from `origins` along `dirs`, each followed by a ray leaving its hit (if any) along the
 /// next direction, on either side; every third one a segment, as shadow rays are.
-pub(crate) fn rays(g: &Geometry, origins: &[Vec3A], dirs: &[Vec3A], s: f32) -> Vec<Ray> {
+fn rays(g: &Geometry, origins: &[Vec3A], dirs: &[Vec3A], s: f32) -> Vec<Ray> {
     let mut out = Vec::new();
     for (k, (&o, &d)) in origins.iter().zip(dirs).enumerate() {
         let t_max = if k % 3 == 0 {
@@ -79,7 +79,7 @@ pub(crate) fn rays(g: &Geometry, origins: &[Vec3A], dirs: &[Vec3A], s: f32) -> V
 }
 
 /// `g` with its queries in each instruction set this CPU runs.
-pub(crate) fn each_isa(mut g: Geometry) -> impl Iterator<Item = (Isa, Geometry)> {
+fn each_isa(mut g: Geometry) -> impl Iterator<Item = (Isa, Geometry)> {
     require_all_isas();
     Isa::all_available().into_iter().map(move |isa| {
         assert!(g.bvh.set_isa(isa));
@@ -87,7 +87,7 @@ pub(crate) fn each_isa(mut g: Geometry) -> impl Iterator<Item = (Isa, Geometry)>
     })
 }
 
-pub(crate) fn bits(h: &Option<Hit>) -> Option<(u32, [u32; 9])> {
+fn bits(h: &Option<Hit>) -> Option<(u32, [u32; 9])> {
     h.map(|h| {
         let v = [
             h.t,
@@ -223,7 +223,7 @@ proptest! {
 }
 
 /// A tessellated square on z = 0, `n` x `n` squares of side 1 from `at`, two triangles each.
-pub(crate) fn grid(n: u32, at: Vec3A) -> Vec<Prim> {
+fn grid(n: u32, at: Vec3A) -> Vec<Prim> {
     let v = |i: u32, j: u32| at + Vec3A::new(i as f32, j as f32, 0.0);
     let mut prims = Vec::new();
     for i in 0..n {
@@ -242,7 +242,7 @@ pub(crate) fn grid(n: u32, at: Vec3A) -> Vec<Prim> {
 /// Rays straight down (`-z`, its `x` and `y` negative zeros) through a `(2n + 1)^2` lattice
 /// of step 1/2 from the origin: the vertices, edges' midpoints and diagonals' midpoints of
 /// [`grid`]`(n, 0)`, row by row.
-pub(crate) fn lattice_rays(n: u32) -> Vec<Ray> {
+fn lattice_rays(n: u32) -> Vec<Ray> {
     (0..(2 * n + 1) * (2 * n + 1))
         .map(|k| {
             let (x, y) = (

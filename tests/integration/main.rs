@@ -19,7 +19,6 @@ mod cpu_dispatch;
 mod effects;
 mod environment;
 mod estimate;
-mod few;
 mod global_waves;
 mod global_weights;
 mod golden;

@@ -42,8 +42,8 @@ fn lit_room(shader: &str, effects: &str) -> String {
     )
 }
 
-/// Mitsuba's Cornell box (scenes/mitsuba-cornell.ron: 36 triangles, whose rays go in lanes,
-/// and a rectangle light) on a small film, under `shader`, with a point light too if `point`.
+/// Mitsuba's Cornell box (scenes/mitsuba-cornell.ron: 36 triangles in a BVH, and a rectangle
+/// light) on a small film, under `shader`, with a point light too if `point`.
 fn triangle_box(shader: &str, effects: &str, point: bool) -> String {
     let text = std::fs::read_to_string(common::scenes_dir().join("mitsuba-cornell.ron")).unwrap();
     let mut text = text
@@ -167,7 +167,7 @@ fn waves_give_the_one_ray_pixels() {
 }
 
 /// Area lights in the waves: an emitting sphere among packed primitives, and a rectangle light
-/// in a small scene of triangles (whose rays go in lanes), with point lights or without, over
+/// in a scene of triangles (in a BVH), with point lights or without, over
 /// the strategies (light sampling, BRDF sampling, MIS; one light by power or by importance, or
 /// all), both samplings, both models, and the effects that skip work.
 #[test]
@@ -196,6 +196,15 @@ fn waves_give_the_one_ray_pixels_with_area_lights() {
             }
         }
     }
+    // Packed primitives and a BVH together: a mesh in the lit room.
+    let shader = "Path(rr_depth: 1, sampling: Brdf, lights: Mis, lights_per_vertex: One)";
+    let mixed = lit_room(shader, "").replace(
+        "entities: [",
+        "entities: [\n            (shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, 0.2, -0.8)], faces: [(0, 1, 2)]), material: Phong(kd: (0.4, 0.5, 0.6))),",
+    );
+    let s = rtis::extract(&scene(&mixed));
+    assert!(!s.geometry.bvh.is_empty());
+    agrees(&s, "sphere light, mesh");
     let shader = "Path(rr_depth: 1, sampling: Brdf, lights: Mis, lights_per_vertex: All)";
     let course = lit_room(shader, "").replace("model: Physical", "model: Course");
     agrees(&rtis::extract(&scene(&course)), "sphere light, Course");
@@ -213,8 +222,7 @@ fn waves_give_the_one_ray_pixels_with_area_lights() {
 
 /// The waves are for the scenes whose vertices the lanes shade: not with uniform sampling (under
 /// either model), not with a light other than point lights and area lights (spot, directional,
-/// the environment), a texture, or a BVH beyond a small scene's triangles; each alone keeps
-/// them off.
+/// the environment), or a texture; each alone keeps them off.
 #[test]
 fn waves_apply_only_where_the_lanes_shade() {
     let path = "Path(sampling: Brdf)";
@@ -241,15 +249,16 @@ fn waves_apply_only_where_the_lanes_shade() {
         "(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))",
         "(light: Environment(radiance: (0.3, 0.35, 0.4)))",
         "(shape: Sphere(center: (1, 1, -1), radius: 0.2), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))",
-        "(shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, -0.9, -0.5)], faces: [(0, 1, 2)]), material: Phong(kd: (0.5, 0.5, 0.5)))",
     ] {
         assert!(!waves::applies(&with(entity)), "{entity}");
     }
-    // An emitting shape, and a small scene of triangles, take the waves.
-    let sphere =
-        "(shape: Sphere(center: (0, 1.2, 0), radius: 0.1), emitter: Emitter(radiance: (8, 7, 6)))";
-    assert!(waves::applies(&with(sphere)), "{sphere}");
-    assert!(waves::applies(&rtis::extract(&scene(&triangle_box(
-        path, "", false
-    )))));
+    // An emitting shape and a BVH take the waves.
+    for entity in [
+        "(shape: Sphere(center: (0, 1.2, 0), radius: 0.1), emitter: Emitter(radiance: (8, 7, 6)))",
+        "(shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, -0.9, -0.5)], faces: [(0, 1, 2)]), material: Phong(kd: (0.5, 0.5, 0.5)))",
+    ] {
+        assert!(waves::applies(&with(entity)), "{entity}");
+    }
+    let text = triangle_box(path, "", false);
+    assert!(waves::applies(&rtis::extract(&scene(&text))));
 }

@@ -1,11 +1,13 @@
 //! Path's diffuse vertices shaded in SIMD lanes: the vertices of a wave of paths
 //! (`render::waves`) that meet a diffuse Phong surface (no specular lobe), under either model,
 //! a path per lane, from the hit to the next ray: the interaction, next-event estimation
-//! over point lights with the shadow rays tested in lanes ([`Geometry::occluded_lanes`]), the
-//! cosine-weighted direction, its weight, and Russian roulette.
+//! over point lights and one area-light sample with the shadow rays tested in lanes
+//! ([`Geometry::occluded_lanes`]) and the area light's MIS weight, the cosine-weighted
+//! direction, its weight, and Russian roulette.
 //!
 //! Every lane computes what [`super::step`] computes for its path, operation for operation
 //! (`Interaction::new`, `Origins`, `PointLight::incident`, `Phong::brdf` and
+//! `surface::light_ray` and `light_weighted`, which it calls lane by lane,
 //! `Phong::course_reflectance`, `reflectance`,
 //! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
 //! draws its random numbers from its own stream in the same order (the draws, the light choice
@@ -105,7 +107,8 @@ impl Diffuse {
 }
 
 /// One round of a wave: trace each path's ray of `slots` and shade the vertex it meets, the
-/// rays in chunks of lanes ([`Geometry::nearest_lanes`]; a scene without a BVH), the diffuse
+/// rays in chunks of lanes ([`Geometry::nearest_lanes`] in a scene without a BVH, else each
+/// with the one-ray query), the diffuse
 /// vertices ([`Diffuse`]) in those lanes, the others with the one-ray [`super::step`] (its
 /// random stream swapped into `tr`). Each path adds its vertex's light to its recorder and
 /// takes its next ray (counted); `alive[k]` (one per slot) says whether path `k` goes on.
@@ -219,19 +222,12 @@ unsafe fn round_in<L: Floats, R: Record>(
             near.hit
         } else {
             let mut rows = [[0.0f32; MAX_LANES]; 8];
-            if geometry.few() && tr.traversal.is_none() {
-                // A small scene's triangles, in lanes.
-                let rays: [Ray; MAX_LANES] =
-                    std::array::from_fn(|i| slots[c + i.min(count - 1)].st.ray);
-                unsafe { geometry.nearest_few::<L>(&rays[..count], &mut hits[..count]) };
-            } else {
-                for (i, hit) in hits.iter_mut().enumerate().take(count) {
-                    let ray = &slots[c + i].st.ray;
-                    *hit = match tr.traversal {
-                        None => geometry.intersect(ray),
-                        Some(t) => geometry.intersect_tallied(ray, t),
-                    };
-                }
+            for (i, hit) in hits.iter_mut().enumerate().take(count) {
+                let ray = &slots[c + i].st.ray;
+                *hit = match tr.traversal {
+                    None => geometry.intersect(ray),
+                    Some(t) => geometry.intersect_tallied(ray, t),
+                };
             }
             for (i, hit) in hits.iter().enumerate().take(count) {
                 if let Some(h) = hit {
