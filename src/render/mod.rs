@@ -290,17 +290,10 @@ pub fn render_until(
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
 ) -> Rendered {
-    let t = match &scene.shader {
-        // The paths of a tile's pixels in waves.
-        Shader::Path(p) if waves::applies(scene) => {
-            let tile = |pixels: &[(u32, u32)], stats: &mut RayStats, _: &mut ()| {
-                let (spp, mut sums) = (scene.film.spp, vec![RgbSum::default(); pixels.len()]);
-                waves::sums(scene, pixels, 0..spp, p, stats, &mut sums);
-                sums.iter().map(|s| s.mean(spp as u64)).collect()
-            };
-            by_tile_pixels(scene, on_tile, stop, tile, |()| {})
-        }
-        _ => by_tiles(scene, on_tile, stop, |col, row, stats| {
+    let spp = scene.film.spp;
+    let t = match in_waves(scene, 0..spp, on_tile, stop, |s| s.mean(spp as u64)) {
+        Some(t) => t,
+        None => by_tiles(scene, on_tile, stop, |col, row, stats| {
             render_pixel(scene, col, row, stats)
         }),
     };
@@ -336,20 +329,34 @@ pub fn render_pass(
         samples.end,
         scene.film.spp
     );
-    if let Shader::Path(p) = &scene.shader
-        && waves::applies(scene)
-    {
-        // The paths of a tile's pixels in waves.
-        let tile = |pixels: &[(u32, u32)], stats: &mut RayStats, _: &mut ()| {
-            let mut sums = vec![RgbSum::default(); pixels.len()];
-            waves::sums(scene, pixels, samples.clone(), p, stats, &mut sums);
-            sums
-        };
-        return by_tile_pixels(scene, on_tile, stop, tile, |()| {});
+    if let Some(t) = in_waves(scene, samples.clone(), on_tile, stop, |s| s) {
+        return t;
     }
     by_tiles(scene, on_tile, stop, |col, row, stats| {
         pixel_sum(scene, col, row, samples.clone(), stats)
     })
+}
+
+/// `each` of the exact sum of the samples `samples` of every pixel, each tile's paths traced
+/// in waves ([`waves::sums`]); `None` where the waves do not apply.
+fn in_waves<T: Clone + Default + Send>(
+    scene: &RenderScene,
+    samples: std::ops::Range<u32>,
+    on_tile: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+    each: impl Fn(RgbSum) -> T + Sync,
+) -> Option<Tiled<T>> {
+    let Shader::Path(p) = &scene.shader else {
+        return None;
+    };
+    if !waves::applies(scene) {
+        return None;
+    }
+    let tile = |pixels: &[(u32, u32)], stats: &mut RayStats, _: &mut ()| {
+        let sums = waves::sums(scene, pixels, samples.clone(), p, stats);
+        sums.into_iter().map(&each).collect()
+    };
+    Some(by_tile_pixels(scene, on_tile, stop, tile, |()| {}))
 }
 
 /// Per-pixel values of a tiled render (a pass's exact sums, for [`render_pass`]).

@@ -195,9 +195,9 @@ fn a_replay_adds_what_the_render_added() {
     }
 }
 
-/// A render traces each pixel's camera rays in groups of up to `MAX_LANES` samples
-/// (`render::pixel_sum`): in packets where every primitive is in the BVH, in lanes where none
-/// is. Every sample still adds what its replay (one ray at a time) adds, whatever range of
+/// Outside Path's waves, a render traces each pixel's camera rays in groups of up to
+/// `MAX_LANES` samples (`render::pixel_sum`): in packets where every primitive is in the BVH,
+/// in lanes where none is. Every sample still adds what its replay (one ray at a time) adds, whatever range of
 /// samples a pass starts and ends at, with the same ray counts.
 #[test]
 fn groups_of_camera_rays_add_what_each_sample_alone_adds() {

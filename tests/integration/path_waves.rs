@@ -1,7 +1,8 @@
 //! Path's samples in waves (src/render/waves.rs, src/shader/path/lanes.rs): where they apply,
-//! every pixel is the one-ray render's to the bit, with the same ray counts, over the
-//! strategies the lanes shade (one light by power or by importance, or all; BRDF or cosine
-//! sampling), Russian roulette
+//! every pixel is the one-ray render's to the bit, with the same ray counts, a pixel alone or
+//! a tile's pixels in one wave, over the strategies the lanes shade (one light by power or by
+//! importance, or all; BRDF or cosine sampling; area lights sampled, left to BRDF-sampled rays
+//! or both under MIS, among packed primitives and in a BVH), Russian roulette
 //! from the first bounce, a depth limit, the effects that end or skip work, lights inside and
 //! outside the planes' room, and the materials the lanes leave to the one-ray code (glossy
 //! Phong, mirror, glass, a black surface).
@@ -62,7 +63,7 @@ fn triangle_box(shader: &str, effects: &str, point: bool) -> String {
         );
     }
     assert!(
-        text.contains(shader) && text.contains("spp: 150"),
+        text.contains(shader) && text.contains("spp: 150") && text.contains("Point(") == point,
         "mitsuba-cornell.ron changed"
     );
     text
@@ -80,8 +81,8 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
         let s = &s;
         assert!(s.film.spp as usize > 2 * waves::WAVE);
         let (mut waved, mut alone) = (RayStats::default(), RayStats::default());
-        let mut pixels = Vec::new();
-        let mut first = Vec::new();
+        let (mut pixels, mut first) = (Vec::new(), Vec::new());
+        let mut first_stats = RayStats::default();
         for row in 0..s.film.height {
             for col in 0..s.film.width {
                 let mut ranges = vec![0..21, 5..17];
@@ -93,6 +94,9 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
                     let mut want = RgbSum::default();
                     for k in samples.clone() {
                         want += render_sample(s, col, row, k, &mut alone);
+                        if samples == (0..21) {
+                            render_sample(s, col, row, k, &mut first_stats);
+                        }
                     }
                     assert_eq!(got, want, "{what} ({isa:?}): pixel {col},{row}");
                     if samples == (0..21) {
@@ -107,9 +111,10 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
         let Shader::Path(p) = &s.shader else {
             panic!("{what}: the waves are the path tracer's")
         };
-        let (mut tiled, mut sums) = (RayStats::default(), vec![RgbSum::default(); pixels.len()]);
-        waves::sums(s, &pixels, 0..21, p, &mut tiled, &mut sums);
+        let mut tiled = RayStats::default();
+        let sums = waves::sums(s, &pixels, 0..21, p, &mut tiled);
         assert_eq!(sums, first, "{what} ({isa:?}): a tile's pixels");
+        assert_eq!(tiled, first_stats, "{what} ({isa:?}): a tile's ray counts");
         // (Without point lights, BRDF sampling alone traces no shadow ray.)
         let no_shadows = what.contains("shadows: false")
             || (what.contains("lights: Brdf") && what.contains("point light false"));
@@ -200,23 +205,43 @@ fn waves_give_the_one_ray_pixels_with_area_lights() {
     let shader = "Path(rr_depth: 1, sampling: Brdf, lights: Mis, lights_per_vertex: One)";
     let mixed = lit_room(shader, "").replace(
         "entities: [",
-        "entities: [\n            (shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, 0.2, -0.8)], faces: [(0, 1, 2)]), material: Phong(kd: (0.4, 0.5, 0.6))),",
+        "entities: [\n            (shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, 0.2, -0.8)], faces: [(0, 1, 2)]), material: Phong(kd: (0.4, 0.5, 0.6))),
+            (shape: TriangleMesh(vertices: [(1.5, -0.9, -1), (1.5, 0.5, -1), (1.2, -0.9, 0.5)], faces: [(0, 1, 2)], normals: [(-0.9, 0.1, 0.3), (-0.8, 0, 0.5), (-1, 0.2, 0)]), material: Phong(kd: (0.6, 0.5, 0.4))),
+            (shape: Rectangle(corner: (-1.5, 1.3, -1), u: (0.3, 0, 0), v: (0, 0, 0.3)), emitter: (radiance: Checkerboard(color0: (0.9, 0.8, 0.7), color1: (0.1, 0.2, 0.3)))),",
     );
+    assert!(mixed.contains("normals:"), "room() changed");
     let s = rtis::extract(&scene(&mixed));
     assert!(!s.geometry.bvh.is_empty());
-    agrees(&s, "sphere light, mesh");
+    // (A smooth triangle, and a textured rectangle light, among them.)
+    agrees(&s, "sphere light, meshes, textured light");
     let shader = "Path(rr_depth: 1, sampling: Brdf, lights: Mis, lights_per_vertex: All)";
     let course = lit_room(shader, "").replace("model: Physical", "model: Course");
+    assert!(course.contains("model: Course"));
     agrees(&rtis::extract(&scene(&course)), "sphere light, Course");
     let course = triangle_box(shader, "", true).replace("model: Physical", "model: Course");
+    assert!(course.contains("model: Course"));
     agrees(&rtis::extract(&scene(&course)), "box, Course");
-    for effects in ["indirect: false", "shadows: false", "emission: false"] {
-        let shader = "Path(rr_depth: 2, sampling: Brdf, lights: Mis, lights_per_vertex: One)";
-        agrees(&rtis::extract(&scene(&lit_room(shader, effects))), effects);
-        agrees(
-            &rtis::extract(&scene(&triangle_box(shader, effects, true))),
-            effects,
-        );
+    let cosine = "Path(max_depth: 3, rr_depth: 1, sampling: Cosine, lights: Mis)";
+    let course = lit_room(cosine, "").replace("model: Physical", "model: Course");
+    agrees(
+        &rtis::extract(&scene(&course)),
+        "sphere light, Course, cosine",
+    );
+    for (effects, lights) in [
+        ("indirect: false", "Mis"),
+        ("indirect: false", "Brdf"),
+        ("shadows: false", "Mis"),
+        ("emission: false", "Mis"),
+    ] {
+        for per_vertex in ["One", "All"] {
+            let shader = format!(
+                "Path(rr_depth: 2, sampling: Brdf, lights: {lights}, lights_per_vertex: {per_vertex})"
+            );
+            let what = format!("{shader}, {effects}");
+            agrees(&rtis::extract(&scene(&lit_room(&shader, effects))), &what);
+            let text = triangle_box(&shader, effects, true);
+            agrees(&rtis::extract(&scene(&text)), &what);
+        }
     }
 }
 

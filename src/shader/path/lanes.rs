@@ -7,12 +7,13 @@
 //!
 //! Every lane computes what [`super::step`] computes for its path, operation for operation
 //! (`Interaction::new`, `Origins`, `PointLight::incident`, `Phong::brdf` and
-//! `surface::light_ray` and `light_weighted`, which it calls lane by lane,
 //! `Phong::course_reflectance`, `reflectance`,
 //! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
 //! draws its random numbers from its own stream in the same order (the draws, the light choice
 //! and `sin_cos` run lane by lane), so each path adds the same contributions and goes on with the
-//! same ray, to the bit (`tests/integration/path_waves.rs`).
+//! same ray, to the bit (`tests/integration/path_waves.rs`). An area-light sample runs the
+//! scalar code lane by lane (`surface::sample_area_light`, `light_ray` on
+//! `Interaction::flat`, and, once its shadow ray has been tested in lanes, `light_weighted`).
 
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
@@ -46,7 +47,7 @@ pub struct PathSlot<R> {
 /// textures: BRDF or cosine sampling (under either model), point lights and area lights (no
 /// environment, no spot or directional light; every point light and one area-light sample per
 /// vertex, or under the Physical model one light chosen by power or by importance), no
-/// textures.
+/// material textures (an emitter's radiance may have one).
 pub fn applies(
     p: &Path,
     lights: &[Light],
@@ -381,7 +382,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
     let mis = (lights == LightSampling::Mis && tr.effects.indirect).then_some(p.sampling);
     let sample_area = lights != LightSampling::Brdf || !tr.effects.indirect;
     // Each lane's area-light sample and the chance of its light, if it drew one.
-    let mut area = AreaRays::new();
+    let mut area = AreaRays::default();
     let nee = if p.one_light_under(tr.model) {
         // The choice, lane by lane: `u` picks the light (by importance: `u`'s place within
         // the point lights' share, with the point and normal of the lane's vertex);
@@ -414,10 +415,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
                 Some(Chosen::Point(j, w)) => Some((j, w)),
                 // An area light: its sample, for the shadow rays of the lanes' area lights.
                 Some(Chosen::Area(light, pmf)) if sample_area && tr.effects.emission => {
-                    if let (Some(hit), Some((m, phong))) = (&at.hits[i], &at.materials[i]) {
-                        let vertex = (hit, slots[i].st.ray.d);
-                        area.sample(tr, i, vertex, (*m, phong), (light, pmf), u12);
-                    }
+                    area.sample(tr, at, i, slots[i].st.ray.d, (light, pmf), u12);
                     None
                 }
                 _ => None,
@@ -466,7 +464,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
         ]
     } else {
         // `point_lights`: the terms summed from zero in the lights' order, then the area
-        // lights' share (none here) added.
+        // lights' sample added.
         let mut sum = [zero; 3];
         for l in tr.lights {
             let Light::Point(l) = l else { continue };
@@ -498,11 +496,8 @@ unsafe fn shade_in<L: Floats, R: Record>(
                 let u12 = s.next_2d();
                 // (No environment light in the waves' scenes, and the point lights take no
                 // part in this choice.)
-                if let Some(Chosen::Area(light, pmf)) = tr.emitters.choose_any(u)
-                    && let (Some(hit), Some((m, phong))) = (&at.hits[i], &at.materials[i])
-                {
-                    let vertex = (hit, slots[i].st.ray.d);
-                    area.sample(tr, i, vertex, (*m, phong), (light, pmf), u12);
+                if let Some(Chosen::Area(light, pmf)) = tr.emitters.choose_any(u) {
+                    area.sample(tr, at, i, slots[i].st.ray.d, (light, pmf), u12);
                 }
             }
         }
@@ -629,12 +624,18 @@ unsafe fn shade_in<L: Floats, R: Record>(
     }
 }
 
-/// The lanes' area-light samples, a column per coordinate: the lanes that drew one, those
-/// whose sample has a shadow ray to test (`light_ray`), the rays, and each sample's direction,
-/// radiance and density.
+/// The lanes' area-light samples: the lanes that drew one, those whose sample has a shadow
+/// ray to test (`light_ray`), and their columns, made at the first sample.
+#[derive(Default)]
 struct AreaRays {
     lanes: u32,
     tested: u32,
+    columns: Option<AreaColumns>,
+}
+
+/// The samples' shadow rays, directions, radiances and densities, a column per coordinate.
+#[derive(Default)]
+struct AreaColumns {
     ray: [[f32; MAX_LANES]; 8],
     wi: [[f32; MAX_LANES]; 3],
     le: [[f32; MAX_LANES]; 3],
@@ -642,46 +643,38 @@ struct AreaRays {
 }
 
 impl AreaRays {
-    /// No samples.
-    fn new() -> Self {
-        AreaRays {
-            lanes: 0,
-            tested: 0,
-            ray: [[0.0; MAX_LANES]; 8],
-            wi: [[0.0; MAX_LANES]; 3],
-            le: [[0.0; MAX_LANES]; 3],
-            pdf: [0.0; MAX_LANES],
-        }
-    }
-
-    /// Lane `i` samples area light `light`, chosen with probability `pmf`, from the random
-    /// numbers `u` (`area_sample`) at its vertex `hit`, met by a ray of direction `d`, on a
-    /// surface of diffuse `material` (number `m` of `tr`'s).
+    /// Lane `i` of `at` (a shaded lane, whose ray has direction `d`) samples area light
+    /// `light`, chosen with probability `pmf`, from the random numbers `u` (`area_sample`).
     #[inline(always)]
-    fn sample(
+    fn sample<L>(
         &mut self,
         tr: &Tracer,
+        at: &Vertices<L>,
         i: usize,
-        (hit, d): (&Hit, Vec3A),
-        (m, material): (u32, &Phong),
+        d: Vec3A,
         (light, pmf): (&AreaLight, f32),
         u: (f32, f32),
     ) {
         self.lanes |= 1 << i;
+        let (Some(hit), Some((m, phong))) = (&at.hits[i], &at.materials[i]) else {
+            // (A shaded lane has both: `round_in` sets them with its bit.)
+            return;
+        };
         let Some(ls) = sample_area_light(tr.emitters, light, hit.p, u) else {
             return;
         };
-        let si = Interaction::flat(*hit, d, &tr.materials[m as usize]);
-        let Some((r, pdf)) = light_ray(&si, material, &ls, pmf) else {
+        let si = Interaction::flat(*hit, d, &tr.materials[*m as usize]);
+        let Some((r, pdf)) = light_ray(&si, phong, &ls, pmf) else {
             return;
         };
+        let c = self.columns.get_or_insert_with(Default::default);
         for x in 0..3 {
-            self.ray[x][i] = r.o[x];
-            self.ray[3 + x][i] = r.d[x];
-            self.wi[x][i] = ls.wi[x];
-            self.le[x][i] = ls.le[x];
+            c.ray[x][i] = r.o[x];
+            c.ray[3 + x][i] = r.d[x];
+            c.wi[x][i] = ls.wi[x];
+            c.le[x][i] = ls.le[x];
         }
-        (self.ray[6][i], self.ray[7][i], self.pdf[i]) = (r.o_err, r.t_max, pdf);
+        (c.ray[6][i], c.ray[7][i], c.pdf[i]) = (r.o_err, r.t_max, pdf);
         self.tested |= 1 << i;
     }
 
@@ -706,10 +699,13 @@ impl AreaRays {
         if self.lanes == 0 {
             return [zero; 3];
         }
-        // The shadow rays, in lanes.
-        let mut blocked = 0u32;
-        if tr.effects.shadows && self.tested != 0 {
-            let load = |row: usize| unsafe { L::from_slice(&self.ray[row]) };
+        // The shadow rays, in lanes (the columns are there if a lane has one).
+        let (mut blocked, c) = (0u32, self.columns.as_ref());
+        if let Some(c) = c
+            && tr.effects.shadows
+            && self.tested != 0
+        {
+            let load = |row: usize| unsafe { L::from_slice(&c.ray[row]) };
             let segments = (
                 [load(0), load(1), load(2)],
                 [load(3), load(4), load(5)],
@@ -717,10 +713,9 @@ impl AreaRays {
                 load(7),
             );
             let live = unsafe { mask::<L>(self.tested) };
-            let hidden = match tr.traversal {
-                None => tr.geometry.occluded_lanes(segments, true, live, &()),
-                Some(t) => tr.geometry.occluded_lanes(segments, true, live, t),
-            };
+            let hidden = tr
+                .geometry
+                .occluded_lanes(segments, true, live, &tr.traversal);
             blocked = L::bitmask(hidden);
             tr.count_shadow_lanes(segments, self.tested);
         }
@@ -729,11 +724,11 @@ impl AreaRays {
         let mut term = [[0.0f32; MAX_LANES]; 3];
         for i in Bits(self.lanes) {
             let mut l = Vec3A::ZERO;
-            if let Some((_, phong)) = &at.materials[i]
+            if let (Some((_, phong)), Some(c)) = (&at.materials[i], c)
                 && self.tested & !blocked & (1 << i) != 0
             {
-                let at = |c: &[[f32; MAX_LANES]; 3]| Vec3A::new(c[0][i], c[1][i], c[2][i]);
-                let sample = (at(&self.wi), at(&self.le), self.pdf[i]);
+                let at = |v: &[[f32; MAX_LANES]; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
+                let sample = (at(&c.wi), at(&c.le), c.pdf[i]);
                 l = light_weighted(tr.model, (at(&wo), at(&n)), phong, sample, mis);
             }
             if summed {
@@ -837,8 +832,8 @@ unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Sur
         let mut blocked = zero.cmpne(zero);
         for (planes, part) in [(false, lit & room), (true, lit & !room)] {
             if L::any(part) {
-                blocked =
-                    blocked | geometry.occluded_lanes((o, wi, o_err, t_max), planes, part, &());
+                blocked = blocked
+                    | geometry.occluded_lanes((o, wi, o_err, t_max), planes, part, &tr.traversal);
             }
         }
         seen = lit & !blocked;
