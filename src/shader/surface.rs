@@ -616,7 +616,7 @@ fn light_term<L: Lobe>(
     light_weighted(tr.model, (si.wo, si.n), lobe, (ls.wi, ls.le, pdf), mis)
 }
 
-/// The first half of [`light_term`]: the shadow ray of light sample `ls` (chosen with
+/// The first half of `light_term`: the shadow ray of light sample `ls` (chosen with
 /// probability `pmf`), which stops just short of the sampled point, and the sample's density
 /// `pmf pdf`; `None` where the term is zero whatever the ray meets (no radiance, a direction
 /// below a surface that does not transmit, no density).
@@ -638,7 +638,7 @@ pub fn light_ray<L: Lobe>(
     Some((si.origins.ray(ls.wi, ls.dist * SHADOW_END), pdf))
 }
 
-/// The second half of [`light_term`], for a sample whose shadow ray met nothing, at a vertex
+/// The second half of `light_term`, for a sample whose shadow ray met nothing, at a vertex
 /// seen from `wo` with shading normal `n`: `L_e r w / pdf` for the sample's direction `wi`,
 /// radiance `le` and density `pdf` ([`light_ray`]'s), `w` the power heuristic's weight against
 /// BRDF sampling under `mis` (else 1).
