@@ -94,6 +94,20 @@ pub fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
     a
 }
 
+/// The lanes of the bits of `bits` as a mask.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+pub unsafe fn lane_mask<L: Floats>(bits: u32) -> L::Mask {
+    let mut f = [0.0f32; MAX_LANES];
+    for (i, x) in f.iter_mut().enumerate() {
+        *x = if bits & (1 << i) != 0 { 1.0 } else { 0.0 };
+    }
+    // SAFETY: the caller's.
+    unsafe { L::from_array(f) }.cmpne(unsafe { L::splat(0.0) })
+}
+
 /// Where rays leave the hits of the lanes, `crate::geometry::Origins::new` lane by lane: the
 /// hit points `p` moved off their surfaces (unit geometric normals `n`) by the error bound
 /// `err` projected on the normal, to the front and to the back, and the origins' error bound

@@ -125,11 +125,7 @@ impl Tracer<'_> {
         let Some(audit) = self.audit else {
             return;
         };
-        let column = |x: L| {
-            let mut v = [0.0f32; crate::accel::MAX_LANES];
-            x.write_to(&mut v);
-            v
-        };
+        let column = crate::accel::lanes::array::<L>;
         let (o, d) = (o.map(column), d.map(column));
         let (o_err, t_max) = (column(o_err), column(t_max));
         let mut bits = mask;

@@ -17,7 +17,7 @@
 
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
-use crate::accel::lanes::{RayLanes, array, dot, origins};
+use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
 use crate::light::{AreaLight, Chosen, Emitters, Light, NO_LIGHT, choose_by_importance};
@@ -229,8 +229,6 @@ unsafe fn round_in<L: Floats, R: Record>(
                     None => geometry.intersect(ray),
                     Some(t) => geometry.intersect_tallied(ray, t),
                 };
-            }
-            for (i, hit) in hits.iter().enumerate().take(count) {
                 if let Some(h) = hit {
                     for x in 0..3 {
                         rows[x][i] = h.p[x];
@@ -338,7 +336,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
     // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block below,
     // each makes values of `L`.
     let (zero, one) = unsafe { (L::splat(0.0), L::splat(1.0)) };
-    let live = unsafe { mask::<L>(shaded) };
+    let live = unsafe { lane_mask::<L>(shaded) };
     // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal), and
     // `Origins::new`: the point moved off the surface by its error's projection on the
     // normal, to either side, with the origins' error bound.
@@ -456,7 +454,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
         };
         // The lanes that chose an area light take its term.
         let term = unsafe { area.terms(tr, at, (wo, n), mis, false) };
-        let lanes = unsafe { mask::<L>(area.lanes) };
+        let lanes = unsafe { lane_mask::<L>(area.lanes) };
         [
             L::select(lanes, term[0], point[0]),
             L::select(lanes, term[1], point[1]),
@@ -712,7 +710,7 @@ impl AreaRays {
                 load(6),
                 load(7),
             );
-            let live = unsafe { mask::<L>(self.tested) };
+            let live = unsafe { lane_mask::<L>(self.tested) };
             let hidden = tr
                 .geometry
                 .occluded_lanes(segments, true, live, &tr.traversal);
@@ -800,7 +798,7 @@ unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Sur
     let (zero, inf, end) =
         unsafe { (L::splat(0.0), L::splat(f32::INFINITY), L::splat(SHADOW_END)) };
     let (p, nh, n, front, back, o_err, f) = (at.p, at.nh, at.n, at.front, at.back, at.o_err, at.f);
-    let lanes = at.live & unsafe { mask::<L>(light.lanes) };
+    let lanes = at.live & unsafe { lane_mask::<L>(light.lanes) };
     // `PointLight::incident`: the unit direction, the distance and `I / d^2`.
     let to = [
         light.pos[0] - p[0],
@@ -827,7 +825,7 @@ unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Sur
             L::select(side, front[2], back[2]),
         ];
         let t_max = dist * end;
-        let room = unsafe { mask::<L>(light.room) };
+        let room = unsafe { lane_mask::<L>(light.room) };
         let geometry: &Geometry = tr.geometry;
         let mut blocked = zero.cmpne(zero);
         for (planes, part) in [(false, lit & room), (true, lit & !room)] {
@@ -851,18 +849,4 @@ unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Sur
         L::select(seen, li[1] * r[1], zero),
         L::select(seen, li[2] * r[2], zero),
     ]
-}
-
-/// The lanes of `bits` as a mask.
-///
-/// # Safety
-/// The CPU must run `L`'s instruction set.
-#[inline(always)]
-unsafe fn mask<L: Floats>(bits: u32) -> L::Mask {
-    let mut f = [0.0f32; MAX_LANES];
-    for (i, x) in f.iter_mut().enumerate() {
-        *x = if bits & (1 << i) != 0 { 1.0 } else { 0.0 };
-    }
-    // SAFETY: the caller's.
-    unsafe { L::from_array(f) }.cmpne(unsafe { L::splat(0.0) })
 }

@@ -20,7 +20,7 @@
 
 use super::{LightLanes, Scratch, point_sums};
 use crate::accel::Tally;
-use crate::accel::lanes::{RayLanes, array, dot, origins};
+use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins};
 use crate::accel::{Floats, Isa, MAX_LANES};
 use crate::geometry::{Hit, Origins, Ray};
 use crate::light::NO_LIGHT;
@@ -440,10 +440,6 @@ unsafe fn chunk<L: Floats>(
     // nothing).
     let mut point = [[0.0f32; MAX_LANES]; 3];
     if lit_lanes != 0 {
-        let mut filled = [0.0f32; MAX_LANES];
-        for (i, f) in filled.iter_mut().enumerate() {
-            *f = if lit_lanes & (1 << i) != 0 { 1.0 } else { 0.0 };
-        }
         let h = LightLanes {
             p,
             n: ns,
@@ -452,7 +448,7 @@ unsafe fn chunk<L: Floats>(
             back,
             kd: kd_l,
             o_err,
-            filled: unsafe { L::from_array(filled) }.cmpne(zero),
+            filled: unsafe { lane_mask::<L>(lit_lanes) },
             scalar: lit_lanes & !lambert,
         };
         let (model, slots) = (tr.model, &s.slots);
