@@ -176,7 +176,7 @@ impl AreaLight {
                     let sin_max = sin2_max.sqrt();
                     let cos_a = sin2 / sin_max + cos_t * (1.0 - sin2 / sin2_max).max(0.0).sqrt();
                     let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
-                    let (sin_p, cos_p) = (TAU * u2).sin_cos();
+                    let (sin_p, cos_p) = crate::sampling::sin_cos_turns(u2);
                     let frame = crate::geometry::Frame::from_normal(-f / d2.sqrt());
                     let n = frame
                         .to_world(Vec3A::new(sin_a * cos_p, sin_a * sin_p, cos_a))

@@ -110,7 +110,7 @@ impl EnvironmentLight {
             Sky::Map { map: m, .. } => {
                 let ((u, v), pdf_uv) = m.sample(u1, u2)?;
                 let (sin_t, cos_t) = (v * PI).sin_cos();
-                let (sin_p, cos_p) = (u * TAU).sin_cos();
+                let (sin_p, cos_p) = crate::sampling::sin_cos_turns(u);
                 if sin_t <= 0.0 {
                     return None;
                 }

@@ -3,6 +3,7 @@
 //! Each warp returns a direction in the local frame (z = normal); use
 //! [`crate::geometry::Frame`] to take it to world space.
 
+use super::sin_cos_turns;
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
@@ -11,7 +12,7 @@ use std::f32::consts::{FRAC_1_PI, PI, TAU};
 pub fn uniform(u1: f32, u2: f32) -> Vec3A {
     let cos_t = u1;
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    let (sin_p, cos_p) = (TAU * u2).sin_cos();
+    let (sin_p, cos_p) = sin_cos_turns(u2);
     Vec3A::new(sin_t * cos_p, sin_t * sin_p, cos_t)
 }
 
@@ -23,7 +24,7 @@ pub const UNIFORM_PDF: f32 = 1.0 / TAU;
 #[inline]
 pub fn cosine(u1: f32, u2: f32) -> Vec3A {
     let r = u1.sqrt();
-    let (sin_p, cos_p) = (TAU * u2).sin_cos();
+    let (sin_p, cos_p) = sin_cos_turns(u2);
     let (x, y) = (r * cos_p, r * sin_p);
     Vec3A::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt())
 }
@@ -40,7 +41,7 @@ pub fn cosine_pdf(cos_theta: f32) -> f32 {
 pub fn phong_lobe(u1: f32, u2: f32, s: f32) -> Vec3A {
     let cos_a = u1.powf(1.0 / (s + 1.0));
     let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
-    let (sin_p, cos_p) = (TAU * u2).sin_cos();
+    let (sin_p, cos_p) = sin_cos_turns(u2);
     Vec3A::new(sin_a * cos_p, sin_a * sin_p, cos_a)
 }
 

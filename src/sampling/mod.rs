@@ -7,6 +7,7 @@ pub mod hemisphere;
 mod pixel;
 mod rng;
 mod strategy;
+pub mod trig;
 pub mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
@@ -15,3 +16,4 @@ pub use filter::PixelFilter;
 pub use pixel::pixel_sample;
 pub use rng::{Sampler, mix};
 pub use strategy::{LightSampling, LightsPerVertex, Sampling, power_heuristic};
+pub use trig::sin_cos_turns;

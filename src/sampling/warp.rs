@@ -2,14 +2,13 @@
 //! directions, a triangle and a disk, each uniform in its own measure.
 
 use glam::Vec3A;
-use std::f32::consts::TAU;
 
 /// Uniform direction on the unit sphere: `z = 1 - 2 u1`, `phi = 2 pi u2`. Density `1 / (4 pi)`.
 #[inline]
 pub fn uniform_sphere(u1: f32, u2: f32) -> Vec3A {
     let z = 1.0 - 2.0 * u1;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let (sin_p, cos_p) = (TAU * u2).sin_cos();
+    let (sin_p, cos_p) = super::sin_cos_turns(u2);
     Vec3A::new(r * cos_p, r * sin_p, z)
 }
 

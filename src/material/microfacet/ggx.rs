@@ -3,7 +3,6 @@
 //! for the anisotropic form).
 
 use glam::Vec3A;
-use std::f32::consts::TAU;
 
 /// `D` without its factor `1 / (pi ax ay cos^4(theta_m))`, from the scaled squared slope `e`.
 #[inline]
@@ -39,10 +38,9 @@ pub(super) fn sample_visible(w: Vec3A, ax: f32, ay: f32, u1: f32, u2: f32) -> Ve
     // The viewer in the unit-roughness configuration.
     let wh = Vec3A::new(ax * w.x, ay * w.y, w.z).normalize();
     // A uniform point of the cap: `z` uniform on [-wh.z, 1], `phi` uniform.
-    let phi = TAU * u1;
     let z = (1.0 - u2) * (1.0 + wh.z) - wh.z;
     let sin_t = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
-    let (sin_p, cos_p) = phi.sin_cos();
+    let (sin_p, cos_p) = crate::sampling::sin_cos_turns(u1);
     let h = Vec3A::new(sin_t * cos_p, sin_t * sin_p, z) + wh;
     // Back to the rough configuration (normals stretch like the viewer here).
     Vec3A::new(ax * h.x, ay * h.y, h.z.max(0.0)).normalize()

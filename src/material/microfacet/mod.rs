@@ -151,7 +151,7 @@ impl Microfacet {
                     Distribution::Ggx => ggx::slope_radius2(u1),
                     Distribution::Beckmann => beckmann::slope_radius2(u1),
                 };
-                let (sin_p, cos_p) = (std::f32::consts::TAU * u2).sin_cos();
+                let (sin_p, cos_p) = crate::sampling::sin_cos_turns(u2);
                 let r = r2.sqrt();
                 from_slopes(ax * r * cos_p, ay * r * sin_p)
             }
