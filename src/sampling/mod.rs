@@ -14,6 +14,6 @@ pub use distribution::{Distribution1D, Distribution2D};
 pub use erf::erf_inv;
 pub use filter::PixelFilter;
 pub use pixel::pixel_sample;
-pub use rng::{Sampler, mix};
+pub use rng::{Sampler, Streams, mix};
 pub use strategy::{LightSampling, LightsPerVertex, Sampling, power_heuristic};
 pub use trig::sin_cos_turns;

@@ -1,14 +1,48 @@
 //! The per-pixel random number generator.
 
-use rand_core::Rng;
-use rand_pcg::Pcg32;
-
 /// A deterministic stream of uniform numbers for one (scene seed, pixel, sample) triple.
 ///
 /// The stream depends only on that triple, never on which thread renders the pixel or in which
-/// order tiles run, so renders are bit-identical for any thread count.
+/// order tiles run, so renders are bit-identical for any thread count. The generator is
+/// O'Neill's PCG32 (XSH RR 64/32: "PCG: A Family of Simple Fast Space-Efficient Statistically
+/// Good Algorithms for Random Number Generation", 2014), the numbers of `rand_pcg::Pcg32`;
+/// [`Streams`] draws several of them side by side.
+#[derive(Clone, Copy, Debug)]
 pub struct Sampler {
-    rng: Pcg32,
+    /// The LCG's state.
+    state: u64,
+    /// The LCG's increment (odd): which of PCG32's streams.
+    inc: u64,
+}
+
+/// PCG32's LCG multiplier (Knuth's MMIX constant).
+const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
+
+/// The LCG's next state: `state a + inc (mod 2^64)`.
+#[inline(always)]
+fn step(state: u64, inc: u64) -> u64 {
+    state.wrapping_mul(MULTIPLIER).wrapping_add(inc)
+}
+
+/// PCG32's output of a state, XSH RR: the high bits xorshifted, then rotated by the top five.
+#[inline(always)]
+fn output(state: u64) -> u32 {
+    let rot = (state >> 59) as u32;
+    let xsh = (((state >> 18) ^ state) >> 27) as u32;
+    xsh.rotate_right(rot)
+}
+
+/// `next_f32` of 32 random bits: the top 24 on a grid of `2^-24`.
+#[inline(always)]
+fn to_f32(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+/// `next_f64` of two draws: 53 bits on a grid of `2^-53`.
+#[inline(always)]
+fn to_f64(a: u32, b: u32) -> f64 {
+    let bits = ((a as u64) << 21) ^ (b as u64 >> 11);
+    bits as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// SplitMix64's finaliser: a bijective 64-bit mix.
@@ -23,23 +57,39 @@ impl Sampler {
     /// The stream for sample `sample` of pixel `pixel` (row-major index) under `seed`.
     pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
         let state = mix(mix(mix(seed) ^ pixel) ^ sample.rotate_left(32));
+        Sampler::pcg32(state, 0x0a02_bdbf_7bb3_c0a7)
+    }
+
+    /// PCG32 seeded as its reference `pcg32_srandom_r(initstate, initseq)` seeds it (and
+    /// `rand_pcg::Pcg32::new`).
+    fn pcg32(initstate: u64, initseq: u64) -> Self {
+        let inc = (initseq << 1) | 1;
         Sampler {
-            rng: Pcg32::new(state, 0x0a02_bdbf_7bb3_c0a7),
+            state: step(initstate.wrapping_add(inc), inc),
+            inc,
         }
+    }
+
+    /// 32 random bits.
+    #[inline]
+    pub fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = step(old, self.inc);
+        output(old)
     }
 
     /// A uniform number in `[0, 1)` with 24 random bits.
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        (self.rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+        to_f32(self.next_u32())
     }
 
     /// A uniform number in `[0, 1)` with 53 random bits (two draws), for choices among many
     /// options whose probabilities are finer than `next_f32`'s grid of 2^-24.
     #[inline]
     pub fn next_f64(&mut self) -> f64 {
-        let bits = ((self.rng.next_u32() as u64) << 21) ^ (self.rng.next_u32() as u64 >> 11);
-        bits as f64 * (1.0 / (1u64 << 53) as f64)
+        let a = self.next_u32();
+        to_f64(a, self.next_u32())
     }
 
     /// Two uniform numbers in `[0, 1)`.
@@ -51,6 +101,112 @@ impl Sampler {
     /// A uniform integer in `[0, n)` for `n > 0`.
     #[inline]
     pub fn next_below(&mut self, n: u32) -> u32 {
-        ((self.rng.next_u32() as u64 * n as u64) >> 32) as u32
+        ((self.next_u32() as u64 * n as u64) >> 32) as u32
+    }
+}
+
+/// Up to [`Streams::MAX`] samplers drawn side by side, lane `i` advancing as sampler `i`'s
+/// own [`Sampler`] methods would: the same numbers, in lanes. Each draw is a loop over fixed
+/// arrays without branches, which the compiler turns into the SIMD instructions of the
+/// function it is inlined in (Path's lanes, `shader::path::lanes`).
+#[derive(Clone, Copy)]
+pub struct Streams {
+    state: [u64; Streams::MAX],
+    inc: [u64; Streams::MAX],
+}
+
+impl Streams {
+    /// The most lanes.
+    pub const MAX: usize = 16;
+
+    /// The streams of `samplers` (at most [`Streams::MAX`]), lane `i` from `samplers[i]`;
+    /// lanes past them hold a stream of their own that nobody reads.
+    #[inline(always)]
+    pub fn load<'a>(samplers: impl Iterator<Item = &'a Sampler>) -> Streams {
+        let mut s = Streams {
+            state: [0; Streams::MAX],
+            inc: [1; Streams::MAX],
+        };
+        for (i, sampler) in samplers.take(Streams::MAX).enumerate() {
+            (s.state[i], s.inc[i]) = (sampler.state, sampler.inc);
+        }
+        s
+    }
+
+    /// Lane `i`'s sampler, where it has got to.
+    #[inline(always)]
+    pub fn sampler(&self, i: usize) -> Sampler {
+        Sampler {
+            state: self.state[i],
+            inc: self.inc[i],
+        }
+    }
+
+    /// [`Sampler::next_u32`] in the first `lanes` lanes.
+    #[inline(always)]
+    pub fn next_u32(&mut self, lanes: usize) -> [u32; Streams::MAX] {
+        let mut out = [0; Streams::MAX];
+        for i in 0..lanes.min(Streams::MAX) {
+            let old = self.state[i];
+            self.state[i] = step(old, self.inc[i]);
+            out[i] = output(old);
+        }
+        out
+    }
+
+    /// [`Sampler::next_f32`] in the first `lanes` lanes.
+    #[inline(always)]
+    pub fn next_f32(&mut self, lanes: usize) -> [f32; Streams::MAX] {
+        self.next_u32(lanes).map(to_f32)
+    }
+
+    /// [`Sampler::next_f64`] in the first `lanes` lanes.
+    #[inline(always)]
+    pub fn next_f64(&mut self, lanes: usize) -> [f64; Streams::MAX] {
+        let (a, b) = (self.next_u32(lanes), self.next_u32(lanes));
+        std::array::from_fn(|i| to_f64(a[i], b[i]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The first outputs of PCG32's reference demo (`pcg32-demo`, seeded with 42 and 54).
+    #[test]
+    fn pcg32_gives_the_reference_numbers() {
+        let mut s = Sampler::pcg32(42, 54);
+        let got: Vec<u32> = (0..6).map(|_| s.next_u32()).collect();
+        assert_eq!(
+            got,
+            [
+                0xa15c02b7, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e
+            ]
+        );
+    }
+
+    /// `Streams` draws each lane's numbers: the samplers' own, lane by lane, in every width.
+    #[test]
+    fn streams_draw_each_samplers_numbers() {
+        for lanes in [4, 8, 16] {
+            let samplers: Vec<Sampler> = (0..lanes).map(|k| Sampler::new(7, k, 3 * k)).collect();
+            let mut streams = Streams::load(samplers.iter());
+            let mut own = samplers.clone();
+            for _ in 0..5 {
+                let (u, x, y) = (
+                    streams.next_u32(lanes as usize),
+                    streams.next_f32(lanes as usize),
+                    streams.next_f64(lanes as usize),
+                );
+                for (i, s) in own.iter_mut().enumerate() {
+                    assert_eq!(u[i], s.next_u32());
+                    assert_eq!(x[i].to_bits(), s.next_f32().to_bits());
+                    assert_eq!(y[i].to_bits(), s.next_f64().to_bits());
+                }
+            }
+            for (i, s) in own.iter().enumerate() {
+                assert_eq!(streams.sampler(i).state, s.state);
+            }
+        }
     }
 }

@@ -22,7 +22,7 @@ use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
 use crate::light::{AreaLight, Chosen, Emitters, Light, NO_LIGHT, choose_by_importance};
 use crate::material::{Material, Model, Phong};
-use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling};
+use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling, Streams};
 use crate::shader::Tracer;
 use crate::shader::record::{Record, Technique};
 use crate::shader::surface::{
@@ -337,6 +337,14 @@ unsafe fn shade_in<L: Floats, R: Record>(
     // each makes values of `L`.
     let (zero, one) = unsafe { (L::splat(0.0), L::splat(1.0)) };
     let live = unsafe { lane_mask::<L>(shaded) };
+    // The paths' random streams, drawn in lanes; the shaded lanes' are written back before
+    // the scalar code draws again (`scatter_diffuse`'s roulette).
+    let mut rng = Streams::load(slots.iter().map(|s| &s.sampler));
+    let keep = |rng: &Streams, slots: &mut [PathSlot<R>]| {
+        for i in Bits(shaded) {
+            slots[i].sampler = rng.sampler(i);
+        }
+    };
     // `Interaction::new`: the normal on the viewer's side (a flat shape's shading normal), and
     // `Origins::new`: the point moved off the surface by its error's projection on the
     // normal, to either side, with the origins' error bound.
@@ -395,10 +403,13 @@ unsafe fn shade_in<L: Floats, R: Record>(
             ),
             false => ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]),
         };
+        let (u, u1, u2) = (
+            rng.next_f64(L::LANES),
+            rng.next_f32(L::LANES),
+            rng.next_f32(L::LANES),
+        );
         for i in Bits(shaded) {
-            let s = &mut slots[i].sampler;
-            let u = s.next_f64();
-            let u12 = s.next_2d();
+            let (u, u12) = (u[i], (u1[i], u2[i]));
             // The light and the factor of its term: `1 / pmf` by power, `1 / (share p)` by
             // importance (a light chosen with a chance below f32's range adds nothing).
             let pick = match tr.emitters.choose_any(u) {
@@ -488,10 +499,13 @@ unsafe fn shade_in<L: Floats, R: Record>(
         // `area_lights` with one sample: the light chosen by power (`u`), a point on it
         // (`u1`, `u2`), its term (zero where none is drawn).
         if sample_area && tr.effects.emission && !tr.emitters.is_empty() {
+            let (u, u1, u2) = (
+                rng.next_f64(L::LANES),
+                rng.next_f32(L::LANES),
+                rng.next_f32(L::LANES),
+            );
             for i in Bits(shaded) {
-                let s = &mut slots[i].sampler;
-                let u = s.next_f64();
-                let u12 = s.next_2d();
+                let (u, u12) = (u[i], (u1[i], u2[i]));
                 // (No environment light in the waves' scenes, and the point lights take no
                 // part in this choice.)
                 if let Some(Chosen::Area(light, pmf)) = tr.emitters.choose_any(u) {
@@ -516,6 +530,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
         }
     }
     if !tr.effects.indirect {
+        keep(&rng, slots);
         for i in Bits(shaded) {
             alive[i] = false;
         }
@@ -524,15 +539,12 @@ unsafe fn shade_in<L: Floats, R: Record>(
     // The next direction: cosine-weighted about the shading normal (`hemisphere::cosine` in
     // the frame of `Frame::from_normal`); its numbers drawn lane by lane.
     let brdf = p.sampling == Sampling::Brdf;
-    let (mut u1, mut u2) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
-    for i in Bits(shaded) {
-        let s = &mut slots[i].sampler;
-        (u1[i], u2[i]) = s.next_2d();
-        if brdf {
-            // `sample_phong` compares a number with the diffuse share, 1 here: the cosine lobe.
-            let _ = s.next_f32();
-        }
+    let (u1, u2) = (rng.next_f32(L::LANES), rng.next_f32(L::LANES));
+    if brdf {
+        // `sample_phong` compares a number with the diffuse share, 1 here: the cosine lobe.
+        rng.next_u32(L::LANES);
     }
+    keep(&rng, slots);
     let (u1, u2) = unsafe { (L::from_array(u1), L::from_array(u2)) };
     let r = u1.sqrt();
     let (sin_p, cos_p) = unsafe { sin_cos_turns(u2) };
