@@ -8,7 +8,7 @@ target/commit-compare/ (kept, so a second run reuses it), then renders --scene w
 
     {"round", "base_s", "head_s", "ratio"}            ratio = base_s / head_s: > 1, this is faster
     {"compare": "head_vs_base", "base", "head", "scene", "width", "rounds",
-     "ratio", "ratio_range", "base_s", "head_s", "same_pixels"}
+     "ratio", "ratio_range", "base_s", "head_s", "same_pixels", "differ"}
 
 How the runs are paired: the machine's speed drifts by tens of percent over minutes, so the
 two binaries run at the same time, one thread each (`--threads 1`), each on its own core of
@@ -16,7 +16,8 @@ the machine; which one starts first alternates between rounds. Each round's rati
 between two runs that saw the same conditions; the summary gives their median and range.
 Times are the renders' own (`rtis render --stats`: from the first pixel to the last, without
 loading and writing). `same_pixels` says whether the two EXR images of the first round are
-identical (their linear pixel values, compared exactly by `rtis diff`: no pixel differs).
+identical (their linear pixel values, compared exactly by `rtis diff`: no pixel differs);
+`differ` gives `rtis diff`'s count of pixels that differ, RMSE and largest error.
 
     python3 bench/commit_compare.py --base e3269bf --scene scenes/cornell-n-bounce.ron --width 360
 """
@@ -102,13 +103,18 @@ def main():
             if same is None:
                 diff = subprocess.run([head, "diff", os.path.join(d, "head.exr"), os.path.join(d, "base.exr")],
                                       cwd=ROOT, capture_output=True, text=True)
-                differ = [l.split() for l in diff.stdout.splitlines() if "pixels that differ" in l]
-                same = diff.returncode == 0 and len(differ) == 1 and differ[0][3] == "0"
+                if diff.returncode != 0:
+                    sys.exit("rtis diff failed: " + diff.stderr)
+                # `rtis diff`'s lines: "RMSE x", "max error x", "pixels that differ n of m".
+                fields = {l.split()[0]: l.split() for l in diff.stdout.splitlines()[1:]}
+                differ = {"pixels": int(fields["pixels"][3]), "rmse": float(fields["RMSE"][1]),
+                          "max_error": float(fields["max"][2])}
+                same = differ["pixels"] == 0
     print(json.dumps({
         "compare": "head_vs_base", "base": base_commit, "head": head_commit, "scene": args.scene,
         "width": args.width, "rounds": args.rounds, "ratio": statistics.median(ratios),
         "ratio_range": [min(ratios), max(ratios)], "base_s": statistics.median(base_s),
-        "head_s": statistics.median(head_s), "same_pixels": same,
+        "head_s": statistics.median(head_s), "same_pixels": same, "differ": differ,
     }))
 
 

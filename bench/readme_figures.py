@@ -534,9 +534,24 @@ def commits(_runs):
         lo, hi = r["ratio_range"]
         lines.append(
             f"| `{scene}` | {width} px wide | {r['base']} | {r['base_s']:.2f} | {r['head']} | {r['head_s']:.2f} | "
-            f"{r['ratio']:.2f}x [{lo:.2f}-{hi:.2f}] | {'yes' if r['same_pixels'] else 'no'} |"
+            f"{r['ratio']:.2f}x [{lo:.2f}-{hi:.2f}] | {same_pixels(r)} |"
         )
-    return "\n".join(lines + ["", stamp(f"`bench/commit_compare.py` ({COMMIT_ROUNDS} rounds, one thread each, the two binaries side by side; medians)")])
+    return "\n".join(lines + ["", SAME_PIXELS_NOTE, "", stamp(f"`bench/commit_compare.py` ({COMMIT_ROUNDS} rounds, one thread each, the two binaries side by side; medians)")])
+
+
+# Why the `commits` block's images may differ from the earlier commit's.
+SAME_PIXELS_NOTE = (
+    "Since 9a6fc42 the warps take the sine and cosine of `2 pi u` from `sampling::sin_cos_turns` "
+    "(plain arithmetic, within 1e-7) instead of libm's `sincosf`, so the two images differ by "
+    "rounding; the last column gives `rtis diff`'s count of differing pixels and the largest difference.")
+
+
+def same_pixels(r):
+    """The `commits` table's last column: "yes", or how much the two images differ."""
+    if r["same_pixels"]:
+        return "yes"
+    d = r["differ"]
+    return f"no: {d['pixels']:,} pixels, largest difference {d['max_error']:.1e}"
 
 
 def build_table(rows):
