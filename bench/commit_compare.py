@@ -17,7 +17,8 @@ between two runs that saw the same conditions; the summary gives their median an
 Times are the renders' own (`rtis render --stats`: from the first pixel to the last, without
 loading and writing). `same_pixels` says whether the two EXR images of the first round are
 identical (their linear pixel values, compared exactly by `rtis diff`: no pixel differs);
-`differ` gives `rtis diff`'s count of pixels that differ, RMSE and largest error.
+`differ` gives `rtis diff`'s count of pixels that differ, RMSE and largest error (printed to
+six decimals: 0 means below 5e-7).
 
     python3 bench/commit_compare.py --base e3269bf --scene scenes/cornell-n-bounce.ron --width 360
 """
@@ -25,6 +26,7 @@ identical (their linear pixel values, compared exactly by `rtis diff`: no pixel 
 import argparse
 import json
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -105,10 +107,16 @@ def main():
                                       cwd=ROOT, capture_output=True, text=True)
                 if diff.returncode != 0:
                     sys.exit("rtis diff failed: " + diff.stderr)
-                # `rtis diff`'s lines: "RMSE x", "max error x", "pixels that differ n of m".
-                fields = {l.split()[0]: l.split() for l in diff.stdout.splitlines()[1:]}
-                differ = {"pixels": int(fields["pixels"][3]), "rmse": float(fields["RMSE"][1]),
-                          "max_error": float(fields["max"][2])}
+                # `rtis diff`'s lines "RMSE x", "max error x" (six decimals) and "pixels that
+                # differ n of m".
+                def field(pattern):
+                    m = re.search(pattern, diff.stdout, re.M)
+                    if m is None:
+                        sys.exit(f"no {pattern!r} in rtis diff's output:\n{diff.stdout}")
+                    return m.group(1)
+                differ = {"pixels": int(field(r"^\s*pixels that differ\s+(\d+) of")),
+                          "rmse": float(field(r"^\s*RMSE\s+(\S+)")),
+                          "max_error": float(field(r"^\s*max error\s+(\S+)"))}
                 same = differ["pixels"] == 0
     print(json.dumps({
         "compare": "head_vs_base", "base": base_commit, "head": head_commit, "scene": args.scene,

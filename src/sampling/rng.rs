@@ -7,7 +7,7 @@
 /// O'Neill's PCG32 (XSH RR 64/32: "PCG: A Family of Simple Fast Space-Efficient Statistically
 /// Good Algorithms for Random Number Generation", 2014), the numbers of `rand_pcg::Pcg32`;
 /// [`Streams`] draws several of them side by side.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone)]
 pub struct Sampler {
     /// The LCG's state.
     state: u64,

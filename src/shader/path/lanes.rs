@@ -9,9 +9,9 @@
 //! (`Interaction::new`, `Origins`, `PointLight::incident`, `Phong::brdf` and
 //! `Phong::course_reflectance`, `reflectance`,
 //! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
-//! draws its random numbers from its own stream in the same order (the draws and the light
-//! choice run lane by lane; `sin_cos_turns` is repeated in lanes), so each path adds the same contributions and goes on with the
-//! same ray, to the bit (`tests/integration/path_waves.rs`). An area-light sample runs the
+//! draws its random numbers from its own stream in the same order (drawn in lanes by
+//! `sampling::Streams`; the light choice runs lane by lane, `sin_cos_turns` is repeated in
+//! lanes), so each path adds the same contributions and goes on with the same ray, to the bit (`tests/integration/path_waves.rs`). An area-light sample runs the
 //! scalar code lane by lane (`surface::sample_area_light`, `light_ray` on
 //! `Interaction::flat`, and, once its shadow ray has been tested in lanes, `light_weighted`).
 
@@ -537,7 +537,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
         return;
     }
     // The next direction: cosine-weighted about the shading normal (`hemisphere::cosine` in
-    // the frame of `Frame::from_normal`); its numbers drawn lane by lane.
+    // the frame of `Frame::from_normal`); its numbers drawn in lanes.
     let brdf = p.sampling == Sampling::Brdf;
     let (u1, u2) = (rng.next_f32(L::LANES), rng.next_f32(L::LANES));
     if brdf {
@@ -801,8 +801,8 @@ struct LightLanes<L> {
 /// The CPU must run `L`'s instruction set.
 #[inline(always)]
 unsafe fn sin_cos_turns<L: Floats>(u: L) -> (L, L) {
+    // (`L::splat` written out below: no closure in a kernel of another instruction set.)
     use crate::sampling::trig::{COS_TAYLOR as C, SIN_TAYLOR as S};
-    // (`L::splat` written out: no closure in a kernel of another instruction set.)
     // The nearest quarter turn.
     let (m1, m2, m3, m4) = unsafe {
         (
@@ -822,9 +822,9 @@ unsafe fn sin_cos_turns<L: Floats>(u: L) -> (L, L) {
     // `sin_cos_eighth`: Horner's form.
     let a2 = a * a;
     let (sin, cos) = unsafe {
-        let s = L::splat(S[3]) + a2 * L::splat(S[4]);
-        let s = L::splat(S[2]) + a2 * s;
+        let s = L::splat(S[2]) + a2 * L::splat(S[3]);
         let s = L::splat(S[1]) + a2 * s;
+        let s = L::splat(S[0]) + a2 * s;
         let c = L::splat(C[4]) + a2 * L::splat(C[5]);
         let c = L::splat(C[3]) + a2 * c;
         let c = L::splat(C[2]) + a2 * c;
@@ -916,9 +916,11 @@ mod tests {
         crate::accel::require_all_isas();
         // SAFETY: `Vec4` runs everywhere; the others only where the CPU has them.
         unsafe { agrees::<glam::Vec4>() };
+        #[cfg(target_arch = "x86_64")]
         if Isa::Avx2.available() {
             unsafe { agrees::<crate::accel::F8>() };
         }
+        #[cfg(target_arch = "x86_64")]
         if Isa::Avx512.available() {
             unsafe { agrees::<crate::accel::F16>() };
         }
