@@ -146,10 +146,11 @@ impl Streams {
     #[inline(always)]
     pub fn next_u32(&mut self, lanes: usize) -> [u32; Streams::MAX] {
         let mut out = [0; Streams::MAX];
-        for i in 0..lanes.min(Streams::MAX) {
-            let old = self.state[i];
-            self.state[i] = step(old, self.inc[i]);
-            out[i] = output(old);
+        let lanes_of = out.iter_mut().zip(&mut self.state).zip(&self.inc);
+        for ((out, state), &inc) in lanes_of.take(lanes) {
+            let old = *state;
+            *state = step(old, inc);
+            *out = output(old);
         }
         out
     }
