@@ -2,10 +2,10 @@
 //! every pixel is the one-ray render's to the bit, with the same ray counts, a pixel alone or
 //! a tile's pixels in one wave, over the strategies the lanes shade (one light by power or by
 //! importance, or all; BRDF or cosine sampling; area lights sampled, left to BRDF-sampled rays
-//! or both under MIS, among packed primitives and in a BVH), Russian roulette
-//! from the first bounce, a depth limit, the effects that end or skip work, lights inside and
-//! outside the planes' room, and the materials the lanes leave to the one-ray code (glossy
-//! Phong, mirror, glass, a black surface).
+//! or both under MIS, among packed primitives and in a BVH), Russian roulette from the first
+//! bounce, a depth limit, the effects that end or skip work, point, spot and directional
+//! lights, lights inside and outside the planes' room, and the materials the lanes leave to the
+//! one-ray code (glossy Phong, mirror, glass, a black surface).
 
 use crate::common::{self, scene};
 use rtis::render::exact::RgbSum;
@@ -30,6 +30,17 @@ fn room(shader: &str, effects: &str) -> String {
             (light: Point(position: (0.5, 1.0, 1.0), intensity: (3, 3, 3))),
             (light: Point(position: (-1.0, 0.6, 0.5), intensity: (1, 2, 1))),
           ])"
+    )
+}
+
+/// [`room`] with a spot light (its cone taking in part of the room) and a directional light
+/// too, which the lanes take lane by lane (`Light::incident`).
+fn spot_room(shader: &str, effects: &str) -> String {
+    room(shader, effects).replace(
+        "(light: Point(position: (0.5, 1.0, 1.0)",
+        "(light: Spot(position: (-1, 1.2, 1), direction: (0.5, -1, -0.5), intensity: (4, 3, 3), cutoff_angle: 35, beam_width: 20)),
+            (light: Directional(direction: (0.3, -1, -0.6), irradiance: (0.6, 0.5, 0.4))),
+            (light: Point(position: (0.5, 1.0, 1.0)",
     )
 }
 
@@ -157,6 +168,24 @@ fn waves_give_the_one_ray_pixels() {
             }
         }
     }
+    // Spot and directional lights beside the point lights, in the planes' room and out of it
+    // (a directional light never is).
+    for model in ["Physical", "Course"] {
+        for per_vertex in ["One", "All", "Importance"] {
+            for sampling in ["Brdf", "Cosine"] {
+                let shader = format!(
+                    "Path(rr_depth: 2, sampling: {sampling}, lights_per_vertex: {per_vertex})"
+                );
+                let text =
+                    spot_room(&shader, "").replace("model: Physical", &format!("model: {model}"));
+                let what = format!("{shader}, {model}, spot and directional");
+                agrees(&rtis::extract(&scene(&text)), &what);
+                let mut s = rtis::extract(&scene(&text));
+                common::lights_out_of_room(&mut s);
+                agrees(&s, &format!("{what}, lights out of the room"));
+            }
+        }
+    }
     // Effects that end paths at their first vertex, or skip the shadow rays.
     for effects in [
         "indirect: false",
@@ -270,15 +299,15 @@ fn waves_apply_only_where_the_lanes_shade() {
         assert!(!waves::applies(&rtis::extract(&scene(&text))), "{what}");
     }
     for entity in [
-        "(light: Spot(position: (-1, 1.2, 1), direction: (0.5, -1, -0.5), intensity: (3, 3, 3)))",
-        "(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))",
         "(light: Environment(radiance: (0.3, 0.35, 0.4)))",
         "(shape: Sphere(center: (1, 1, -1), radius: 0.2), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))",
     ] {
         assert!(!waves::applies(&with(entity)), "{entity}");
     }
-    // An emitting shape and a BVH take the waves.
+    // Spot and directional lights, an emitting shape and a BVH take the waves.
     for entity in [
+        "(light: Spot(position: (-1, 1.2, 1), direction: (0.5, -1, -0.5), intensity: (3, 3, 3)))",
+        "(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))",
         "(shape: Sphere(center: (0, 1.2, 0), radius: 0.1), emitter: Emitter(radiance: (8, 7, 6)))",
         "(shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, -0.9, -0.5)], faces: [(0, 1, 2)]), material: Phong(kd: (0.5, 0.5, 0.5)))",
     ] {

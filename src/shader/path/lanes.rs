@@ -1,7 +1,8 @@
 //! Path's diffuse vertices shaded in SIMD lanes: the vertices of a wave of paths
 //! (`render::waves`) that meet a diffuse Phong surface (no specular lobe), under either model,
 //! a path per lane, from the hit to the next ray: the interaction, next-event estimation
-//! over point lights and one area-light sample with the shadow rays tested in lanes
+//! over point, spot and directional lights and one area-light sample with the shadow rays
+//! tested in lanes
 //! ([`Geometry::occluded_lanes`]) and the area light's MIS weight, the cosine-weighted
 //! direction, its weight, and Russian roulette.
 //!
@@ -11,9 +12,11 @@
 //! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
 //! draws its random numbers from its own stream in the same order (drawn in lanes by
 //! `sampling::Streams`; the light choice runs lane by lane, `sin_cos_turns` is repeated in
-//! lanes), so each path adds the same contributions and goes on with the same ray, to the bit (`tests/integration/path_waves.rs`). An area-light sample runs the
-//! scalar code lane by lane (`surface::sample_area_light`, `light_ray` on
-//! `Interaction::flat`, and, once its shadow ray has been tested in lanes, `light_weighted`).
+//! lanes), so each path adds the same contributions and goes on with the same ray, to the bit
+//! (`tests/integration/path_waves.rs`). A spot or directional light's incident light
+//! (`Light::incident`) and an area-light sample run the scalar code lane by lane
+//! (`surface::sample_area_light`, `light_ray` on `Interaction::flat`, and, once its shadow
+//! ray has been tested in lanes, `light_weighted`).
 
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
@@ -43,21 +46,15 @@ pub struct PathSlot<R> {
     pub rec: R,
 }
 
-/// True if `p`'s vertices can be shaded in lanes in a scene of these lights, emitters and
-/// textures: BRDF or cosine sampling (under either model), point lights and area lights (no
-/// environment, no spot or directional light; every point light and one area-light sample per
-/// vertex, or under the Physical model one light chosen by power or by importance), no
-/// material textures (an emitter's radiance may have one).
-pub fn applies(
-    p: &Path,
-    lights: &[Light],
-    emitters: &Emitters,
-    textures: &[MaterialTextures],
-) -> bool {
+/// True if `p`'s vertices can be shaded in lanes in a scene of these emitters and textures:
+/// BRDF or cosine sampling (under either model), any point, spot and directional lights and
+/// area lights but no environment (every light and one area-light sample per vertex, or under
+/// the Physical model one light chosen by power or by importance), no material textures (an
+/// emitter's radiance may have one).
+pub fn applies(p: &Path, emitters: &Emitters, textures: &[MaterialTextures]) -> bool {
     matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
         && emitters.environment.is_none()
         && textures.is_empty()
-        && lights.iter().all(|l| matches!(l, Light::Point(_)))
 }
 
 /// Each material that the lanes shade: a Phong material that reflects light diffusely only
@@ -369,7 +366,6 @@ unsafe fn shade_in<L: Floats, R: Record>(
         ),
     };
     let surface = Surface {
-        p: p_,
         nh,
         n,
         front,
@@ -396,6 +392,8 @@ unsafe fn shade_in<L: Floats, R: Record>(
         // does not read.
         let (mut pos, mut intensity) = ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]);
         let (mut pmf, mut room, mut chosen) = ([1.0f32; MAX_LANES], 0u32, 0u32);
+        // The lanes that chose a spot or directional light, and which.
+        let (mut other, mut others) = ([0usize; MAX_LANES], 0u32);
         let (at_p, at_n) = match by_importance {
             true => (
                 [array(p_[0]), array(p_[1]), array(p_[2])],
@@ -429,16 +427,22 @@ unsafe fn shade_in<L: Floats, R: Record>(
                 }
                 _ => None,
             };
-            if let Some((j, w)) = pick
-                && let Light::Point(l) = &tr.lights[j]
-            {
-                for c in 0..3 {
-                    pos[c][i] = l.position[c];
-                    intensity[c][i] = l.intensity[c];
-                }
+            if let Some((j, w)) = pick {
                 pmf[i] = w;
-                room |= u32::from(l.in_room) << i;
-                chosen |= 1 << i;
+                match &tr.lights[j] {
+                    Light::Point(l) => {
+                        for c in 0..3 {
+                            pos[c][i] = l.position[c];
+                            intensity[c][i] = l.intensity[c];
+                        }
+                        room |= u32::from(l.in_room) << i;
+                        chosen |= 1 << i;
+                    }
+                    Light::Spot(_) | Light::Directional(_) => {
+                        other[i] = j;
+                        others |= 1 << i;
+                    }
+                }
             }
         }
         let light = unsafe {
@@ -457,7 +461,20 @@ unsafe fn shade_in<L: Floats, R: Record>(
                 lanes: chosen,
             }
         };
-        let term = unsafe { point_term(tr, &light, &surface) };
+        let mut term = unsafe { light_term(tr, &light.incident(p_), &surface) };
+        if others != 0 {
+            // The spot and directional lights' incident light lane by lane, then their terms
+            // in lanes as the point lights'.
+            let at_p = [array(p_[0]), array(p_[1]), array(p_[2])];
+            let inc = unsafe { incidents_by_lane(|i| &tr.lights[other[i]], &at_p, others) };
+            let t = unsafe { light_term(tr, &inc, &surface) };
+            let lanes = unsafe { lane_mask::<L>(others) };
+            term = [
+                L::select(lanes, t[0], term[0]),
+                L::select(lanes, t[1], term[1]),
+                L::select(lanes, t[2], term[2]),
+            ];
+        }
         let w = unsafe { L::from_array(pmf) };
         let point = match by_importance {
             true => [term[0] * w, term[1] * w, term[2] * w],
@@ -475,25 +492,32 @@ unsafe fn shade_in<L: Floats, R: Record>(
         // `point_lights`: the terms summed from zero in the lights' order, then the area
         // lights' sample added.
         let mut sum = [zero; 3];
-        for l in tr.lights {
-            let Light::Point(l) = l else { continue };
-            let light = unsafe {
-                LightLanes {
-                    pos: [
-                        L::splat(l.position.x),
-                        L::splat(l.position.y),
-                        L::splat(l.position.z),
-                    ],
-                    intensity: [
-                        L::splat(l.intensity.x),
-                        L::splat(l.intensity.y),
-                        L::splat(l.intensity.z),
-                    ],
-                    room: if l.in_room { u32::MAX } else { 0 },
-                    lanes: u32::MAX,
-                }
+        let at_p = [array(p_[0]), array(p_[1]), array(p_[2])];
+        for light in tr.lights {
+            let inc = match light {
+                Light::Point(l) => unsafe {
+                    LightLanes {
+                        pos: [
+                            L::splat(l.position.x),
+                            L::splat(l.position.y),
+                            L::splat(l.position.z),
+                        ],
+                        intensity: [
+                            L::splat(l.intensity.x),
+                            L::splat(l.intensity.y),
+                            L::splat(l.intensity.z),
+                        ],
+                        room: if l.in_room { u32::MAX } else { 0 },
+                        lanes: u32::MAX,
+                    }
+                    .incident(p_)
+                },
+                // Lane by lane (no lane form).
+                Light::Spot(_) | Light::Directional(_) => unsafe {
+                    incidents_by_lane(|_| light, &at_p, shaded)
+                },
             };
-            let term = unsafe { point_term(tr, &light, &surface) };
+            let term = unsafe { light_term(tr, &inc, &surface) };
             sum = [sum[0] + term[0], sum[1] + term[1], sum[2] + term[2]];
         }
         // `area_lights` with one sample: the light chosen by power (`u`), a point on it
@@ -768,12 +792,11 @@ impl Iterator for Bits {
     }
 }
 
-/// What the light terms read of a chunk's vertices: the hit points, geometric and shading
+/// What the light terms read of a chunk's vertices: the geometric and shading
 /// normals, the two origins and their error bound, the reflectance's factor `f` (the BRDF
 /// `kd / pi` under the Physical model, the course's `kd`), the lanes where `wo` counts as
 /// above the surface (all of them under the Course model), and the lanes shaded.
 struct Surface<L: Floats> {
-    p: [L; 3],
     nh: [L; 3],
     n: [L; 3],
     front: [L; 3],
@@ -791,6 +814,90 @@ struct LightLanes<L> {
     intensity: [L; 3],
     room: u32,
     lanes: u32,
+}
+
+impl<L: Floats> LightLanes<L> {
+    /// `PointLight::incident` in lanes at the points `p`: the unit direction, the distance and
+    /// `I / d^2`, where the light is not at the point (`d^2` neither zero nor infinite).
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn incident(&self, p: [L; 3]) -> Incidents<L> {
+        // SAFETY: the caller's.
+        let (zero, inf) = unsafe { (L::splat(0.0), L::splat(f32::INFINITY)) };
+        let to = [self.pos[0] - p[0], self.pos[1] - p[1], self.pos[2] - p[2]];
+        let d2 = dot(to, to);
+        let dist = d2.sqrt();
+        Incidents {
+            wi: [to[0] / dist, to[1] / dist, to[2] / dist],
+            dist,
+            li: [
+                self.intensity[0] / d2,
+                self.intensity[1] / d2,
+                self.intensity[2] / d2,
+            ],
+            valid: unsafe { lane_mask::<L>(self.lanes) } & d2.cmpne(zero) & d2.cmplt(inf),
+            room: self.room,
+        }
+    }
+}
+
+/// The light arriving at each lane's vertex from its light (`Light::incident`): the unit
+/// direction towards it, the distance, the radiance `L_i`, the lanes that receive some, and
+/// the lanes whose light is in the planes' room.
+struct Incidents<L: Floats> {
+    wi: [L; 3],
+    dist: L,
+    li: [L; 3],
+    valid: L::Mask,
+    room: u32,
+}
+
+/// `Light::incident` lane by lane, for the lights without a lane form (spot and directional):
+/// lane `i` of `lanes` from light `light_of(i)` at the point `p[..][i]`.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn incidents_by_lane<'a, L: Floats>(
+    light_of: impl Fn(usize) -> &'a Light,
+    p: &[[f32; MAX_LANES]; 3],
+    lanes: u32,
+) -> Incidents<L> {
+    let (mut wi, mut li) = ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]);
+    let (mut dist, mut valid, mut room) = ([0.0f32; MAX_LANES], 0u32, 0u32);
+    for i in Bits(lanes) {
+        let light = light_of(i);
+        let Some(inc) = light.incident(Vec3A::new(p[0][i], p[1][i], p[2][i])) else {
+            continue;
+        };
+        for c in 0..3 {
+            wi[c][i] = inc.wi[c];
+            li[c][i] = inc.li[c];
+        }
+        dist[i] = inc.dist;
+        valid |= 1 << i;
+        room |= u32::from(light.in_room()) << i;
+    }
+    // SAFETY: the caller's.
+    unsafe {
+        Incidents {
+            wi: [
+                L::from_array(wi[0]),
+                L::from_array(wi[1]),
+                L::from_array(wi[2]),
+            ],
+            dist: L::from_array(dist),
+            li: [
+                L::from_array(li[0]),
+                L::from_array(li[1]),
+                L::from_array(li[2]),
+            ],
+            valid: lane_mask::<L>(valid),
+            room,
+        }
+    }
 }
 
 /// [`crate::sampling::sin_cos_turns`] in lanes, operation for operation (the quarter chosen
@@ -840,36 +947,22 @@ unsafe fn sin_cos_turns<L: Floats>(u: L) -> (L, L) {
     )
 }
 
-/// `point_light` in lanes: each lane's light's term `L_i r(wi, wo) V` at its vertex (zero where
-/// the light is behind the surface, at the point, or hidden), its shadow ray tested in lanes
-/// (`Tracer::unoccluded`, or `unoccluded_in_room` in the lanes of `light.room`) and counted.
+/// `point_light` in lanes: each lane's light's term `L_i r(wi, wo) V` at its vertex from its
+/// incident light `inc` (zero where the light is behind the surface, gives none, or is
+/// hidden), its shadow ray tested in lanes (`Tracer::unoccluded`, or `unoccluded_in_room` in
+/// the lanes of `inc.room`) and counted.
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.
 #[inline(always)]
-unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Surface<L>) -> [L; 3] {
+unsafe fn light_term<L: Floats>(tr: &mut Tracer, inc: &Incidents<L>, at: &Surface<L>) -> [L; 3] {
     // SAFETY: the caller's.
-    let (zero, inf, end) =
-        unsafe { (L::splat(0.0), L::splat(f32::INFINITY), L::splat(SHADOW_END)) };
-    let (p, nh, n, front, back, o_err, f) = (at.p, at.nh, at.n, at.front, at.back, at.o_err, at.f);
-    let lanes = at.live & unsafe { lane_mask::<L>(light.lanes) };
-    // `PointLight::incident`: the unit direction, the distance and `I / d^2`.
-    let to = [
-        light.pos[0] - p[0],
-        light.pos[1] - p[1],
-        light.pos[2] - p[2],
-    ];
-    let d2 = dot(to, to);
-    let dist = d2.sqrt();
-    let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
-    let li = [
-        light.intensity[0] / d2,
-        light.intensity[1] / d2,
-        light.intensity[2] / d2,
-    ];
+    let (zero, end) = unsafe { (L::splat(0.0), L::splat(SHADOW_END)) };
+    let (nh, n, front, back, o_err, f) = (at.nh, at.n, at.front, at.back, at.o_err, at.f);
+    let (wi, dist, li) = (inc.wi, inc.dist, inc.li);
     // `point_light_ray`: a light below the surface adds nothing.
     let cos = dot(wi, n);
-    let lit = lanes & d2.cmpne(zero) & d2.cmplt(inf) & cos.cmpgt(zero);
+    let lit = at.live & inc.valid & cos.cmpgt(zero);
     let mut seen = lit;
     if tr.effects.shadows && L::any(lit) {
         let side = dot(nh, wi).cmpge(zero);
@@ -879,7 +972,7 @@ unsafe fn point_term<L: Floats>(tr: &mut Tracer, light: &LightLanes<L>, at: &Sur
             L::select(side, front[2], back[2]),
         ];
         let t_max = dist * end;
-        let room = unsafe { lane_mask::<L>(light.room) };
+        let room = unsafe { lane_mask::<L>(inc.room) };
         let geometry: &Geometry = tr.geometry;
         let mut blocked = zero.cmpne(zero);
         for (planes, part) in [(false, lit & room), (true, lit & !room)] {
