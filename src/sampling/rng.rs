@@ -161,6 +161,15 @@ impl Streams {
         self.next_u32(lanes).map(to_f32)
     }
 
+    /// [`Sampler::next_f64`] in lane `i` alone (a draw the other lanes do not make).
+    #[inline(always)]
+    pub fn next_f64_at(&mut self, i: usize) -> f64 {
+        let mut s = self.sampler(i);
+        let x = s.next_f64();
+        self.state[i] = s.state;
+        x
+    }
+
     /// [`Sampler::next_f64`] in the first `lanes` lanes.
     #[inline(always)]
     pub fn next_f64(&mut self, lanes: usize) -> [f64; Streams::MAX] {

@@ -274,9 +274,60 @@ fn waves_give_the_one_ray_pixels_with_area_lights() {
     }
 }
 
+/// Environment lights in the waves: a constant sky and an image (`scenes/assets/sky.exr`) over
+/// the lit room (open to the front and the right), with its point lights and its emitting
+/// sphere, over the strategies and both samplings, and with the effects that skip work.
+#[test]
+fn waves_give_the_one_ray_pixels_with_an_environment() {
+    let _limit = common::deadline(240);
+    let sky = common::scenes_dir().join("assets/sky.exr");
+    let skies = [
+        "(light: Environment(radiance: (0.3, 0.35, 0.4)))".to_string(),
+        format!("(light: Environment(image: {sky:?}, rotate: (0, 40, 0)))"),
+    ];
+    let under = |shader: &str, effects: &str, sky: &str| {
+        let text = lit_room(shader, effects)
+            .replace("entities: [", &format!("entities: [\n            {sky},"));
+        assert!(text.contains("Environment("), "room() changed");
+        rtis::extract(&scene(&text))
+    };
+    for sky in &skies {
+        for lights in ["Mis", "Light", "Brdf"] {
+            for per_vertex in ["One", "All", "Importance"] {
+                for (sampling, depth) in [
+                    ("Brdf", "rr_depth: 1"),
+                    ("Cosine", "max_depth: 3, rr_depth: 2"),
+                ] {
+                    let shader = format!(
+                        "Path({depth}, sampling: {sampling}, lights: {lights}, lights_per_vertex: {per_vertex})"
+                    );
+                    agrees(&under(&shader, "", sky), &format!("{shader}, {sky}"));
+                }
+            }
+        }
+        // The Course model (every light at every vertex, the course's weights).
+        let shader = "Path(rr_depth: 2, sampling: Brdf, lights: Mis)";
+        let text = lit_room(shader, "")
+            .replace("model: Physical", "model: Course")
+            .replace("entities: [", &format!("entities: [\n            {sky},"));
+        assert!(text.contains("model: Course") && text.contains("Environment("));
+        agrees(&rtis::extract(&scene(&text)), &format!("Course, {sky}"));
+        for effects in ["indirect: false", "shadows: false", "emission: false"] {
+            for per_vertex in ["One", "All"] {
+                let shader = format!(
+                    "Path(rr_depth: 2, sampling: Brdf, lights: Mis, lights_per_vertex: {per_vertex})"
+                );
+                agrees(
+                    &under(&shader, effects, sky),
+                    &format!("{shader}, {effects}, {sky}"),
+                );
+            }
+        }
+    }
+}
+
 /// The waves are for the scenes whose vertices the lanes shade: not with uniform sampling (under
-/// either model), not with a light other than point lights and area lights (spot, directional,
-/// the environment), or a texture; each alone keeps them off.
+/// either model), or a material texture; each alone keeps them off.
 #[test]
 fn waves_apply_only_where_the_lanes_shade() {
     let path = "Path(sampling: Brdf)";
@@ -299,13 +350,13 @@ fn waves_apply_only_where_the_lanes_shade() {
         assert!(!waves::applies(&rtis::extract(&scene(&text))), "{what}");
     }
     for entity in [
-        "(light: Environment(radiance: (0.3, 0.35, 0.4)))",
         "(shape: Sphere(center: (1, 1, -1), radius: 0.2), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))",
     ] {
         assert!(!waves::applies(&with(entity)), "{entity}");
     }
-    // Spot and directional lights, an emitting shape and a BVH take the waves.
+    // Spot, directional and environment lights, an emitting shape and a BVH take the waves.
     for entity in [
+        "(light: Environment(radiance: (0.3, 0.35, 0.4)))",
         "(light: Spot(position: (-1, 1.2, 1), direction: (0.5, -1, -0.5), intensity: (3, 3, 3)))",
         "(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))",
         "(shape: Sphere(center: (0, 1.2, 0), radius: 0.1), emitter: Emitter(radiance: (8, 7, 6)))",

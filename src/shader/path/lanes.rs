@@ -1,8 +1,8 @@
 //! Path's diffuse vertices shaded in SIMD lanes: the vertices of a wave of paths
 //! (`render::waves`) that meet a diffuse Phong surface (no specular lobe), under either model,
 //! a path per lane, from the hit to the next ray: the interaction, next-event estimation
-//! over point, spot and directional lights and one area-light sample with the shadow rays
-//! tested in lanes
+//! over point, spot and directional lights and one sample of the area lights and the
+//! environment with the shadow rays tested in lanes
 //! ([`Geometry::occluded_lanes`]) and the area light's MIS weight, the cosine-weighted
 //! direction, its weight, and Russian roulette.
 //!
@@ -14,16 +14,18 @@
 //! `sampling::Streams`; the light choice runs lane by lane, `sin_cos_turns` is repeated in
 //! lanes), so each path adds the same contributions and goes on with the same ray, to the bit
 //! (`tests/integration/path_waves.rs`). A spot or directional light's incident light
-//! (`Light::incident`) and an area-light sample run the scalar code lane by lane
-//! (`surface::sample_area_light`, `light_ray` on `Interaction::flat`, and, once its shadow
-//! ray has been tested in lanes, `light_weighted`).
+//! (`Light::incident`) and an area-light or environment sample run the scalar code lane by
+//! lane (`surface::sample_area_light` or `EnvironmentLight::sample`, `light_ray` on
+//! `Interaction::flat`, and, once its shadow ray has been tested in lanes, `light_weighted`).
 
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
 use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
-use crate::light::{AreaLight, Chosen, Emitters, Light, NO_LIGHT, choose_by_importance};
+use crate::light::{
+    AreaLight, Chosen, EnvironmentLight, Light, LightSample, NO_LIGHT, choose_by_importance,
+};
 use crate::material::{Material, Model, Phong};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling, Streams};
 use crate::shader::Tracer;
@@ -46,15 +48,13 @@ pub struct PathSlot<R> {
     pub rec: R,
 }
 
-/// True if `p`'s vertices can be shaded in lanes in a scene of these emitters and textures:
-/// BRDF or cosine sampling (under either model), any point, spot and directional lights and
-/// area lights but no environment (every light and one area-light sample per vertex, or under
-/// the Physical model one light chosen by power or by importance), no material textures (an
-/// emitter's radiance may have one).
-pub fn applies(p: &Path, emitters: &Emitters, textures: &[MaterialTextures]) -> bool {
-    matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
-        && emitters.environment.is_none()
-        && textures.is_empty()
+/// True if `p`'s vertices can be shaded in lanes in a scene of these textures: BRDF or cosine
+/// sampling (under either model), with any lights (every point, spot and directional light and
+/// one sample of the area lights and the environment per vertex, or under the Physical model
+/// one light chosen by power or by importance), and no material textures (an emitter's
+/// radiance may have one).
+pub fn applies(p: &Path, textures: &[MaterialTextures]) -> bool {
+    matches!(p.sampling, Sampling::Brdf | Sampling::Cosine) && textures.is_empty()
 }
 
 /// Each material that the lanes shade: a Phong material that reflects light diffusely only
@@ -425,6 +425,12 @@ unsafe fn shade_in<L: Floats, R: Record>(
                     area.sample(tr, at, i, slots[i].st.ray.d, (light, pmf), u12);
                     None
                 }
+                // The environment: its sample from two more numbers of the lane's stream.
+                Some(Chosen::Environment(env, pmf)) if sample_area && tr.effects.emission => {
+                    let v = (rng.next_f64_at(i), rng.next_f64_at(i));
+                    area.sample_environment(tr, at, i, slots[i].st.ray.d, (env, pmf), v);
+                    None
+                }
                 _ => None,
             };
             if let Some((j, w)) = pick {
@@ -530,10 +536,15 @@ unsafe fn shade_in<L: Floats, R: Record>(
             );
             for i in Bits(shaded) {
                 let (u, u12) = (u[i], (u1[i], u2[i]));
-                // (No environment light in the waves' scenes, and the point lights take no
-                // part in this choice.)
-                if let Some(Chosen::Area(light, pmf)) = tr.emitters.choose_any(u) {
-                    area.sample(tr, at, i, slots[i].st.ray.d, (light, pmf), u12);
+                // (The point lights take no part in this choice.)
+                let d = slots[i].st.ray.d;
+                match tr.emitters.choose_any(u) {
+                    Some(Chosen::Area(light, pmf)) => area.sample(tr, at, i, d, (light, pmf), u12),
+                    Some(Chosen::Environment(env, pmf)) => {
+                        let v = (rng.next_f64_at(i), rng.next_f64_at(i));
+                        area.sample_environment(tr, at, i, d, (env, pmf), v);
+                    }
+                    Some(Chosen::Point(..)) | None => {}
                 }
             }
         }
@@ -684,12 +695,41 @@ impl AreaRays {
         (light, pmf): (&AreaLight, f32),
         u: (f32, f32),
     ) {
+        let ls = at.hits[i].and_then(|hit| sample_area_light(tr.emitters, light, hit.p, u));
+        self.record(tr, at, i, d, ls, pmf);
+    }
+
+    /// Lane `i` of `at` (a shaded lane, whose ray has direction `d`) samples the environment
+    /// `env`, chosen with probability `pmf`, from the random numbers `v`
+    /// (`environment_sample`).
+    #[inline(always)]
+    fn sample_environment<L>(
+        &mut self,
+        tr: &Tracer,
+        at: &Vertices<L>,
+        i: usize,
+        d: Vec3A,
+        (env, pmf): (&EnvironmentLight, f32),
+        v: (f64, f64),
+    ) {
+        self.record(tr, at, i, d, env.sample(v.0, v.1), pmf);
+    }
+
+    /// Lane `i`'s light sample `ls` (none if the light gave none), chosen with probability
+    /// `pmf`: its shadow ray, direction, radiance and density (`light_ray`) in the columns.
+    #[inline(always)]
+    fn record<L>(
+        &mut self,
+        tr: &Tracer,
+        at: &Vertices<L>,
+        i: usize,
+        d: Vec3A,
+        ls: Option<LightSample>,
+        pmf: f32,
+    ) {
         self.lanes |= 1 << i;
-        let (Some(hit), Some((m, phong))) = (&at.hits[i], &at.materials[i]) else {
-            // (A shaded lane has both: `round_in` sets them with its bit.)
-            return;
-        };
-        let Some(ls) = sample_area_light(tr.emitters, light, hit.p, u) else {
+        let (Some(hit), Some((m, phong)), Some(ls)) = (&at.hits[i], &at.materials[i], ls) else {
+            // (A shaded lane has a hit and a material: `round_in` sets them with its bit.)
             return;
         };
         let si = Interaction::flat(*hit, d, &tr.materials[*m as usize]);
