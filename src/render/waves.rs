@@ -40,7 +40,7 @@ pub fn applies(scene: &RenderScene) -> bool {
     let Shader::Path(p) = &scene.shader else {
         return false;
     };
-    scene.geometry.in_bvh <= MAX_BVH_PRIMS && lanes::applies(p, &scene.textures)
+    scene.geometry.in_bvh <= MAX_BVH_PRIMS && lanes::applies(p)
 }
 
 /// The exact sum of the samples `samples` of pixel `(col, row)` under the path tracer `p`,

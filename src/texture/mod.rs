@@ -192,6 +192,26 @@ impl MaterialTextures {
             || self.alpha_v.is_some()
     }
 
+    /// True if only the reflectance (Phong's `kd`) is textured: no other parameter, no normal
+    /// map.
+    pub fn only_reflectance(&self) -> bool {
+        // (Every field named, so that a new one is not forgotten here.)
+        let MaterialTextures {
+            reflectance,
+            specular,
+            transmittance,
+            alpha_u,
+            alpha_v,
+            normal_map,
+        } = self;
+        reflectance.is_some()
+            && specular.is_none()
+            && transmittance.is_none()
+            && alpha_u.is_none()
+            && alpha_v.is_none()
+            && normal_map.is_none()
+    }
+
     /// The shading normal the normal map gives at `uv` for a footprint `width` wide, in the
     /// local frame (`z` the surface's normal, `x` its tangent): `2 c - 1` for the map's
     /// colour `c`, normalised; `+z` where that has no length. `None` without a map.

@@ -326,8 +326,58 @@ fn waves_give_the_one_ray_pixels_with_an_environment() {
     }
 }
 
+/// Textured materials in the waves: a diffuse `kd` textured by a checkerboard (one square
+/// black, which the lanes leave to the one-ray code) on the back wall and by an image
+/// (`scenes/assets/checks.png`, filtered over each sample's footprint) on the floor, a
+/// textured glossy sphere and a normal-mapped one (the one-ray code's), with the room's point
+/// lights and emitting sphere, over the strategies, both samplings and both models.
+#[test]
+fn waves_give_the_one_ray_pixels_with_textures() {
+    let _limit = common::deadline(240);
+    let checks = common::scenes_dir().join("assets/checks.png");
+    let textured = |shader: &str| {
+        let text = lit_room(shader, "")
+            .replace(
+                "material: Phong(kd: (0.6, 0.6, 0.6))",
+                &format!("material: Phong(kd: Image(path: {checks:?}, uv_transform: (scale: (3, 3))))"),
+            )
+            .replace(
+                "material: Phong(kd: (0.5, 0.3, 0.2))",
+                "material: Phong(kd: Checkerboard(color0: (0.7, 0.4, 0.2), color1: (0, 0, 0), uv_transform: (scale: (4, 4))))",
+            )
+            .replace(
+                "entities: [",
+                "entities: [
+            (shape: Sphere(center: (0.9, 0.5, -0.8), radius: 0.3), material: Phong(kd: Checkerboard(color0: (0.5, 0.4, 0.3)), ks: (0.2, 0.2, 0.2), shininess: 30)),
+            (shape: Sphere(center: (-1.0, 0.6, -0.9), radius: 0.3), material: NormalMap(normal_map: Checkerboard(color0: (0.6, 0.5, 1), color1: (0.4, 0.5, 1)), material: Phong(kd: (0.5, 0.6, 0.7)))),",
+            );
+        assert!(
+            text.contains("Image(") && text.matches("Checkerboard(").count() == 3,
+            "room() changed"
+        );
+        text
+    };
+    for model in ["Physical", "Course"] {
+        for lights in ["Mis", "Light"] {
+            for per_vertex in ["One", "All", "Importance"] {
+                for sampling in ["Brdf", "Cosine"] {
+                    let shader = format!(
+                        "Path(rr_depth: 2, sampling: {sampling}, lights: {lights}, lights_per_vertex: {per_vertex})"
+                    );
+                    let text =
+                        textured(&shader).replace("model: Physical", &format!("model: {model}"));
+                    agrees(
+                        &rtis::extract(&scene(&text)),
+                        &format!("{shader}, {model}, textured"),
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// The waves are for the scenes whose vertices the lanes shade: not with uniform sampling (under
-/// either model), or a material texture; each alone keeps them off.
+/// either model).
 #[test]
 fn waves_apply_only_where_the_lanes_shade() {
     let path = "Path(sampling: Brdf)";
@@ -349,10 +399,10 @@ fn waves_apply_only_where_the_lanes_shade() {
     ] {
         assert!(!waves::applies(&rtis::extract(&scene(&text))), "{what}");
     }
-    let textured = "(shape: Sphere(center: (1, 1, -1), radius: 0.2), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))";
-    assert!(!waves::applies(&with(textured)), "{textured}");
-    // Spot, directional and environment lights, an emitting shape and a BVH take the waves.
+    // Spot, directional and environment lights, textures, an emitting shape and a BVH take the
+    // waves.
     for entity in [
+        "(shape: Sphere(center: (1, 1, -1), radius: 0.2), material: Phong(kd: Checkerboard(color0: (1, 1, 1))))",
         "(light: Environment(radiance: (0.3, 0.35, 0.4)))",
         "(light: Spot(position: (-1, 1.2, 1), direction: (0.5, -1, -0.5), intensity: (3, 3, 3)))",
         "(light: Directional(direction: (0.3, -1, 0.2), irradiance: (2, 1.5, 1)))",

@@ -1,5 +1,6 @@
 //! Path's diffuse vertices shaded in SIMD lanes: the vertices of a wave of paths
-//! (`render::waves`) that meet a diffuse Phong surface (no specular lobe), under either model,
+//! (`render::waves`) that meet a diffuse Phong surface (no specular lobe; its `kd` constant or
+//! textured, looked up at the hit), under either model,
 //! a path per lane, from the hit to the next ray: the interaction, next-event estimation
 //! over point, spot and directional lights and one sample of the area lights and the
 //! environment with the shadow rays tested in lanes
@@ -34,7 +35,6 @@ use crate::shader::surface::{
     Interaction, SHADOW_END, diffuse_probability, light_ray, light_weighted, sample_area_light,
 };
 use crate::stats::RayKind;
-use crate::texture::MaterialTextures;
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
@@ -48,46 +48,54 @@ pub struct PathSlot<R> {
     pub rec: R,
 }
 
-/// True if `p`'s vertices can be shaded in lanes in a scene of these textures: BRDF or cosine
-/// sampling (under either model), with any lights (every point, spot and directional light and
-/// one sample of the area lights and the environment per vertex, or under the Physical model
-/// one light chosen by power or by importance), and no material textures (an emitter's
-/// radiance may have one).
-pub fn applies(p: &Path, textures: &[MaterialTextures]) -> bool {
-    matches!(p.sampling, Sampling::Brdf | Sampling::Cosine) && textures.is_empty()
+/// True if `p`'s vertices can be shaded in lanes: BRDF or cosine sampling (under either
+/// model), with any lights (every point, spot and directional light and one sample of the area
+/// lights and the environment per vertex, or under the Physical model one light chosen by
+/// power or by importance) and any textures (a diffuse material with a textured `kd` is looked
+/// up at each hit; other textured materials go to the one-ray code).
+pub fn applies(p: &Path) -> bool {
+    matches!(p.sampling, Sampling::Brdf | Sampling::Cosine)
 }
 
 /// Each material that the lanes shade: a Phong material that reflects light diffusely only
 /// (so its BRDF sampling always picks the cosine lobe), by index.
-pub struct Diffuse(Vec<Option<Phong>>);
+/// A material whose `kd` alone is textured is one too where its texel is not black: its
+/// parameters are looked up at each hit, as `Interaction::new` looks them up.
+pub struct Diffuse(Vec<Option<(Phong, Kd)>>);
+
+/// Where a diffuse material's `kd` comes from.
+#[derive(Clone, Copy, PartialEq)]
+enum Kd {
+    /// The material's own.
+    Constant,
+    /// Its texture, at each hit.
+    Textured,
+}
 
 impl Diffuse {
     /// The table of `tr`'s materials.
     pub fn table(tr: &Tracer) -> Diffuse {
-        let diffuse = |m: &Material| match m {
-            Material::Phong(phong)
-                if phong.ks == Vec3A::ZERO
-                    && !phong.is_black()
-                    && diffuse_probability(phong) == 1.0 =>
-            {
-                Some(*phong)
+        let diffuse = |(i, m): (usize, &Material)| {
+            let Material::Phong(phong) = m else {
+                return None;
+            };
+            if phong.ks != Vec3A::ZERO {
+                return None;
             }
-            _ => None,
+            match tr.textures.get(i).filter(|t| !t.is_empty()) {
+                None => (!phong.is_black() && diffuse_probability(phong) == 1.0)
+                    .then_some((*phong, Kd::Constant)),
+                Some(t) => t.only_reflectance().then_some((*phong, Kd::Textured)),
+            }
         };
-        Diffuse(tr.materials.iter().map(diffuse).collect())
+        Diffuse(tr.materials.iter().enumerate().map(diffuse).collect())
     }
 
     /// The material (index and parameters) of `hit`, if the vertex it makes on path `st` is
     /// shaded in lanes: a flat primitive of a diffuse material that emits nothing, where the
     /// path may scatter.
     #[inline]
-    pub fn at(
-        &self,
-        geometry: &Geometry,
-        p: &Path,
-        st: &PathState,
-        hit: &Hit,
-    ) -> Option<(u32, Phong)> {
+    pub fn at(&self, tr: &Tracer, p: &Path, st: &PathState, hit: &Hit) -> Option<(u32, Phong)> {
         let max_depth = p
             .max_depth
             .unwrap_or(super::MAX_DEPTH)
@@ -95,12 +103,27 @@ impl Diffuse {
         if st.depth >= max_depth {
             return None;
         }
+        let geometry: &Geometry = tr.geometry;
         let (material, smooth, light) = geometry.shading_of(hit.prim);
         if smooth || light != NO_LIGHT {
             return None;
         }
-        let phong = self.0.get(material as usize).copied().flatten()?;
-        Some((material, phong))
+        let (phong, kd) = self.0.get(material as usize).copied().flatten()?;
+        if kd == Kd::Constant {
+            return Some((material, phong));
+        }
+        // `Interaction::new`'s lookup: the texture at the hit's coordinates, filtered over
+        // the sample's footprint there.
+        let (i, prim) = (material as usize, geometry.prim(hit.prim));
+        let uv = geometry.uv(&prim, hit.p);
+        let width = tr.footprint.width(hit.p, hit.n) * geometry.uv_rate(&prim, hit.p);
+        let physical = tr.model == Model::Physical;
+        let Material::Phong(phong) = tr.textures[i].apply(&tr.materials[i], uv, width, physical)
+        else {
+            return None;
+        };
+        // A black texel reflects nothing, and draws no light sample: the one-ray code's.
+        (!phong.is_black() && diffuse_probability(&phong) == 1.0).then_some((material, phong))
     }
 }
 
@@ -249,7 +272,7 @@ unsafe fn round_in<L: Floats, R: Record>(
             let k = c + i;
             let slot = &mut slots[k];
             if let Some(h) = hit
-                && let Some((m, phong)) = diffuse.at(geometry, p, &slot.st, h)
+                && let Some((m, phong)) = diffuse.at(tr, p, &slot.st, h)
             {
                 shaded |= 1 << i;
                 materials[i] = Some((m, phong));
