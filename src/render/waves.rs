@@ -4,11 +4,12 @@
 //! one or two samples per pixel). Each round traces the paths' rays in chunks of SIMD lanes
 //! ([`crate::accel::Geometry::nearest_lanes`] in a scene whose primitives are all packed, each
 //! ray through the BVH with the one-ray query in others) and shades the diffuse vertices in
-//! those lanes ([`crate::shader::path::lanes`]: the interaction, the point lights and one
-//! area-light sample with their shadow rays in lanes, the next direction and Russian roulette)
-//! and every other vertex (mirrors, glass, glossy Phong, emitters, escapes) with the one-ray
-//! code ([`crate::shader::path::step`]); the slots of the paths that ended go to the next
-//! samples.
+//! those lanes ([`crate::shader::path::lanes`]: the interaction, the point, spot and
+//! directional lights and one sample of the area lights and the environment with their shadow
+//! rays in lanes, the next direction and Russian roulette) and every other vertex (mirrors,
+//! glass, glossy Phong, emitters, escapes, smooth triangles, normal maps, black texels) with
+//! the one-ray code ([`crate::shader::path::step`]); the slots of the paths that ended go to
+//! the next samples.
 //!
 //! Each sample draws from its own random stream in the one-ray order and adds the same
 //! contributions, each computed by the same operations, and its pixel's sum is exact

@@ -214,6 +214,12 @@ mod tests {
                     assert_eq!(y[i].to_bits(), s.next_f64().to_bits());
                 }
             }
+            // A draw of one lane alone.
+            let last = lanes as usize - 1;
+            assert_eq!(
+                streams.next_f64_at(last).to_bits(),
+                own[last].next_f64().to_bits()
+            );
             for (i, s) in own.iter().enumerate() {
                 assert_eq!(streams.sampler(i).state, s.state);
             }

@@ -82,9 +82,10 @@ impl<'a> Interaction<'a> {
     }
 
     /// The interaction of a ray of direction `d` with its nearest hit, `hit`, on a flat
-    /// primitive of untextured `material` that emits nothing: what [`Interaction::new`] makes
-    /// there (its shading normal the geometric one on the viewer's side), without looking the
-    /// primitive up.
+    /// primitive of `material` that emits nothing and has no normal map: what
+    /// [`Interaction::new`] makes there (its shading normal the geometric one on the viewer's
+    /// side), without looking the primitive up or its textures (Path's lanes pass the
+    /// looked-up Phong to `light_ray` and `light_weighted`, which read nothing else of it).
     #[inline]
     pub fn flat(hit: Hit, d: Vec3A, material: &'a Material) -> Self {
         let wo = -d;

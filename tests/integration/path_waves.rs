@@ -3,9 +3,10 @@
 //! a tile's pixels in one wave, over the strategies the lanes shade (one light by power or by
 //! importance, or all; BRDF or cosine sampling; area lights sampled, left to BRDF-sampled rays
 //! or both under MIS, among packed primitives and in a BVH), Russian roulette from the first
-//! bounce, a depth limit, the effects that end or skip work, point, spot and directional
-//! lights, lights inside and outside the planes' room, and the materials the lanes leave to the
-//! one-ray code (glossy Phong, mirror, glass, a black surface).
+//! bounce, a depth limit, the effects that end or skip work, point, spot, directional and
+//! environment lights, lights inside and outside the planes' room, textured `kd` (black texels
+//! included), and the materials the lanes leave to the one-ray code (glossy Phong, mirror,
+//! glass, a black surface, normal maps).
 
 use crate::common::{self, scene};
 use rtis::render::exact::RgbSum;
@@ -33,10 +34,18 @@ fn room(shader: &str, effects: &str) -> String {
     )
 }
 
-/// [`room`] with a spot light (its cone taking in part of the room) and a directional light
-/// too, which the lanes take lane by lane (`Light::incident`).
+/// [`room`] without its ceiling: open to the sky above.
+fn open_room(shader: &str, effects: &str) -> String {
+    let text = room(shader, effects);
+    let ceiling = "(shape: InfinitePlane(point: (0, 1.4, 0), normal: (0, -1, 0)), material: Phong(kd: (0, 0, 0))),";
+    assert!(text.contains(ceiling), "room() changed");
+    text.replace(ceiling, "")
+}
+
+/// [`open_room`] with a spot light (its cone taking in part of the room) and a directional
+/// light from above too, which the lanes take lane by lane (`Light::incident`).
 fn spot_room(shader: &str, effects: &str) -> String {
-    room(shader, effects).replace(
+    open_room(shader, effects).replace(
         "(light: Point(position: (0.5, 1.0, 1.0)",
         "(light: Spot(position: (-1, 1.2, 1), direction: (0.5, -1, -0.5), intensity: (4, 3, 3), cutoff_angle: 35, beam_width: 20)),
             (light: Directional(direction: (0.3, -1, -0.6), irradiance: (0.6, 0.5, 0.4))),
@@ -275,8 +284,10 @@ fn waves_give_the_one_ray_pixels_with_area_lights() {
 }
 
 /// Environment lights in the waves: a constant sky and an image (`scenes/assets/sky.exr`) over
-/// the lit room (open to the front and the right), with its point lights and its emitting
-/// sphere, over the strategies and both samplings, and with the effects that skip work.
+/// the lit room without its ceiling (the sky seen above, and through the front and the right),
+/// with its point lights and its emitting sphere, over the strategies and both samplings, and
+/// with the effects that skip work; and the sky through the open side of Mitsuba's box (a BVH)
+/// with a spot and a directional light.
 #[test]
 fn waves_give_the_one_ray_pixels_with_an_environment() {
     let _limit = common::deadline(240);
@@ -285,8 +296,14 @@ fn waves_give_the_one_ray_pixels_with_an_environment() {
         "(light: Environment(radiance: (0.3, 0.35, 0.4)))".to_string(),
         format!("(light: Environment(image: {sky:?}, rotate: (0, 40, 0)))"),
     ];
+    // The lit room without its ceiling.
+    let open = |text: String| {
+        let ceiling = "(shape: InfinitePlane(point: (0, 1.4, 0), normal: (0, -1, 0)), material: Phong(kd: (0, 0, 0))),";
+        assert!(text.contains(ceiling), "room() changed");
+        text.replace(ceiling, "")
+    };
     let under = |shader: &str, effects: &str, sky: &str| {
-        let text = lit_room(shader, effects)
+        let text = open(lit_room(shader, effects))
             .replace("entities: [", &format!("entities: [\n            {sky},"));
         assert!(text.contains("Environment("), "room() changed");
         rtis::extract(&scene(&text))
@@ -307,7 +324,7 @@ fn waves_give_the_one_ray_pixels_with_an_environment() {
         }
         // The Course model (every light at every vertex, the course's weights).
         let shader = "Path(rr_depth: 2, sampling: Brdf, lights: Mis)";
-        let text = lit_room(shader, "")
+        let text = open(lit_room(shader, ""))
             .replace("model: Physical", "model: Course")
             .replace("entities: [", &format!("entities: [\n            {sky},"));
         assert!(text.contains("model: Course") && text.contains("Environment("));
@@ -322,6 +339,26 @@ fn waves_give_the_one_ray_pixels_with_an_environment() {
                     &format!("{shader}, {effects}, {sky}"),
                 );
             }
+        }
+        // A BVH's shadow rays, one at a time: the sky, a spot and a directional light in
+        // Mitsuba's box.
+        for per_vertex in ["One", "All", "Importance"] {
+            let shader = format!(
+                "Path(rr_depth: 2, sampling: Brdf, lights: Mis, lights_per_vertex: {per_vertex})"
+            );
+            let text = triangle_box(&shader, "", false).replace(
+                "entities: [",
+                &format!(
+                    "entities: [\n        {sky},
+        (light: Spot(position: (0, 0.8, 0.5), direction: (0.2, -1, -0.3), intensity: (2, 2, 1.5), cutoff_angle: 40)),
+        (light: Directional(direction: (0.1, -0.3, -1), irradiance: (0.5, 0.5, 0.4))),"
+                ),
+            );
+            assert!(text.contains("Spot(") && text.contains("Environment("));
+            agrees(
+                &rtis::extract(&scene(&text)),
+                &format!("{shader}, box, {sky}"),
+            );
         }
     }
 }

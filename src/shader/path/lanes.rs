@@ -4,7 +4,7 @@
 //! a path per lane, from the hit to the next ray: the interaction, next-event estimation
 //! over point, spot and directional lights and one sample of the area lights and the
 //! environment with the shadow rays tested in lanes
-//! ([`Geometry::occluded_lanes`]) and the area light's MIS weight, the cosine-weighted
+//! ([`Geometry::occluded_lanes`]) and the light sample's MIS weight, the cosine-weighted
 //! direction, its weight, and Russian roulette.
 //!
 //! Every lane computes what [`super::step`] computes for its path, operation for operation
@@ -58,16 +58,16 @@ pub fn applies(p: &Path) -> bool {
 }
 
 /// Each material that the lanes shade: a Phong material that reflects light diffusely only
-/// (so its BRDF sampling always picks the cosine lobe), by index.
-/// A material whose `kd` alone is textured is one too where its texel is not black: its
-/// parameters are looked up at each hit, as `Interaction::new` looks them up.
-pub struct Diffuse(Vec<Option<(Phong, Kd)>>);
+/// (so its BRDF sampling always picks the cosine lobe), by index. A material whose `kd` alone
+/// is textured is one too where its texel is not black: its parameters are looked up at each
+/// hit, as `Interaction::new` looks them up.
+pub struct Diffuse(Vec<Option<Kd>>);
 
 /// Where a diffuse material's `kd` comes from.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy)]
 enum Kd {
-    /// The material's own.
-    Constant,
+    /// The material's own parameters.
+    Constant(Phong),
     /// Its texture, at each hit.
     Textured,
 }
@@ -84,8 +84,8 @@ impl Diffuse {
             }
             match tr.textures.get(i).filter(|t| !t.is_empty()) {
                 None => (!phong.is_black() && diffuse_probability(phong) == 1.0)
-                    .then_some((*phong, Kd::Constant)),
-                Some(t) => t.only_reflectance().then_some((*phong, Kd::Textured)),
+                    .then_some(Kd::Constant(*phong)),
+                Some(t) => t.only_reflectance().then_some(Kd::Textured),
             }
         };
         Diffuse(tr.materials.iter().enumerate().map(diffuse).collect())
@@ -108,23 +108,29 @@ impl Diffuse {
         if smooth || light != NO_LIGHT {
             return None;
         }
-        let (phong, kd) = self.0.get(material as usize).copied().flatten()?;
-        if kd == Kd::Constant {
-            return Some((material, phong));
+        match self.0.get(material as usize).copied().flatten()? {
+            Kd::Constant(phong) => Some((material, phong)),
+            Kd::Textured => Some((material, textured(tr, material, hit)?)),
         }
-        // `Interaction::new`'s lookup: the texture at the hit's coordinates, filtered over
-        // the sample's footprint there.
-        let (i, prim) = (material as usize, geometry.prim(hit.prim));
-        let uv = geometry.uv(&prim, hit.p);
-        let width = tr.footprint.width(hit.p, hit.n) * geometry.uv_rate(&prim, hit.p);
-        let physical = tr.model == Model::Physical;
-        let Material::Phong(phong) = tr.textures[i].apply(&tr.materials[i], uv, width, physical)
-        else {
-            return None;
-        };
-        // A black texel reflects nothing, and draws no light sample: the one-ray code's.
-        (!phong.is_black() && diffuse_probability(&phong) == 1.0).then_some((material, phong))
     }
+}
+
+/// The Phong parameters of textured material `material` at `hit` (on a flat primitive), as
+/// `Interaction::new` looks them up, if the lanes shade them: not at a black texel, which
+/// reflects nothing and draws no light sample in the one-ray code. (Out of line: the
+/// untextured scenes' rounds stay as small as they were.)
+#[inline(never)]
+fn textured(tr: &Tracer, material: u32, hit: &Hit) -> Option<Phong> {
+    // The texture at the hit's coordinates, filtered over the sample's footprint there.
+    let (geometry, i): (&Geometry, usize) = (tr.geometry, material as usize);
+    let prim = geometry.prim(hit.prim);
+    let uv = geometry.uv(&prim, hit.p);
+    let width = tr.footprint.width(hit.p, hit.n) * geometry.uv_rate(&prim, hit.p);
+    let physical = tr.model == Model::Physical;
+    let Material::Phong(phong) = tr.textures[i].apply(&tr.materials[i], uv, width, physical) else {
+        return None;
+    };
+    (!phong.is_black() && diffuse_probability(&phong) == 1.0).then_some(phong)
 }
 
 /// One round of a wave: trace each path's ray of `slots` and shade the vertex it meets, the
@@ -186,14 +192,6 @@ unsafe fn round_avx2<R: Record>(
     unsafe { round_in::<crate::accel::F8, R>(tr, p, diffuse, slots, alive) }
 }
 
-/// Rows of a chunk's gathered rays and throughputs.
-const O: usize = 0;
-const D: usize = 3;
-const O_ERR: usize = 6;
-const T_MAX: usize = 7;
-const BETA: usize = 8;
-const ROWS: usize = 11;
-
 /// [`round`] in lanes `L`. No closures that compute in lanes, so that this inlines whole into
 /// the AVX2 and AVX-512 copies.
 ///
@@ -211,31 +209,27 @@ unsafe fn round_in<L: Floats, R: Record>(
     for c in (0..slots.len()).step_by(L::LANES) {
         let count = (slots.len() - c).min(L::LANES);
         // The chunk's rays and throughputs in lanes (lanes past `count` repeat the last).
-        let mut v = [[0.0f32; MAX_LANES]; ROWS];
+        let st = |i: usize| &slots[c + i.min(count - 1)].st;
+        let (mut o_err, mut t_max) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
         for i in 0..L::LANES {
-            let s = &slots[c + i.min(count - 1)].st;
-            for x in 0..3 {
-                v[O + x][i] = s.ray.o[x];
-                v[D + x][i] = s.ray.d[x];
-                v[BETA + x][i] = s.beta[x];
-            }
-            v[O_ERR][i] = s.ray.o_err;
-            v[T_MAX][i] = s.ray.t_max;
+            (o_err[i], t_max[i]) = (st(i).ray.o_err, st(i).ray.t_max);
         }
         // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block
-        // below, each makes values of `L`.
-        let load = |row: usize| unsafe { L::from_slice(&v[row]) };
-        let (o, d) = (
-            [load(O), load(O + 1), load(O + 2)],
-            [load(D), load(D + 1), load(D + 2)],
-        );
-        let beta = [load(BETA), load(BETA + 1), load(BETA + 2)];
+        // below, each makes values of `L`. The vectors transposed into lanes by shuffles.
+        let (o, d, beta) = unsafe {
+            (
+                L::transpose3::<MAX_LANES>(&std::array::from_fn(|i| &st(i).ray.o)),
+                L::transpose3::<MAX_LANES>(&std::array::from_fn(|i| &st(i).ray.d)),
+                L::transpose3::<MAX_LANES>(&std::array::from_fn(|i| &st(i).beta)),
+            )
+        };
+        let (o_err, t_max) = unsafe { (L::from_array(o_err), L::from_array(t_max)) };
         // The nearest hits, with their records, in the lanes: the packed primitives tested
         // in lanes, or each ray through the BVH with the one-ray query.
         let mut hits = [None; MAX_LANES];
         let h = if geometry.bvh.is_empty() {
-            let lanes = RayLanes::from_parts(o, d, load(O_ERR));
-            let near = unsafe { geometry.nearest_lanes(&lanes, load(T_MAX)) };
+            let lanes = RayLanes::from_parts(o, d, o_err);
+            let near = unsafe { geometry.nearest_lanes(&lanes, t_max) };
             let rows = near.rows();
             for (i, hit) in hits.iter_mut().enumerate().take(count) {
                 *hit = geometry.lane_hit(&rows, i);
@@ -331,7 +325,7 @@ struct Vertices<'h, L> {
     d: [L; 3],
     beta: [L; 3],
     kd: [L; 3],
-    /// The same hits lane by lane, for the area lights' samples.
+    /// The same hits lane by lane, for the area and environment samples.
     hits: &'h [Option<Hit>; MAX_LANES],
     /// Each shaded lane's material, index and parameters.
     materials: &'h [Option<(u32, Phong)>; MAX_LANES],
@@ -454,7 +448,8 @@ unsafe fn shade_in<L: Floats, R: Record>(
                     area.sample_environment(tr, at, i, slots[i].st.ray.d, (env, pmf), v);
                     None
                 }
-                _ => None,
+                // A light left to BRDF-sampled rays, or none.
+                Some(Chosen::Area(..) | Chosen::Environment(..)) | None => None,
             };
             if let Some((j, w)) = pick {
                 pmf[i] = w;
@@ -687,7 +682,8 @@ unsafe fn shade_in<L: Floats, R: Record>(
     }
 }
 
-/// The lanes' area-light samples: the lanes that drew one, those whose sample has a shadow
+/// The lanes' samples of the area lights and the environment: the lanes that drew one, those
+/// whose sample has a shadow
 /// ray to test (`light_ray`), and their columns, made at the first sample.
 #[derive(Default)]
 struct AreaRays {
