@@ -209,6 +209,26 @@ fn waves_give_the_one_ray_pixels() {
     }
 }
 
+/// The path tracers of the light-sample tests: light sampling, BRDF sampling or MIS; one
+/// light by power or by importance, or all; BRDF sampling (roulette from the first bounce) or
+/// cosine sampling (a depth limit).
+fn light_strategies() -> Vec<String> {
+    let mut shaders = Vec::new();
+    for lights in ["Mis", "Light", "Brdf"] {
+        for per_vertex in ["One", "All", "Importance"] {
+            for (sampling, depth) in [
+                ("Brdf", "rr_depth: 1"),
+                ("Cosine", "max_depth: 3, rr_depth: 2"),
+            ] {
+                shaders.push(format!(
+                    "Path({depth}, sampling: {sampling}, lights: {lights}, lights_per_vertex: {per_vertex})"
+                ));
+            }
+        }
+    }
+    shaders
+}
+
 /// Area lights in the waves: an emitting sphere among packed primitives, and a rectangle light
 /// in a scene of triangles (in a BVH), with point lights or without, over
 /// the strategies (light sampling, BRDF sampling, MIS; one light by power or by importance, or
@@ -216,27 +236,17 @@ fn waves_give_the_one_ray_pixels() {
 #[test]
 fn waves_give_the_one_ray_pixels_with_area_lights() {
     let _limit = common::deadline(240);
-    for lights in ["Mis", "Light", "Brdf"] {
-        for per_vertex in ["One", "All", "Importance"] {
-            for (sampling, depth) in [
-                ("Brdf", "rr_depth: 1"),
-                ("Cosine", "max_depth: 3, rr_depth: 2"),
-            ] {
-                let shader = format!(
-                    "Path({depth}, sampling: {sampling}, lights: {lights}, lights_per_vertex: {per_vertex})"
-                );
-                agrees(
-                    &rtis::extract(&scene(&lit_room(&shader, ""))),
-                    &format!("{shader}, sphere light"),
-                );
-                for point in [false, true] {
-                    let text = triangle_box(&shader, "", point);
-                    agrees(
-                        &rtis::extract(&scene(&text)),
-                        &format!("{shader}, box, point light {point}"),
-                    );
-                }
-            }
+    for shader in light_strategies() {
+        agrees(
+            &rtis::extract(&scene(&lit_room(&shader, ""))),
+            &format!("{shader}, sphere light"),
+        );
+        for point in [false, true] {
+            let text = triangle_box(&shader, "", point);
+            agrees(
+                &rtis::extract(&scene(&text)),
+                &format!("{shader}, box, point light {point}"),
+            );
         }
     }
     // Packed primitives and a BVH together: a mesh in the lit room.
@@ -309,18 +319,8 @@ fn waves_give_the_one_ray_pixels_with_an_environment() {
         rtis::extract(&scene(&text))
     };
     for sky in &skies {
-        for lights in ["Mis", "Light", "Brdf"] {
-            for per_vertex in ["One", "All", "Importance"] {
-                for (sampling, depth) in [
-                    ("Brdf", "rr_depth: 1"),
-                    ("Cosine", "max_depth: 3, rr_depth: 2"),
-                ] {
-                    let shader = format!(
-                        "Path({depth}, sampling: {sampling}, lights: {lights}, lights_per_vertex: {per_vertex})"
-                    );
-                    agrees(&under(&shader, "", sky), &format!("{shader}, {sky}"));
-                }
-            }
+        for shader in light_strategies() {
+            agrees(&under(&shader, "", sky), &format!("{shader}, {sky}"));
         }
         // The Course model (every light at every vertex, the course's weights).
         let shader = "Path(rr_depth: 2, sampling: Brdf, lights: Mis)";
