@@ -24,9 +24,7 @@ use crate::accel::lanes::SurfaceLanes;
 use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
 use crate::geometry::{Hit, Ray};
-use crate::light::{
-    AreaLight, Chosen, EnvironmentLight, Light, LightSample, NO_LIGHT, choose_by_importance,
-};
+use crate::light::{Chosen, Light, LightSample, NO_LIGHT, choose_by_importance};
 use crate::material::{Material, Model, Phong};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling, Streams};
 use crate::shader::Tracer;
@@ -418,11 +416,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
             ),
             false => ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]),
         };
-        let (u, u1, u2) = (
-            rng.next_f64(L::LANES),
-            rng.next_f32(L::LANES),
-            rng.next_f32(L::LANES),
-        );
+        let (u, u1, u2) = light_numbers(&mut rng, L::LANES);
         for i in Bits(shaded) {
             let (u, u12) = (u[i], (u1[i], u2[i]));
             // The light and the factor of its term: `1 / pmf` by power, `1 / (share p)` by
@@ -437,15 +431,9 @@ unsafe fn shade_in<L: Floats, R: Record>(
                         .filter(|(_, w)| w.is_finite())
                 }
                 Some(Chosen::Point(j, w)) => Some((j, w)),
-                // An area light: its sample, for the shadow rays of the lanes' area lights.
-                Some(Chosen::Area(light, pmf)) if sample_area && tr.effects.emission => {
-                    area.sample(tr, at, i, slots[i].st.ray.d, (light, pmf), u12);
-                    None
-                }
-                // The environment: its sample from two more numbers of the lane's stream.
-                Some(Chosen::Environment(env, pmf)) if sample_area && tr.effects.emission => {
-                    let v = (rng.next_f64_at(i), rng.next_f64_at(i));
-                    area.sample_environment(tr, at, i, slots[i].st.ray.d, (env, pmf), v);
+                // An area light or the environment: its sample, for the lanes' shadow rays.
+                Some(c) if sample_area && tr.effects.emission => {
+                    area.sample(tr, at, (i, slots[i].st.ray.d), c, u12, &mut rng);
                     None
                 }
                 // A light left to BRDF-sampled rays, or none.
@@ -516,7 +504,6 @@ unsafe fn shade_in<L: Floats, R: Record>(
         // `point_lights`: the terms summed from zero in the lights' order, then the area
         // lights' sample added.
         let mut sum = [zero; 3];
-        let at_p = [array(p_[0]), array(p_[1]), array(p_[2])];
         for light in tr.lights {
             let inc = match light {
                 Light::Point(l) => unsafe {
@@ -538,6 +525,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
                 },
                 // Lane by lane (no lane form).
                 Light::Spot(_) | Light::Directional(_) => unsafe {
+                    let at_p = [array(p_[0]), array(p_[1]), array(p_[2])];
                     incidents_by_lane(|_| light, &at_p, shaded)
                 },
             };
@@ -547,22 +535,11 @@ unsafe fn shade_in<L: Floats, R: Record>(
         // `area_lights` with one sample: the light chosen by power (`u`), a point on it
         // (`u1`, `u2`), its term (zero where none is drawn).
         if sample_area && tr.effects.emission && !tr.emitters.is_empty() {
-            let (u, u1, u2) = (
-                rng.next_f64(L::LANES),
-                rng.next_f32(L::LANES),
-                rng.next_f32(L::LANES),
-            );
+            let (u, u1, u2) = light_numbers(&mut rng, L::LANES);
             for i in Bits(shaded) {
-                let (u, u12) = (u[i], (u1[i], u2[i]));
                 // (The point lights take no part in this choice.)
-                let d = slots[i].st.ray.d;
-                match tr.emitters.choose_any(u) {
-                    Some(Chosen::Area(light, pmf)) => area.sample(tr, at, i, d, (light, pmf), u12),
-                    Some(Chosen::Environment(env, pmf)) => {
-                        let v = (rng.next_f64_at(i), rng.next_f64_at(i));
-                        area.sample_environment(tr, at, i, d, (env, pmf), v);
-                    }
-                    Some(Chosen::Point(..)) | None => {}
+                if let Some(c) = tr.emitters.choose_any(u[i]) {
+                    area.sample(tr, at, (i, slots[i].st.ray.d), c, (u1[i], u2[i]), &mut rng);
                 }
             }
         }
@@ -702,36 +679,31 @@ struct AreaColumns {
 }
 
 impl AreaRays {
-    /// Lane `i` of `at` (a shaded lane, whose ray has direction `d`) samples area light
-    /// `light`, chosen with probability `pmf`, from the random numbers `u` (`area_sample`).
+    /// Lane `i` of `at` (a shaded lane, whose ray has direction `d`) samples the light it
+    /// chose: an area light from the random numbers `u` (`area_sample`), the environment from
+    /// two more numbers of the lane's stream in `rng` (`environment_sample`); a point light
+    /// has its term apart (`light_term`).
     #[inline(always)]
     fn sample<L>(
         &mut self,
         tr: &Tracer,
         at: &Vertices<L>,
-        i: usize,
-        d: Vec3A,
-        (light, pmf): (&AreaLight, f32),
+        (i, d): (usize, Vec3A),
+        chosen: Chosen,
         u: (f32, f32),
+        rng: &mut Streams,
     ) {
-        let ls = at.hits[i].and_then(|hit| sample_area_light(tr.emitters, light, hit.p, u));
-        self.record(tr, at, i, d, ls, pmf);
-    }
-
-    /// Lane `i` of `at` (a shaded lane, whose ray has direction `d`) samples the environment
-    /// `env`, chosen with probability `pmf`, from the random numbers `v`
-    /// (`environment_sample`).
-    #[inline(always)]
-    fn sample_environment<L>(
-        &mut self,
-        tr: &Tracer,
-        at: &Vertices<L>,
-        i: usize,
-        d: Vec3A,
-        (env, pmf): (&EnvironmentLight, f32),
-        v: (f64, f64),
-    ) {
-        self.record(tr, at, i, d, env.sample(v.0, v.1), pmf);
+        match chosen {
+            Chosen::Area(light, pmf) => {
+                let ls = at.hits[i].and_then(|hit| sample_area_light(tr.emitters, light, hit.p, u));
+                self.record(tr, at, i, d, ls, pmf);
+            }
+            Chosen::Environment(env, pmf) => {
+                let v = (rng.next_f64_at(i), rng.next_f64_at(i));
+                self.record(tr, at, i, d, env.sample(v.0, v.1), pmf);
+            }
+            Chosen::Point(..) => {}
+        }
     }
 
     /// Lane `i`'s light sample `ls` (none if the light gave none), chosen with probability
@@ -834,6 +806,18 @@ impl AreaRays {
             ]
         }
     }
+}
+
+/// The numbers `one_light` and `area_lights` draw for a light sample, in lanes: `u` (53 bits)
+/// chooses the light, `u1` and `u2` a point on an area light.
+#[inline(always)]
+fn light_numbers(
+    rng: &mut Streams,
+    lanes: usize,
+) -> ([f64; MAX_LANES], [f32; MAX_LANES], [f32; MAX_LANES]) {
+    let u = rng.next_f64(lanes);
+    let u1 = rng.next_f32(lanes);
+    (u, u1, rng.next_f32(lanes))
 }
 
 /// The set bits of a lane mask, lowest first.
