@@ -59,9 +59,9 @@ def build_base(rev):
     return commit, os.path.join(target, "release", "rtis")
 
 
-def render(binary, scene, width, out, stats, result, key):
+def render(binary, scene, film, out, stats, result, key):
     subprocess.run(
-        [binary, "render", scene, "--width", str(width), "--threads", "1", "-o", out, "--stats", stats],
+        [binary, "render", scene, *film, "--threads", "1", "-o", out, "--stats", stats],
         cwd=ROOT, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
     )
     with open(stats) as f:
@@ -73,10 +73,12 @@ def main():
     ap.add_argument("--base", default="HEAD~1", help="the commit to compare with (default HEAD~1)")
     ap.add_argument("--scene", default="scenes/cornell-n-bounce.ron")
     ap.add_argument("--width", type=int, default=360, help="film width (the height keeps the aspect)")
+    ap.add_argument("--height", type=int, help="film height, for commits whose --width alone keeps the scene's height")
     ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
-    if args.rounds < 1 or args.width < 1:
-        sys.exit("--rounds and --width must be at least 1")
+    if args.rounds < 1 or args.width < 1 or (args.height is not None and args.height < 1):
+        sys.exit("--rounds, --width and --height must be at least 1")
+    film = ["--width", str(args.width)] + (["--height", str(args.height)] if args.height else [])
     head = build_head()
     base_commit, base = build_base(args.base)
     head_commit = git("rev-parse", "--short", "HEAD") + ("+" if git("status", "--porcelain", "--untracked-files=no") else "")
@@ -90,7 +92,7 @@ def main():
             ]
             if r % 2:
                 runs.reverse()
-            threads = [threading.Thread(target=render, args=(b, args.scene, args.width, o, s, result, k)) for b, o, s, k in runs]
+            threads = [threading.Thread(target=render, args=(b, args.scene, film, o, s, result, k)) for b, o, s, k in runs]
             for t in threads:
                 t.start()
             for t in threads:
@@ -120,7 +122,7 @@ def main():
                 same = differ["pixels"] == 0
     print(json.dumps({
         "compare": "head_vs_base", "base": base_commit, "head": head_commit, "scene": args.scene,
-        "width": args.width, "rounds": args.rounds, "ratio": statistics.median(ratios),
+        "width": args.width, "height": args.height, "rounds": args.rounds, "ratio": statistics.median(ratios),
         "ratio_range": [min(ratios), max(ratios)], "base_s": statistics.median(base_s),
         "head_s": statistics.median(head_s), "same_pixels": same, "differ": differ,
     }))

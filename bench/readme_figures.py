@@ -345,7 +345,8 @@ def inspect(_runs):
         "",
         f"An inspected render (`--aov --parts --fireflies 5`) of `{box}` at {width} px and 16 spp took "
         f"{inspected:.2f} s against {plain:.2f} s plain, wall clock ({inspected / plain:.2f}x): the price "
-        f"of the counters, the clock, the split by technique and bounce, the first-hit layers and "
+        f"of tracing each sample alone (the plain render runs Path in waves, the same image to the bit), "
+        f"the counters, the clock, the split by technique and bounce, the first-hit layers and "
         f"writing two more files; the cheaper a scene's samples, the larger its share. Its largest "
         f"firefly, pixel {x},{y} sample {top['sample']} (luminance {top['luminance']:.3g}, "
         f"{top['excess']:.3g} above its pixel), replayed:",

@@ -12,6 +12,10 @@
 //!   the exact sum of the contributions it holds: the parts of a pixel sum exactly to its
 //!   exact sum, so to the render's pixel.
 //!
+//! Every sample is traced alone, one ray at a time ([`crate::shader::radiance`]), not in
+//! Path's waves ([`super::waves`]) or in groups of camera rays: those add the same bits, but
+//! only a sample traced alone can be timed, counted and split on its own.
+//!
 //! The samples that stand out most above their pixel ("fireflies") are kept, then replayed
 //! to give the path of each.
 //! A replay ([`replay`]) traces one sample again from its own random stream, so that it finds

@@ -80,8 +80,14 @@ fn total(parts: &[RgbSum]) -> RgbSum {
 #[test]
 fn parts_sum_to_the_render_bit_for_bit() {
     let _limit = common::deadline(300);
+    let mut in_waves = 0;
     for text in path_variants() {
         let s = rtis::extract(&scene(&text));
+        // The plain render runs these in waves (BRDF and cosine sampling) or one ray at a
+        // time (uniform sampling); the inspected render always one at a time.
+        let waves = rtis::render::waves::applies(&s);
+        assert_eq!(waves, !text.contains("sampling: Uniform"), "{text}");
+        in_waves += waves as usize;
         let mut some_light = [false; 3];
         for row in 0..s.film.height {
             for col in 0..s.film.width {
@@ -113,6 +119,7 @@ fn parts_sum_to_the_render_bit_for_bit() {
         assert_eq!(bits(&inspected.image), bits(&rendered.image), "{text}");
         assert_eq!(inspected.stats, rendered.stats, "{text}");
     }
+    assert_eq!(in_waves, 36, "two samplings of three, in 54 variants");
 }
 
 /// Under MIS both techniques of the area light find some of it: BSDF-sampled light is not
@@ -263,6 +270,62 @@ fn per_pixel_counts_sum_to_the_render() {
         // Every camera ray meets a surface here: a normal, a depth, an albedo.
         assert!(p.depth > 0.0 && p.normal != glam::Vec3A::ZERO, "{p:?}");
         assert!(p.albedo != glam::Vec3A::ZERO, "{p:?}");
+    }
+}
+
+/// The variance layer is the variance of the pixel's mean, from its samples' spread: the
+/// unbiased variance of the samples each render adds (`render_sample`), over their count.
+#[test]
+fn the_variance_layer_is_the_spread_of_the_samples_the_render_adds() {
+    let text = room("Path(rr_depth: 3)", "Physical").replace("spp: 6", "spp: 9");
+    let s = rtis::extract(&scene(&text));
+    let r = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
+    let mut spread = 0;
+    for (i, p) in r.pixels.iter().enumerate() {
+        let (col, row) = (i as u32 % s.film.width, i as u32 / s.film.width);
+        let l: Vec<glam::DVec3> = (0..s.film.spp)
+            .map(|k| {
+                let sample = render_sample(&s, col, row, k, &mut RayStats::default());
+                sample.mean(1).as_dvec3()
+            })
+            .collect();
+        let n = l.len() as f64;
+        let mean = l.iter().sum::<glam::DVec3>() / n;
+        let var = l
+            .iter()
+            .map(|x| (*x - mean) * (*x - mean))
+            .sum::<glam::DVec3>()
+            / (n - 1.0)
+            / n;
+        let got = p.variance.as_dvec3();
+        let scale = l.iter().map(|x| x.length_squared()).sum::<f64>() / n;
+        assert!(
+            (got - var).abs().max_element() <= 1e-6 * scale + 1e-12,
+            "pixel {col},{row}: {got} against {var}"
+        );
+        spread += (var.max_element() > 0.0) as usize;
+    }
+    assert!(spread > r.pixels.len() / 2, "most pixels vary: {spread}");
+}
+
+/// In a sphere room of radius 10 centred on the camera every camera ray meets the wall at
+/// distance 10, where its albedo is the Phong `kd` and its normal faces the camera.
+#[test]
+fn first_hit_layers_in_a_room_centred_on_the_camera() {
+    let text = "Scene(film: (width: 8, height: 6, spp: 4), shader: Path(),
+          camera: Perspective(position: (0, 0, 0), look_at: (0, 0, 1), fov: 70),
+          entities: [(shape: Sphere(center: (0, 0, 0), radius: 10), material: Phong(kd: (0.5, 0.25, 0.125))),
+                     (light: Point(position: (0, 2, 0), intensity: (5, 5, 5)))])";
+    let s = rtis::extract(&scene(text));
+    let r = inspect(&s, counted(0), &|| {}, &AtomicBool::new(false));
+    for p in &r.pixels {
+        assert!((p.depth - 10.0).abs() <= 1e-4, "{}", p.depth);
+        assert_eq!(p.albedo, glam::Vec3A::new(0.5, 0.25, 0.125));
+        // The mean of the inward normals of the pixel's samples: nearly unit (they span a
+        // pixel), towards the camera, so against the view direction +z.
+        let len = p.normal.length();
+        assert!(len > 0.99 && len <= 1.0 + 1e-5, "{}", p.normal);
+        assert!(p.normal.z < -0.5, "{}", p.normal);
     }
 }
 
