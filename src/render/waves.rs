@@ -99,8 +99,10 @@ fn wave(
     stats: &mut RayStats,
     out: &mut [RgbSum],
 ) {
-    // The next sample to start: its pixel's place in `pixels`, and its index.
-    let (mut pixel, mut next) = (0, samples.start);
+    let mut feed = Feed {
+        pixel: 0,
+        next: samples.start,
+    };
     // The paths in flight and each one's pixel.
     let mut slots: Vec<PathSlot<SampleSum>> = Vec::with_capacity(WAVE);
     let mut of = Vec::with_capacity(WAVE);
@@ -108,42 +110,78 @@ fn wave(
     // One tracer for the wave; a path shaded one ray at a time gets its stream swapped in.
     let mut tr = scene.tracer(Sampler::new(0, 0, 0), stats);
     let diffuse = lanes::Diffuse::table(&tr);
-    loop {
-        // Free slots take the next samples, their camera rays first.
-        while slots.len() < WAVE && pixel < pixels.len() {
-            if next >= samples.end {
-                (pixel, next) = (pixel + 1, samples.start);
-                continue;
-            }
-            let (col, row) = pixels[pixel];
-            let (ray, sampler) = camera_ray(scene, col, row, next);
-            next += 1;
-            tr.count(&ray, RayKind::Camera);
-            slots.push(PathSlot {
-                st: PathState::new(&ray),
-                sampler,
-                rec: SampleSum::default(),
-            });
-            of.push(pixel);
-        }
-        if slots.is_empty() {
-            return;
-        }
+    // The slots take the first samples, their camera rays first.
+    while slots.len() < WAVE
+        && let Some((pixel, slot)) = feed.start(scene, pixels, &samples, &mut tr)
+    {
+        slots.push(slot);
+        of.push(pixel);
+    }
+    while !slots.is_empty() {
         // The round: each path's ray traced and its vertex shaded.
         alive.clear();
         alive.resize(slots.len(), false);
         lanes::round(&mut tr, p, &diffuse, &mut slots, &mut alive);
-        // The paths that ended give their sums to their pixels and their slots to new
-        // samples.
+        // The paths that ended give their sums to their pixels and their slots, in place, to
+        // the next samples (a slot is not moved: it is large); when none are left the slots
+        // close up.
         let mut k = 0;
         while k < slots.len() {
             if alive[k] {
                 k += 1;
-            } else {
-                let done = slots.swap_remove(k);
-                alive.swap_remove(k);
-                done.rec.keep_into(&mut out[of.swap_remove(k)], tr.stats);
+                continue;
+            }
+            slots[k].rec.keep_into(&mut out[of[k]], tr.stats);
+            match feed.start(scene, pixels, &samples, &mut tr) {
+                Some((pixel, slot)) => {
+                    (slots[k], of[k]) = (slot, pixel);
+                    k += 1;
+                }
+                None => {
+                    slots.swap_remove(k);
+                    alive.swap_remove(k);
+                    of.swap_remove(k);
+                }
             }
         }
+    }
+}
+
+/// The next sample of a wave to start: its pixel's place in the wave's pixels, and its index.
+struct Feed {
+    pixel: usize,
+    next: u32,
+}
+
+impl Feed {
+    /// The next sample's pixel (its place in `pixels`) and its slot, its camera ray made and
+    /// counted; `None` when every sample has started.
+    #[inline]
+    fn start(
+        &mut self,
+        scene: &RenderScene,
+        pixels: &[(u32, u32)],
+        samples: &std::ops::Range<u32>,
+        tr: &mut crate::shader::Tracer,
+    ) -> Option<(usize, PathSlot<SampleSum>)> {
+        loop {
+            if self.pixel >= pixels.len() {
+                return None;
+            }
+            if self.next < samples.end {
+                break;
+            }
+            (self.pixel, self.next) = (self.pixel + 1, samples.start);
+        }
+        let (col, row) = pixels[self.pixel];
+        let (ray, sampler) = camera_ray(scene, col, row, self.next);
+        self.next += 1;
+        tr.count(&ray, RayKind::Camera);
+        let slot = PathSlot {
+            st: PathState::new(&ray),
+            sampler,
+            rec: SampleSum::default(),
+        };
+        Some((self.pixel, slot))
     }
 }
