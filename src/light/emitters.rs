@@ -176,17 +176,28 @@ impl Emitters {
         if self.cdf.is_empty() {
             return None;
         }
-        let i = self
-            .cdf
-            .partition_point(|&c| c <= u)
-            .min(self.cdf.len() - 1);
+        Some(self.chosen(self.cdf.partition_point(|&c| c <= u)))
+    }
+
+    /// The cumulative shares of the choice ([`Emitters::choose_any`] picks the light at the
+    /// count of those at or below `u`, or the last); empty without lights.
+    #[inline]
+    pub fn cdf(&self) -> &[f64] {
+        &self.cdf
+    }
+
+    /// The light at place `i` of the choice (the last if `i` is past it; there is one), with
+    /// its probability.
+    #[inline]
+    pub fn chosen(&self, i: usize) -> Chosen<'_> {
+        let i = i.min(self.cdf.len() - 1);
         let pmf = self.pmf[i];
         let n = self.lights.len();
-        Some(match (self.lights.get(i), &self.environment) {
+        match (self.lights.get(i), &self.environment) {
             (Some(l), _) => Chosen::Area(l, pmf),
             (None, Some(env)) if i == n => Chosen::Environment(env, pmf),
             (None, _) => Chosen::Point(i - self.sampled(), pmf),
-        })
+        }
     }
 
     /// Density per unit solid angle with which one light sample from `p` (choose a light, then

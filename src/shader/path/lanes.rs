@@ -423,11 +423,13 @@ unsafe fn shade_in<L: Floats, R: Record>(
             false => ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]),
         };
         let (u, u1, u2) = light_numbers(&mut rng, L::LANES);
+        let place = choice_places(tr.emitters.cdf(), &u);
+        let any_light = !tr.emitters.cdf().is_empty();
         for i in Bits(shaded) {
             let (u, u12) = (u[i], (u1[i], u2[i]));
             // The light and the factor of its term: `1 / pmf` by power, `1 / (share p)` by
             // importance (a light chosen with a chance below f32's range adds nothing).
-            let pick = match tr.emitters.choose_any(u) {
+            let pick = match any_light.then(|| tr.emitters.chosen(place[i] as usize)) {
                 Some(Chosen::Point(..)) if by_importance => {
                     let (start, share) = tr.emitters.point_share();
                     let v = ((u - start) / share).clamp(0.0, 1.0 - f64::EPSILON / 2.0);
@@ -542,11 +544,11 @@ unsafe fn shade_in<L: Floats, R: Record>(
         // (`u1`, `u2`), its term (zero where none is drawn).
         if sample_area && tr.effects.emission && !tr.emitters.is_empty() {
             let (u, u1, u2) = light_numbers(&mut rng, L::LANES);
+            let place = choice_places(tr.emitters.cdf(), &u);
             for i in Bits(shaded) {
                 // (The point lights take no part in this choice.)
-                if let Some(c) = tr.emitters.choose_any(u[i]) {
-                    area.sample(tr, at, (i, slots[i].st.ray.d), c, (u1[i], u2[i]), &mut rng);
-                }
+                let c = tr.emitters.chosen(place[i] as usize);
+                area.sample(tr, at, (i, slots[i].st.ray.d), c, (u1[i], u2[i]), &mut rng);
             }
         }
         let area = unsafe { area.terms(tr, at, (wo, n), mis, true) };
@@ -824,6 +826,20 @@ fn light_numbers(
     let u = rng.next_f64(lanes);
     let u1 = rng.next_f32(lanes);
     (u, u1, rng.next_f32(lanes))
+}
+
+/// Each lane's place in the light choice for its number `u` (`Emitters::choose_any`'s
+/// `partition_point`): the count of the cumulative shares `cdf` at or below it (they do not
+/// decrease), without the binary search's branches, in lanes (the loops vectorise).
+#[inline(always)]
+fn choice_places(cdf: &[f64], u: &[f64; MAX_LANES]) -> [u32; MAX_LANES] {
+    let mut place = [0u32; MAX_LANES];
+    for &c in cdf {
+        for (p, &u) in place.iter_mut().zip(u) {
+            *p += u32::from(c <= u);
+        }
+    }
+    place
 }
 
 /// The set bits of a lane mask, lowest first.
