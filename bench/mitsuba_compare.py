@@ -14,7 +14,10 @@ machine's state:
 - `area`: Mitsuba's own `cornell_box()` lit by its area light (scenes/mitsuba-cornell.ron),
   against the stored 4096-spp Mitsuba image.
 
-For each it prints wall seconds, samples per second, RMSE against the reference and the
+For each it prints seconds (each renderer's render alone: Mitsuba's `render` call after a first
+call has compiled its kernels, rtis's render from its first pixel to its last as `--stats`
+reports it; neither counts loading the scene, building its BVH or writing the image), samples
+per second, RMSE against the reference and the
 renderer's own RMSE (the reference's noise taken out), and the time each needs to reach the
 smallest own error (RMSE falls as 1/sqrt(spp)). rtis renders with the same estimator as
 Mitsuba's `path` (one light sample per vertex, MIS with the BSDF sample) and with its other
@@ -27,12 +30,17 @@ Setup (once):
 
 Usage:
     .venv/bin/python bench/mitsuba_compare.py [--spp 64] [--scenes diffuse,full,area]
-        [--reference-spp 1024] [--variant llvm_ad_rgb]
+        [--reference-spp 1024] [--variant llvm_ad_rgb] [--rounds 5]
+
+Each renderer and strategy renders --rounds times, the rounds interleaved (Mitsuba first in
+even rounds, last in odd ones), so that each round's ratios compare runs that saw the same
+machine; the tables give the median of each round's ratio and their range.
 """
 
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -138,58 +146,86 @@ AREA_STRATEGIES = [
 ]
 
 
-def rtis_rows(text, strategies, spp, ref, flip):
-    """rtis's rows: each strategy's seconds and RMSE against `ref` (flipped left-right first
-    if `flip`: Mitsuba's camera is right-handed)."""
+def rtis_runs(text, strategies, spp):
+    """rtis's runs: for each strategy, a function that renders it once and returns (seconds,
+    image), the scene file written once."""
     rtis = os.path.join(ROOT, "target/release/rtis")
-    rows = []
-    with tempfile.TemporaryDirectory() as d:
-        for label, strategy in strategies:
-            scene_file = os.path.join(d, "scene.ron")
-            with open(scene_file, "w") as f:
-                f.write(text.replace("sampling: Brdf)", f"sampling: Brdf, {strategy})"))
-            out = os.path.join(d, "rtis.exr")
-            t = time.perf_counter()
-            subprocess.run([rtis, "render", scene_file, "--spp", str(spp), "-o", out], check=True,
-                           stderr=subprocess.DEVNULL)
-            seconds = time.perf_counter() - t
-            img = read_exr(out)
-            rows.append((label, seconds, rmse(img[:, ::-1, :] if flip else img, ref)))
-    return rows
+    d = tempfile.mkdtemp()
+    runs = []
+    for k, (label, strategy) in enumerate(strategies):
+        scene_file = os.path.join(d, f"scene{k}.ron")
+        with open(scene_file, "w") as f:
+            f.write(text.replace("sampling: Brdf)", f"sampling: Brdf, {strategy})"))
+
+        def run(scene_file=scene_file):
+            out, stats = os.path.join(d, "rtis.exr"), os.path.join(d, "stats.json")
+            subprocess.run([rtis, "render", scene_file, "--spp", str(spp), "-o", out, "--stats", stats],
+                           check=True, stderr=subprocess.DEVNULL)
+            # The render's own seconds, from its first pixel to its last: as Mitsuba's are
+            # timed, without loading the scene (its BVH built) and writing the image.
+            with open(stats) as f:
+                return json.load(f)["seconds"], read_exr(out)
+
+        runs.append((label, run))
+    return runs
 
 
-def mitsuba_row(mi, scene, spp, variant, ref):
-    """Mitsuba's row: seconds (its kernels compiled first, outside the timing) and RMSE."""
+def mitsuba_run(mi, scene, spp, variant):
+    """Mitsuba's run: a function that renders once and returns (seconds, image); its kernels
+    are compiled first, outside the timing."""
     mi.render(scene, spp=1)
-    t = time.perf_counter()
-    img = np.array(mi.render(scene, spp=spp))
-    return ("Mitsuba 3 " + variant, time.perf_counter() - t, rmse(img, ref))
+
+    def run():
+        t = time.perf_counter()
+        img = np.array(mi.render(scene, spp=spp))
+        return time.perf_counter() - t, img
+
+    return ("Mitsuba 3 " + variant, run)
 
 
 def compare(name, mi, args):
-    """One scene: (width, height, reference noise RMSE, rows)."""
+    """One scene: (width, height, reference noise RMSE, rows), each row (label, seconds of each
+    round, RMSE). Each round renders Mitsuba and every rtis strategy once, Mitsuba first in
+    even rounds and last in odd ones; the images are the same in every round (fixed seeds),
+    so the RMSE is the first round's."""
     if name == "diffuse":
         ref = read_exr(os.path.join(ROOT, "tests/data/cornell_rtis_diffuse_360x288_dinf_spp4096.exr"))
         noise, size = 0.007, (360, 288)
-        rows = [mitsuba_row(mi, mi.load_dict(mitsuba_scene(mi, args.spp)), args.spp, args.variant, ref)]
-        rows += rtis_rows(PHYSICAL, POINT_STRATEGIES, args.spp, ref, True)
+        runs = [mitsuba_run(mi, mi.load_dict(mitsuba_scene(mi, args.spp)), args.spp, args.variant)]
+        runs += rtis_runs(PHYSICAL, POINT_STRATEGIES, args.spp)
     elif name == "full":
         # The reference: two independent halves, their mean, and its noise from their difference.
         half = mi.load_dict(mitsuba_scene(mi, args.reference_spp // 2, full=True))
         a = np.array(mi.render(half, spp=args.reference_spp // 2, seed=1))
         b = np.array(mi.render(half, spp=args.reference_spp // 2, seed=2))
         ref, noise, size = (a + b) / 2, rmse(a, b) / 2, (360, 288)
-        rows = [mitsuba_row(mi, mi.load_dict(mitsuba_scene(mi, args.spp, full=True)), args.spp,
-                            args.variant, ref)]
-        rows += rtis_rows(FULL, POINT_STRATEGIES, args.spp, ref, True)
+        runs = [mitsuba_run(mi, mi.load_dict(mitsuba_scene(mi, args.spp, full=True)), args.spp, args.variant)]
+        runs += rtis_runs(FULL, POINT_STRATEGIES, args.spp)
     else:
         ref = read_exr(os.path.join(ROOT, "tests/data/mitsuba_cornell_area_128_spp4096.exr"))
         with open(os.path.join(ROOT, "tests/data/mitsuba_cornell_area_128_spp4096.json")) as f:
             noise = json.load(f)["noise_rmse"]
         size = (128, 128)
-        rows = [mitsuba_row(mi, mi.load_dict(area_scene(mi, args.spp)), args.spp, args.variant, ref)]
-        rows += rtis_rows(AREA, AREA_STRATEGIES, args.spp, ref, True)
-    return size, noise, rows
+        runs = [mitsuba_run(mi, mi.load_dict(area_scene(mi, args.spp)), args.spp, args.variant)]
+        runs += rtis_runs(AREA, AREA_STRATEGIES, args.spp)
+    seconds = [[] for _ in runs]
+    errors = [None for _ in runs]
+    for r in range(args.rounds):
+        order = list(range(len(runs)))
+        if r % 2 == 1:
+            order = order[1:] + order[:1]
+        for k in order:
+            t, img = runs[k][1]()
+            seconds[k].append(t)
+            if errors[k] is None:
+                # rtis's camera is left-handed: its image is Mitsuba's mirrored left-right.
+                errors[k] = rmse(img if k == 0 else img[:, ::-1, :], ref)
+    return size, noise, [(label, s, e) for (label, _), s, e in zip(runs, seconds, errors)]
+
+
+def interval(values):
+    """The median of `values` and their range."""
+    return statistics.median(values), [min(values), max(values)]
 
 
 def main():
@@ -198,7 +234,10 @@ def main():
     ap.add_argument("--scenes", default="diffuse,full,area")
     ap.add_argument("--reference-spp", type=int, default=1024)
     ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--rounds", type=int, default=5, help="renders of each renderer and strategy")
     args = ap.parse_args()
+    if args.rounds < 1:
+        sys.exit("--rounds must be at least 1")
 
     llvm = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
     if args.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(llvm):
@@ -206,7 +245,8 @@ def main():
     import mitsuba as mi
 
     mi.set_variant(args.variant)
-    report = {"spp": args.spp, "variant": args.variant, "reference_spp": args.reference_spp, "scenes": {}}
+    report = {"spp": args.spp, "variant": args.variant, "reference_spp": args.reference_spp,
+              "rounds": args.rounds, "scenes": {}}
     for name in args.scenes.split(","):
         (w, h), noise, rows = compare(name, mi, args)
         samples = w * h * args.spp
@@ -214,16 +254,26 @@ def main():
         # left, and it falls as 1/sqrt(time): time to reach a common error e is t (own / e)^2.
         own = [max(e * e - noise**2, 1e-12) ** 0.5 for _, _, e in rows]
         target = min(own)
-        eq = [t * (o / target) ** 2 for (_, t, _), o in zip(rows, own)]
-        print(f"\n{name}: {w}x{h} at {args.spp} spp (reference noise RMSE {noise:.5f})")
-        print(f"{'renderer':<40} {'seconds':>8} {'Msamples/s':>11} {'RMSE':>9} {'own RMSE':>9} {'equal-error s':>14}")
-        for (label, t, e), o, q in zip(rows, own, eq):
-            print(f"{label:<40} {t:>8.2f} {samples / t / 1e6:>11.2f} {e:>9.5f} {o:>9.5f} {q:>14.2f}")
-        report["scenes"][name] = {
-            "width": w, "height": h, "reference_noise": noise,
-            "rows": [{"renderer": n, "seconds": t, "rmse": e, "own_rmse": o, "seconds_at_equal_error": q}
-                     for (n, t, e), o, q in zip(rows, own, eq)],
-        }
+        scale = [(o / target) ** 2 for o in own]
+        mitsuba_s = rows[0][1]
+        print(f"\n{name}: {w}x{h} at {args.spp} spp (reference noise RMSE {noise:.5f}), "
+              f"{args.rounds} rounds (medians; ratios to Mitsuba per round, median [range])")
+        print(f"{'renderer':<40} {'seconds':>8} {'Msamples/s':>11} {'vs Mitsuba':>22} {'RMSE':>9} "
+              f"{'own RMSE':>9} {'equal-error vs Mitsuba':>24}")
+        out = []
+        for (label, secs, e), o, sc in zip(rows, own, scale):
+            t = statistics.median(secs)
+            # Each round's ratios: Mitsuba's seconds over this row's, at the same samples and
+            # at equal error.
+            rate, rate_range = interval([m / x for m, x in zip(mitsuba_s, secs)])
+            eq, eq_range = interval([m * scale[0] / (x * sc) for m, x in zip(mitsuba_s, secs)])
+            print(f"{label:<40} {t:>8.2f} {samples / t / 1e6:>11.2f} "
+                  f"{rate:>8.2f}x [{rate_range[0]:.2f}-{rate_range[1]:.2f}] {e:>9.5f} {o:>9.5f} "
+                  f"{eq:>9.2f}x [{eq_range[0]:.2f}-{eq_range[1]:.2f}]")
+            out.append({"renderer": label, "seconds": t, "seconds_rounds": secs, "rmse": e, "own_rmse": o,
+                        "seconds_at_equal_error": t * sc, "vs_mitsuba": rate, "vs_mitsuba_range": rate_range,
+                        "equal_error_vs_mitsuba": eq, "equal_error_range": eq_range})
+        report["scenes"][name] = {"width": w, "height": h, "reference_noise": noise, "rows": out}
     print(json.dumps(report))
 
 

@@ -593,25 +593,27 @@ def mitsuba(_runs):
     lines = []
     for name, sc in r["scenes"].items():
         rows = sc["rows"]
-        mitsuba_rate = sc["width"] * sc["height"] * r["spp"] / rows[0]["seconds"]
-        base = rows[0]["seconds_at_equal_error"]
         lines += [
             f"{titles[name]}, {sc['width']}x{sc['height']} at {r['spp']} spp (reference noise RMSE "
             f"{sc['reference_noise']:.4f}):",
             "",
-            "| renderer | seconds | Msamples/s | samples/s vs Mitsuba | RMSE | own RMSE | seconds at equal error | speed at equal error |",
+            "| renderer | seconds | Msamples/s | samples/s vs Mitsuba [range] | RMSE | own RMSE | seconds at equal error | speed at equal error [range] |",
             "|---|---|---|---|---|---|---|---|",
         ]
         for row in rows:
             rate = sc["width"] * sc["height"] * r["spp"] / row["seconds"]
+            lo, hi = row["vs_mitsuba_range"]
+            elo, ehi = row["equal_error_range"]
             lines.append(
-                f"| {row['renderer']} | {row['seconds']:.2f} | {rate / 1e6:.2f} | {rate / mitsuba_rate:.2f}x | "
+                f"| {row['renderer']} | {row['seconds']:.2f} | {rate / 1e6:.2f} | "
+                f"{row['vs_mitsuba']:.2f}x [{lo:.2f}-{hi:.2f}] | "
                 f"{row['rmse']:.4f} | {row['own_rmse']:.4f} | {row['seconds_at_equal_error']:.2f} | "
-                f"{base / row['seconds_at_equal_error']:.2f}x Mitsuba |"
+                f"{row['equal_error_vs_mitsuba']:.2f}x [{elo:.2f}-{ehi:.2f}] |"
             )
         lines.append("")
     return "\n".join(lines + [stamp(f"`bench/mitsuba_compare.py --spp {r['spp']}` ({r['variant']}; "
-                                    f"the full box's reference at {r['reference_spp']} spp)")])
+                                    f"{r['rounds']} rounds, medians; the full box's reference at "
+                                    f"{r['reference_spp']} spp)")])
 
 
 def block_re(name):
