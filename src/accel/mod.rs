@@ -98,6 +98,31 @@ impl LeafRay {
     }
 }
 
+/// The leaf test of [`Geometry::intersect`]'s walk: a block's nearest hit, the unit normal
+/// of the last one kept. A type of its own (not a closure) so that its test is inlined into
+/// the walk and compiled for the walk's instruction set.
+struct NearestBlock<'a, T> {
+    geometry: &'a Geometry,
+    r: &'a BvhRay,
+    leaf_ray: LeafRay,
+    lane_normal: Option<glam::Vec3A>,
+    tally: &'a T,
+}
+
+impl<T: Tally> wide::NearestLeaf for &mut NearestBlock<'_, T> {
+    #[inline(always)]
+    fn nearest(&mut self, b: u32, t_max: f32) -> Option<(u32, f32)> {
+        let g = self.geometry;
+        let (r, br) = self.leaf_ray.get(self.r, g.has_triangles);
+        let block = &g.blocks[b as usize];
+        self.tally.prims(block.count as u64);
+        let (lane, t, n) = block.closest(&g.others, br, r, t_max)?;
+        // The last hit a leaf reports is the nearest: keep its normal.
+        self.lane_normal = n;
+        Some((4 * b + lane, t))
+    }
+}
+
 /// All of a scene's primitives, ready for ray queries.
 ///
 /// A primitive's index (what [`Hit::prim`] holds) below `4 * blocks.len()` is a lane of a BVH
@@ -480,6 +505,41 @@ impl Geometry {
     /// [`Geometry::intersect`], telling `tally` the nodes and primitives it tests.
     #[inline]
     pub fn intersect_tallied(&self, ray: &Ray, tally: &impl Tally) -> Option<Hit> {
+        #[cfg(target_arch = "x86_64")]
+        if matches!(self.bvh.isa(), Isa::Avx2 | Isa::Avx512) {
+            // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
+            return unsafe { self.nearest_avx2(ray, tally) };
+        }
+        self.nearest_baseline(ray, tally)
+    }
+
+    /// [`Geometry::intersect_tallied`] in the baseline instruction set, out of line (as the
+    /// AVX2 one is: inlined, it made its callers' code twice as large).
+    #[inline(never)]
+    fn nearest_baseline(&self, ray: &Ray, tally: &impl Tally) -> Option<Hit> {
+        // SAFETY: with `false`, no instruction set beyond the baseline.
+        unsafe { self.nearest_in::<false>(ray, tally) }
+    }
+
+    /// [`Geometry::intersect_tallied`] compiled for AVX2: the traversal and its leaf tests in
+    /// one body.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn nearest_avx2(&self, ray: &Ray, tally: &impl Tally) -> Option<Hit> {
+        // SAFETY: the caller's.
+        unsafe { self.nearest_in::<true>(ray, tally) }
+    }
+
+    /// [`Geometry::intersect_tallied`]'s body, its BVH walked by AVX2's node test inlined if
+    /// `AVX2`.
+    ///
+    /// # Safety
+    /// With `AVX2`, the CPU must have AVX2 and the caller be compiled for it.
+    #[inline(always)]
+    unsafe fn nearest_in<const AVX2: bool>(&self, ray: &Ray, tally: &impl Tally) -> Option<Hit> {
         let mut t_max = ray.t_max;
         let mut best: Option<u32> = None;
         // The BVH's nearest hit, and its unit normal if a block's lane test found it.
@@ -493,20 +553,22 @@ impl Geometry {
         }
         if !self.bvh.is_empty() {
             let r = ray.for_bvh(t_max);
-            let mut leaf_ray = LeafRay::default();
-            let leaf = |b: u32, t_max: f32| {
-                let (r, br) = leaf_ray.get(&r, self.has_triangles);
-                let block = &self.blocks[b as usize];
-                tally.prims(block.count as u64);
-                let hit = block.closest(&self.others, br, r, t_max);
-                hit.map(|(lane, t, n)| {
-                    // The last hit a leaf reports is the nearest: keep its normal.
-                    lane_normal = n;
-                    (4 * b + lane, t)
-                })
+            let mut leaf = NearestBlock {
+                geometry: self,
+                r: &r,
+                leaf_ray: LeafRay::default(),
+                lane_normal: None,
+                tally,
             };
             let touch = |b: u32| wide::prefetch(self.blocks.as_ptr().wrapping_add(b as usize));
-            if let Some((i, t)) = self.bvh.closest_tallied(&r, leaf, touch, tally) {
+            let found = match AVX2 {
+                // SAFETY: the caller's.
+                #[cfg(target_arch = "x86_64")]
+                true => unsafe { self.bvh.closest_avx2_inline(&r, &mut leaf, touch, tally) },
+                _ => self.bvh.closest_tallied(&r, &mut leaf, touch, tally),
+            };
+            lane_normal = leaf.lane_normal;
+            if let Some((i, t)) = found {
                 t_max = t;
                 best = Some(i);
                 bvh_best = best;
@@ -574,21 +636,75 @@ impl Geometry {
     /// shaders' light loops it measured slower.
     #[inline(never)]
     fn occluded_by(&self, ray: &Ray, planes: bool, tally: &impl Tally) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if matches!(self.bvh.isa(), Isa::Avx2 | Isa::Avx512) {
+            // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
+            return unsafe { self.blocked_avx2(ray, planes, tally) };
+        }
+        // SAFETY: with `false`, no instruction set beyond the baseline.
+        unsafe { self.blocked_in::<false>(ray, planes, tally) }
+    }
+
+    /// [`Geometry::occluded_by`] compiled for AVX2: the traversal and its leaf tests in one
+    /// body.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn blocked_avx2(&self, ray: &Ray, planes: bool, tally: &impl Tally) -> bool {
+        // SAFETY: the caller's.
+        unsafe { self.blocked_in::<true>(ray, planes, tally) }
+    }
+
+    /// [`Geometry::occluded_by`]'s body, its BVH walked by AVX2's node test inlined if `AVX2`.
+    ///
+    /// # Safety
+    /// With `AVX2`, the CPU must have AVX2 and the caller be compiled for it.
+    #[inline(always)]
+    unsafe fn blocked_in<const AVX2: bool>(
+        &self,
+        ray: &Ray,
+        planes: bool,
+        tally: &impl Tally,
+    ) -> bool {
         (self.has_packets() && {
             let lanes = RayLanes::new(ray);
             self.spheres.any(&lanes, ray.t_max, SphereLanes::hit, tally)
                 || (planes && self.planes.any(&lanes, ray.t_max, PlaneLanes::hit, tally))
         }) || (!self.bvh.is_empty() && {
             let r = ray.for_bvh(ray.t_max);
-            let mut leaf_ray = LeafRay::default();
-            let leaf = |b: u32, r: &BvhRay| {
-                let (r, br) = leaf_ray.get(r, self.has_triangles);
-                let block = &self.blocks[b as usize];
-                tally.prims(block.count as u64);
-                block.any(&self.others, br, r)
+            let leaf = AnyBlock {
+                geometry: self,
+                leaf_ray: LeafRay::default(),
+                tally,
             };
-            self.bvh.any_tallied(&r, leaf, tally)
+            match AVX2 {
+                // SAFETY: the caller's.
+                #[cfg(target_arch = "x86_64")]
+                true => unsafe { self.bvh.any_avx2_inline(&r, leaf, tally) },
+                _ => self.bvh.any_tallied(&r, leaf, tally),
+            }
         })
+    }
+}
+
+/// The leaf test of [`Geometry::occluded`]'s walk: whether a block blocks the ray. A type of
+/// its own, as [`NearestBlock`].
+struct AnyBlock<'a, T> {
+    geometry: &'a Geometry,
+    leaf_ray: LeafRay,
+    tally: &'a T,
+}
+
+impl<T: Tally> wide::AnyLeaf for AnyBlock<'_, T> {
+    #[inline(always)]
+    fn any(&mut self, b: u32, r: &BvhRay) -> bool {
+        let g = self.geometry;
+        let (r, br) = self.leaf_ray.get(r, g.has_triangles);
+        let block = &g.blocks[b as usize];
+        self.tally.prims(block.count as u64);
+        block.any(&g.others, br, r)
     }
 }
 

@@ -497,6 +497,36 @@ impl Planes for TopNode {
     }
 }
 
+/// The leaf test of a nearest-hit walk ([`WideBvh::closest`]): the nearest hit among leaf
+/// `leaf`'s primitives within `(0, t_max]`, its primitive and distance. A closure is one; a
+/// type of its own can have its test inlined into the walk (`#[inline(always)]`), and so
+/// compiled for the walk's instruction set, which a closure's call is not.
+pub trait NearestLeaf {
+    /// The nearest hit in leaf `leaf` within `(0, t_max]`.
+    fn nearest(&mut self, leaf: u32, t_max: f32) -> Option<(u32, f32)>;
+}
+
+impl<F: FnMut(u32, f32) -> Option<(u32, f32)>> NearestLeaf for F {
+    #[inline(always)]
+    fn nearest(&mut self, leaf: u32, t_max: f32) -> Option<(u32, f32)> {
+        self(leaf, t_max)
+    }
+}
+
+/// The leaf test of an any-hit walk ([`WideBvh::any`]): whether a primitive of leaf `leaf`
+/// blocks `ray`. As [`NearestLeaf`], a closure or a type of its own.
+pub trait AnyLeaf {
+    /// True if a primitive of leaf `leaf` is hit within `(0, ray.t_max]`.
+    fn any(&mut self, leaf: u32, ray: &BvhRay) -> bool;
+}
+
+impl<F: FnMut(u32, &BvhRay) -> bool> AnyLeaf for F {
+    #[inline(always)]
+    fn any(&mut self, leaf: u32, ray: &BvhRay) -> bool {
+        self(leaf, ray)
+    }
+}
+
 impl WideBvh {
     /// Collapse a binary tree (nodes in the layout of [`super::Bvh`]: an interior node's first
     /// child follows it and `index` is its second) into eight-wide nodes. Each wide node takes a
@@ -599,7 +629,7 @@ impl WideBvh {
     pub fn closest_tallied(
         &self,
         ray: &BvhRay,
-        test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
+        test: impl NearestLeaf,
         touch: impl Fn(u32),
         tally: &impl Tally,
     ) -> Option<(u32, f32)> {
@@ -621,7 +651,7 @@ impl WideBvh {
     fn closest_baseline(
         &self,
         ray: &BvhRay,
-        test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
+        test: impl NearestLeaf,
         touch: impl Fn(u32),
         tally: &impl Tally,
     ) -> Option<(u32, f32)> {
@@ -638,12 +668,7 @@ impl WideBvh {
 
     /// [`WideBvh::any`], telling `tally` each node test.
     #[inline]
-    pub fn any_tallied(
-        &self,
-        ray: &BvhRay,
-        test: impl FnMut(u32, &BvhRay) -> bool,
-        tally: &impl Tally,
-    ) -> bool {
+    pub fn any_tallied(&self, ray: &BvhRay, test: impl AnyLeaf, tally: &impl Tally) -> bool {
         debug_assert!(self.isa.available());
         match self.isa {
             // SAFETY: `isa` is private to this file and set only by `collapse` and `Default`
@@ -681,7 +706,7 @@ impl WideBvh {
     unsafe fn closest_avx2(
         &self,
         ray: &BvhRay,
-        test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
+        test: impl NearestLeaf,
         touch: impl Fn(u32),
         tally: &impl Tally,
     ) -> Option<(u32, f32)> {
@@ -696,10 +721,39 @@ impl WideBvh {
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn any_avx2(
+    unsafe fn any_avx2(&self, ray: &BvhRay, test: impl AnyLeaf, tally: &impl Tally) -> bool {
+        // SAFETY: the caller's.
+        unsafe { self.any_in::<super::simd::avx2::Avx2>(ray, test, tally) }
+    }
+
+    /// [`WideBvh::closest_tallied`] with AVX2's node test, inlined into its caller (which
+    /// its leaf test then runs in too: a call, it ran apart, in SSE2).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2, and the caller be compiled for it.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub unsafe fn closest_avx2_inline(
         &self,
         ray: &BvhRay,
-        test: impl FnMut(u32, &BvhRay) -> bool,
+        test: impl NearestLeaf,
+        touch: impl Fn(u32),
+        tally: &impl Tally,
+    ) -> Option<(u32, f32)> {
+        // SAFETY: the caller's.
+        unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch, tally) }
+    }
+
+    /// [`WideBvh::any_tallied`] with AVX2's node test, inlined into its caller.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2, and the caller be compiled for it.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub unsafe fn any_avx2_inline(
+        &self,
+        ray: &BvhRay,
+        test: impl AnyLeaf,
         tally: &impl Tally,
     ) -> bool {
         // SAFETY: the caller's.
@@ -740,7 +794,7 @@ impl WideBvh {
     unsafe fn closest_in<L: Lanes8>(
         &self,
         ray: &BvhRay,
-        mut test: impl FnMut(u32, f32) -> Option<(u32, f32)>,
+        mut test: impl NearestLeaf,
         touch: impl Fn(u32),
         tally: &impl Tally,
     ) -> Option<(u32, f32)> {
@@ -785,7 +839,7 @@ impl WideBvh {
             };
             // One place tests leaves: a hit shortens the reach and becomes the best so far.
             while cur & LEAF != 0 {
-                if let Some((p, t)) = test(cur & !LEAF, t_max) {
+                if let Some((p, t)) = test.nearest(cur & !LEAF, t_max) {
                     t_max = t;
                     best = Some((p, t));
                 }
@@ -887,7 +941,7 @@ impl WideBvh {
     unsafe fn any_in<L: Lanes8>(
         &self,
         ray: &BvhRay,
-        mut test: impl FnMut(u32, &BvhRay) -> bool,
+        mut test: impl AnyLeaf,
         tally: &impl Tally,
     ) -> bool {
         if self.is_empty() {
@@ -907,7 +961,7 @@ impl WideBvh {
                 mask &= mask - 1;
                 let c = child[i];
                 if c & LEAF != 0 {
-                    if test(c & !LEAF, ray) {
+                    if test.any(c & !LEAF, ray) {
                         return true;
                     }
                 } else {
