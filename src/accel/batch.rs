@@ -99,6 +99,27 @@ unsafe fn chunk<L: Floats>(rays: &[Ray], k: usize) -> ([&Ray; MAX_LANES], L) {
 /// Segments in lanes: origins, unit directions, the origins' error bounds and the ends.
 pub type Segments<L> = ([L; 3], [L; 3], L, L);
 
+/// The leaf test of a packet's walk in [`Geometry::intersect_packet`]: ray `i`'s nearest hit
+/// in a block, the unit normal of the last one kept. A type of its own (not a closure) so that
+/// its test is inlined into the walk and compiled for the walk's instruction set.
+struct PacketBlocks<'a> {
+    geometry: &'a Geometry,
+    rays: &'a [&'a BvhRay; PACKET],
+    leaf_rays: [LeafRay; PACKET],
+    normals: [Option<glam::Vec3A>; PACKET],
+}
+
+impl super::wide::packet::PacketLeaf for &mut PacketBlocks<'_> {
+    #[inline(always)]
+    fn nearest(&mut self, i: usize, b: u32, t_max: f32) -> Option<(u32, f32)> {
+        let g = self.geometry;
+        let (r, br) = self.leaf_rays[i].get(self.rays[i], g.has_triangles);
+        let (lane, t, n) = g.blocks[b as usize].closest(&g.others, br, r, t_max)?;
+        self.normals[i] = n;
+        Some((4 * b + lane, t))
+    }
+}
+
 impl Geometry {
     /// True if the batched queries can put rays in the lanes: every primitive is packed.
     #[inline]
@@ -212,22 +233,14 @@ impl Geometry {
         });
         // Each ray's leaf constants when it reaches its first leaf, and the normal of its
         // nearest lane hit, as in `intersect`.
-        let mut leaf_rays: [LeafRay; PACKET] = Default::default();
-        let mut normals = [None; PACKET];
-        let found = self.bvh.closest_packet(
-            &refs,
-            live,
-            back,
-            |i, b, t_max| {
-                let (r, br) = leaf_rays[i].get(refs[i], self.has_triangles);
-                let hit = self.blocks[b as usize].closest(&self.others, br, r, t_max);
-                hit.map(|(lane, t, n)| {
-                    normals[i] = n;
-                    (4 * b + lane, t)
-                })
-            },
-            &(),
-        );
+        let mut leaf = PacketBlocks {
+            geometry: self,
+            rays: &refs,
+            leaf_rays: Default::default(),
+            normals: [None; PACKET],
+        };
+        let found = self.bvh.closest_packet(&refs, live, back, &mut leaf, &());
+        let normals = leaf.normals;
         for (i, (ray, hit)) in rays.iter().zip(out.iter_mut()).enumerate() {
             // Rays of other octants, and ties, alone.
             let alone = live & (1 << i) == 0 || found.tied & (1 << i) != 0;

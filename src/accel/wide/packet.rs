@@ -193,6 +193,21 @@ impl<L: Lanes8> PacketBox<L> {
     }
 }
 
+/// The leaf test of a packet's walk ([`WideBvh::closest_packet`]): ray `i`'s nearest hit
+/// among leaf `leaf`'s primitives within `(0, t_max]`. A closure is one; a type of its own
+/// can have its test inlined into the walk, as [`super::NearestLeaf`].
+pub trait PacketLeaf {
+    /// Ray `i`'s nearest hit in leaf `leaf` within `(0, t_max]`.
+    fn nearest(&mut self, i: usize, leaf: u32, t_max: f32) -> Option<(u32, f32)>;
+}
+
+impl<F: FnMut(usize, u32, f32) -> Option<(u32, f32)>> PacketLeaf for F {
+    #[inline(always)]
+    fn nearest(&mut self, i: usize, leaf: u32, t_max: f32) -> Option<(u32, f32)> {
+        self(i, leaf, t_max)
+    }
+}
+
 impl WideBvh {
     /// Nearest hits of the rays `rays[i]` for `i` in `live` (a bit mask; `rays` holds a ray
     /// in every lane, those outside `live` repeating a live one), which must all have the
@@ -205,7 +220,7 @@ impl WideBvh {
         rays: &[&BvhRay; PACKET],
         live: u32,
         back: u32,
-        test: impl FnMut(usize, u32, f32) -> Option<(u32, f32)>,
+        test: impl PacketLeaf,
         tally: &impl Tally,
     ) -> PacketHits {
         debug_assert!(self.isa.available());
@@ -228,7 +243,7 @@ impl WideBvh {
         rays: &[&BvhRay; PACKET],
         live: u32,
         back: u32,
-        test: impl FnMut(usize, u32, f32) -> Option<(u32, f32)>,
+        test: impl PacketLeaf,
         tally: &impl Tally,
     ) -> PacketHits {
         // SAFETY: the baseline runs on every CPU.
@@ -247,7 +262,7 @@ impl WideBvh {
         rays: &[&BvhRay; PACKET],
         live: u32,
         back: u32,
-        test: impl FnMut(usize, u32, f32) -> Option<(u32, f32)>,
+        test: impl PacketLeaf,
         tally: &impl Tally,
     ) -> PacketHits {
         // SAFETY: the caller's.
@@ -264,7 +279,7 @@ impl WideBvh {
         rays: &[&BvhRay; PACKET],
         live: u32,
         back: u32,
-        mut test: impl FnMut(usize, u32, f32) -> Option<(u32, f32)>,
+        mut test: impl PacketLeaf,
         tally: &impl Tally,
     ) -> PacketHits {
         let mut out = PacketHits::default();
@@ -304,7 +319,7 @@ impl WideBvh {
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
-                    if let Some((p, t)) = test(i, node & !LEAF, t_max[i]) {
+                    if let Some((p, t)) = test.nearest(i, node & !LEAF, t_max[i]) {
                         // A hit at the reach a hit of another leaf set: a tie.
                         if out.best[i].is_some() && t == t_max[i] {
                             out.tied |= 1 << i;
