@@ -310,7 +310,7 @@ fn packets_send_their_ties_to_the_one_ray_query() {
                 &refs,
                 live,
                 octant(refs[0]),
-                |i, b, t_max| {
+                |i: usize, b: u32, t_max: f32| {
                     let full = refs[i].sheared();
                     let br = rtis::accel::block::BlockRay::new(&full);
                     g.blocks[b as usize]
