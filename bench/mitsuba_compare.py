@@ -146,11 +146,10 @@ AREA_STRATEGIES = [
 ]
 
 
-def rtis_runs(text, strategies, spp):
+def rtis_runs(text, strategies, spp, d):
     """rtis's runs: for each strategy, a function that renders it once and returns (seconds,
-    image), the scene file written once."""
+    image), the scene file written once into the folder `d`."""
     rtis = os.path.join(ROOT, "target/release/rtis")
-    d = tempfile.mkdtemp()
     runs = []
     for k, (label, strategy) in enumerate(strategies):
         scene_file = os.path.join(d, f"scene{k}.ron")
@@ -172,8 +171,9 @@ def rtis_runs(text, strategies, spp):
 
 def mitsuba_run(mi, scene, spp, variant):
     """Mitsuba's run: a function that renders once and returns (seconds, image); its kernels
-    are compiled first, outside the timing."""
-    mi.render(scene, spp=1)
+    are compiled first, outside the timing, by a render at the same spp (a kernel depends on
+    it: `render` coalesces its passes from 4 spp on and folds the spp into the kernel)."""
+    mi.render(scene, spp=spp)
 
     def run():
         t = time.perf_counter()
@@ -184,6 +184,12 @@ def mitsuba_run(mi, scene, spp, variant):
 
 
 def compare(name, mi, args):
+    """`measure` in a temporary folder of its own, removed after."""
+    with tempfile.TemporaryDirectory() as tmp:
+        return measure(name, mi, args, tmp)
+
+
+def measure(name, mi, args, tmp):
     """One scene: (width, height, reference noise RMSE, rows), each row (label, seconds of each
     round, RMSE). Each round renders Mitsuba and every rtis strategy once, Mitsuba first in
     even rounds and last in odd ones; the images are the same in every round (fixed seeds),
@@ -192,7 +198,7 @@ def compare(name, mi, args):
         ref = read_exr(os.path.join(ROOT, "tests/data/cornell_rtis_diffuse_360x288_dinf_spp4096.exr"))
         noise, size = 0.007, (360, 288)
         runs = [mitsuba_run(mi, mi.load_dict(mitsuba_scene(mi, args.spp)), args.spp, args.variant)]
-        runs += rtis_runs(PHYSICAL, POINT_STRATEGIES, args.spp)
+        runs += rtis_runs(PHYSICAL, POINT_STRATEGIES, args.spp, tmp)
     elif name == "full":
         # The reference: two independent halves, their mean, and its noise from their difference.
         half = mi.load_dict(mitsuba_scene(mi, args.reference_spp // 2, full=True))
@@ -200,14 +206,14 @@ def compare(name, mi, args):
         b = np.array(mi.render(half, spp=args.reference_spp // 2, seed=2))
         ref, noise, size = (a + b) / 2, rmse(a, b) / 2, (360, 288)
         runs = [mitsuba_run(mi, mi.load_dict(mitsuba_scene(mi, args.spp, full=True)), args.spp, args.variant)]
-        runs += rtis_runs(FULL, POINT_STRATEGIES, args.spp)
+        runs += rtis_runs(FULL, POINT_STRATEGIES, args.spp, tmp)
     else:
         ref = read_exr(os.path.join(ROOT, "tests/data/mitsuba_cornell_area_128_spp4096.exr"))
         with open(os.path.join(ROOT, "tests/data/mitsuba_cornell_area_128_spp4096.json")) as f:
             noise = json.load(f)["noise_rmse"]
         size = (128, 128)
         runs = [mitsuba_run(mi, mi.load_dict(area_scene(mi, args.spp)), args.spp, args.variant)]
-        runs += rtis_runs(AREA, AREA_STRATEGIES, args.spp)
+        runs += rtis_runs(AREA, AREA_STRATEGIES, args.spp, tmp)
     seconds = [[] for _ in runs]
     errors = [None for _ in runs]
     for r in range(args.rounds):

@@ -100,7 +100,7 @@ impl LeafRay {
 
 /// The leaf test of [`Geometry::intersect`]'s walk: a block's nearest hit, the unit normal
 /// of the last one kept. A type of its own (not a closure) so that its test is inlined into
-/// the walk and compiled for the walk's instruction set.
+/// the walk and compiled for the walk's instruction set (a closure may stay a call).
 struct NearestBlock<'a, T> {
     geometry: &'a Geometry,
     r: &'a BvhRay,
@@ -537,7 +537,7 @@ impl Geometry {
     /// `AVX2`.
     ///
     /// # Safety
-    /// With `AVX2`, the CPU must have AVX2 and the caller be compiled for it.
+    /// With `AVX2`, the CPU must have AVX2 (and the caller should be compiled for it).
     #[inline(always)]
     unsafe fn nearest_in<const AVX2: bool>(&self, ray: &Ray, tally: &impl Tally) -> Option<Hit> {
         let mut t_max = ray.t_max;
@@ -660,7 +660,7 @@ impl Geometry {
     /// [`Geometry::occluded_by`]'s body, its BVH walked by AVX2's node test inlined if `AVX2`.
     ///
     /// # Safety
-    /// With `AVX2`, the CPU must have AVX2 and the caller be compiled for it.
+    /// With `AVX2`, the CPU must have AVX2 (and the caller should be compiled for it).
     #[inline(always)]
     unsafe fn blocked_in<const AVX2: bool>(
         &self,

@@ -498,9 +498,9 @@ impl Planes for TopNode {
 }
 
 /// The leaf test of a nearest-hit walk ([`WideBvh::closest`]): the nearest hit among leaf
-/// `leaf`'s primitives within `(0, t_max]`, its primitive and distance. A closure is one; a
-/// type of its own can have its test inlined into the walk (`#[inline(always)]`), and so
-/// compiled for the walk's instruction set, which a closure's call is not.
+/// `leaf`'s primitives within `(0, t_max]`, its primitive and distance. A closure is one (and
+/// may stay a call, compiled for the baseline); a type of its own can have its test inlined
+/// into the walk (`#[inline(always)]`), and so compiled for the walk's instruction set.
 pub trait NearestLeaf {
     /// The nearest hit in leaf `leaf` within `(0, t_max]`.
     fn nearest(&mut self, leaf: u32, t_max: f32) -> Option<(u32, f32)>;
@@ -696,8 +696,8 @@ impl WideBvh {
         ok
     }
 
-    /// [`WideBvh::closest`] compiled for AVX2, the node test inlined into it (the leaf test, a
-    /// closure, may stay a call).
+    /// [`WideBvh::closest`] compiled for AVX2, the node test inlined into it (a leaf test that
+    /// is a closure may stay a call).
     ///
     /// # Safety
     /// The CPU must have AVX2.
@@ -714,8 +714,8 @@ impl WideBvh {
         unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch, tally) }
     }
 
-    /// [`WideBvh::any`] compiled for AVX2, the node test inlined into it (the leaf test, a
-    /// closure, may stay a call).
+    /// [`WideBvh::any`] compiled for AVX2, the node test inlined into it (a leaf test that is a
+    /// closure may stay a call).
     ///
     /// # Safety
     /// The CPU must have AVX2.
@@ -726,11 +726,11 @@ impl WideBvh {
         unsafe { self.any_in::<super::simd::avx2::Avx2>(ray, test, tally) }
     }
 
-    /// [`WideBvh::closest_tallied`] with AVX2's node test, inlined into its caller (which
-    /// its leaf test then runs in too: a call, it ran apart, in SSE2).
+    /// [`WideBvh::closest_tallied`] with AVX2's node test, inlined into its caller, which
+    /// should be compiled for AVX2 (so the walk and an inlined leaf test run in it).
     ///
     /// # Safety
-    /// The CPU must have AVX2, and the caller be compiled for it.
+    /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub unsafe fn closest_avx2_inline(
@@ -744,10 +744,11 @@ impl WideBvh {
         unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch, tally) }
     }
 
-    /// [`WideBvh::any_tallied`] with AVX2's node test, inlined into its caller.
+    /// [`WideBvh::any_tallied`] with AVX2's node test, inlined into its caller, which should
+    /// be compiled for AVX2.
     ///
     /// # Safety
-    /// The CPU must have AVX2, and the caller be compiled for it.
+    /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub unsafe fn any_avx2_inline(

@@ -186,8 +186,11 @@ impl Emitters {
         &self.cdf
     }
 
-    /// The light at place `i` of the choice (the last if `i` is past it; there is one), with
-    /// its probability.
+    /// The light at place `i` of the choice (the last if `i` is past it), with its probability.
+    ///
+    /// # Panics
+    /// If there is no light ([`Emitters::cdf`] empty): [`Emitters::choose_any`] answers `None`
+    /// there.
     #[inline]
     pub fn chosen(&self, i: usize) -> Chosen<'_> {
         let i = i.min(self.cdf.len() - 1);

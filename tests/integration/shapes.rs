@@ -244,9 +244,14 @@ proptest! {
             let want = scalar(&ray).map(|(_, t)| t);
             let got_packed = packed.intersect(&ray).map(|h| h.t);
             let got_bvh = bvh.intersect(&ray).map(|h| h.t);
-            let want_bits = baseline.intersect(&ray).map(|h| (h.prim, h.t.to_bits()));
+            // The whole record, to the bit: its point and normal are made in each set's body.
+            let bits = |h: Hit| {
+                let v = |v: Vec3A| v.to_array().map(f32::to_bits);
+                (h.prim, h.t.to_bits(), v(h.p), v(h.n), h.err.to_bits(), h.err_along.to_bits())
+            };
+            let want_bits = baseline.intersect(&ray).map(bits);
             for g in &isas {
-                let hit = g.intersect(&ray).map(|h| (h.prim, h.t.to_bits()));
+                let hit = g.intersect(&ray).map(bits);
                 prop_assert_eq!(hit, want_bits, "{:?}", g.bvh.isa());
                 prop_assert_eq!(g.occluded(&ray), baseline.occluded(&ray), "{:?}", g.bvh.isa());
             }

@@ -423,7 +423,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
             false => ([[0.0f32; MAX_LANES]; 3], [[0.0f32; MAX_LANES]; 3]),
         };
         let (u, u1, u2) = light_numbers(&mut rng, L::LANES);
-        let place = choice_places(tr.emitters.cdf(), &u);
+        let place = choice_places(tr.emitters.cdf(), &u, L::LANES);
         let any_light = !tr.emitters.cdf().is_empty();
         for i in Bits(shaded) {
             let (u, u12) = (u[i], (u1[i], u2[i]));
@@ -544,7 +544,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
         // (`u1`, `u2`), its term (zero where none is drawn).
         if sample_area && tr.effects.emission && !tr.emitters.is_empty() {
             let (u, u1, u2) = light_numbers(&mut rng, L::LANES);
-            let place = choice_places(tr.emitters.cdf(), &u);
+            let place = choice_places(tr.emitters.cdf(), &u, L::LANES);
             for i in Bits(shaded) {
                 // (The point lights take no part in this choice.)
                 let c = tr.emitters.chosen(place[i] as usize);
@@ -728,7 +728,8 @@ impl AreaRays {
     ) {
         self.lanes |= 1 << i;
         let (Some(hit), Some((m, phong)), Some(ls)) = (&at.hits[i], &at.materials[i], ls) else {
-            // (A shaded lane has a hit and a material: `round_in` sets them with its bit.)
+            // (A shaded lane has a hit, and a material where the scene has area lights or an
+            // environment, the only scenes that sample here: `round_in` sets them with its bit.)
             return;
         };
         let si = Interaction::flat(*hit, d, &tr.materials[*m as usize]);
@@ -828,12 +829,22 @@ fn light_numbers(
     (u, u1, rng.next_f32(lanes))
 }
 
+/// The most lights [`choice_places`] counts through; past them, a binary search per lane.
+const COUNTED_LIGHTS: usize = 32;
+
 /// Each lane's place in the light choice for its number `u` (`Emitters::choose_any`'s
-/// `partition_point`): the count of the cumulative shares `cdf` at or below it (they do not
-/// decrease), without the binary search's branches, in lanes (the loops vectorise).
+/// `partition_point`, the same index): for a few lights, the count of the cumulative shares
+/// `cdf` at or below it (they do not decrease), without the binary search's branches, in
+/// lanes (the loops vectorise); for more, the binary search in each of the first `lanes`.
 #[inline(always)]
-fn choice_places(cdf: &[f64], u: &[f64; MAX_LANES]) -> [u32; MAX_LANES] {
+fn choice_places(cdf: &[f64], u: &[f64; MAX_LANES], lanes: usize) -> [u32; MAX_LANES] {
     let mut place = [0u32; MAX_LANES];
+    if cdf.len() > COUNTED_LIGHTS {
+        for (p, &u) in place.iter_mut().zip(u).take(lanes) {
+            *p = cdf.partition_point(|&c| c <= u) as u32;
+        }
+        return place;
+    }
     for &c in cdf {
         for (p, &u) in place.iter_mut().zip(u) {
             *p += u32::from(c <= u);
