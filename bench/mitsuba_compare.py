@@ -172,8 +172,10 @@ def rtis_runs(text, strategies, spp, d):
 def mitsuba_run(mi, scene, spp, variant):
     """Mitsuba's run: a function that renders once and returns (seconds, image); its kernels
     are compiled first, outside the timing, by a render at the same spp (a kernel depends on
-    it: `render` coalesces its passes from 4 spp on and folds the spp into the kernel)."""
-    mi.render(scene, spp=spp)
+    it: `render` coalesces its passes from 4 spp on and folds the spp into the kernel) whose
+    image is read (Dr.Jit is lazy: a render never read runs nothing, and the first timed one
+    then compiled its kernels, twice the time of the others on the area box)."""
+    np.array(mi.render(scene, spp=spp))
 
     def run():
         t = time.perf_counter()
