@@ -711,7 +711,7 @@ impl WideBvh {
         tally: &impl Tally,
     ) -> Option<(u32, f32)> {
         // SAFETY: the caller's.
-        unsafe { self.closest_in::<super::simd::avx2::Avx2>(ray, test, touch, tally) }
+        unsafe { self.closest_avx2_inline(ray, test, touch, tally) }
     }
 
     /// [`WideBvh::any`] compiled for AVX2, the node test inlined into it (a leaf test that is a
@@ -723,7 +723,7 @@ impl WideBvh {
     #[target_feature(enable = "avx2")]
     unsafe fn any_avx2(&self, ray: &BvhRay, test: impl AnyLeaf, tally: &impl Tally) -> bool {
         // SAFETY: the caller's.
-        unsafe { self.any_in::<super::simd::avx2::Avx2>(ray, test, tally) }
+        unsafe { self.any_avx2_inline(ray, test, tally) }
     }
 
     /// [`WideBvh::closest_tallied`] with AVX2's node test, inlined into its caller, which
