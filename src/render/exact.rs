@@ -71,8 +71,19 @@ impl ExactSum {
     fn add_scaled(&mut self, mantissa: u64, shift: u32) {
         let (word, offset) = ((shift / 64) as usize, shift % 64);
         let wide = (mantissa as u128) << offset;
-        self.add_at(word, wide as u64);
-        self.add_at(word + 1, (wide >> 64) as u64);
+        if word + 1 < WORDS {
+            // The two words it spans as one 128-bit add, the carry (rare) taken further up:
+            // no loop whose length depends on the value.
+            let both = self.words[word] as u128 | (self.words[word + 1] as u128) << 64;
+            let (sum, carry) = both.overflowing_add(wide);
+            (self.words[word], self.words[word + 1]) = (sum as u64, (sum >> 64) as u64);
+            if carry {
+                self.add_at(word + 2, 1);
+            }
+        } else {
+            // The top word: what would go past it is beyond the accumulator's range.
+            self.add_at(word, wide as u64);
+        }
     }
 
     /// Add `x` at word `i`, carrying upwards.
