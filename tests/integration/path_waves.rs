@@ -142,6 +142,15 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
     }
 }
 
+/// [`agrees`] on the scene `text`, then with its lights moved out of the planes' room (so that
+/// their shadow rays test the planes too).
+fn agrees_in_and_out_of_room(text: &str, what: &str) {
+    agrees(&rtis::extract(&scene(text)), what);
+    let mut s = rtis::extract(&scene(text));
+    common::lights_out_of_room(&mut s);
+    agrees(&s, &format!("{what}, lights out of the room"));
+}
+
 #[test]
 fn waves_give_the_one_ray_pixels() {
     let _limit = common::deadline(120);
@@ -151,12 +160,7 @@ fn waves_give_the_one_ray_pixels() {
                 let shader =
                     format!("Path({depth}, sampling: {sampling}, lights_per_vertex: {per_vertex})");
                 let text = room(&shader, "");
-                let what = shader.clone();
-                agrees(&rtis::extract(&scene(&text)), &what);
-                // Shadow rays that test the planes too.
-                let mut s = rtis::extract(&scene(&text));
-                common::lights_out_of_room(&mut s);
-                agrees(&s, &format!("{what}, lights out of the room"));
+                agrees_in_and_out_of_room(&text, &shader);
             }
         }
     }
@@ -169,11 +173,7 @@ fn waves_give_the_one_ray_pixels() {
                 let shader =
                     format!("Path({depth}, sampling: {sampling}, lights_per_vertex: {per_vertex})");
                 let text = room(&shader, "").replace("model: Physical", "model: Course");
-                let what = format!("{shader}, Course");
-                agrees(&rtis::extract(&scene(&text)), &what);
-                let mut s = rtis::extract(&scene(&text));
-                common::lights_out_of_room(&mut s);
-                agrees(&s, &format!("{what}, lights out of the room"));
+                agrees_in_and_out_of_room(&text, &format!("{shader}, Course"));
             }
         }
     }
@@ -188,10 +188,7 @@ fn waves_give_the_one_ray_pixels() {
                 let text =
                     spot_room(&shader, "").replace("model: Physical", &format!("model: {model}"));
                 let what = format!("{shader}, {model}, spot and directional");
-                agrees(&rtis::extract(&scene(&text)), &what);
-                let mut s = rtis::extract(&scene(&text));
-                common::lights_out_of_room(&mut s);
-                agrees(&s, &format!("{what}, lights out of the room"));
+                agrees_in_and_out_of_room(&text, &what);
             }
         }
     }
