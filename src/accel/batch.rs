@@ -11,16 +11,17 @@
 //! and keeps the parameters of the primitive it hits, so that the hit records are computed in the
 //! lanes too ([`Geometry::nearest_lanes`], which the Global shader's waves use as well); the
 //! answers are bit-identical to [`Geometry::intersect`] and [`Geometry::occluded`] in every
-//! instruction set. Scenes with a BVH answer ray by ray.
+//! instruction set. A small scene of triangles alone meets each of its triangles in the lanes too
+//! ([`Geometry::nearest_small`], `small.rs`); other scenes with a BVH answer ray by ray.
 //!
 //! The instruction set is the BVH's ([`super::WideBvh::isa`]): AVX-512 or AVX2 where the CPU
 //! has it. Their copies are `#[target_feature]` functions around the generic code, which has
 //! no closures, so every lane operation inlines into them.
 
-use super::lanes::{RayLanes, SurfaceLanes, plane_surface, sphere_surface};
+use super::lanes::{RayLanes, SurfaceLanes, lane_mask, plane_surface, sphere_surface};
 use super::simd::{Floats, Isa, MAX_LANES};
 use super::wide::packet::{PACKET, octant};
-use super::{Geometry, LeafRay, Tally, Traversal};
+use super::{Geometry, LeafRay, ShearLanes, Tally, Traversal};
 use crate::geometry::BvhRay;
 use crate::geometry::{Hit, Ray};
 use glam::Vec4;
@@ -142,7 +143,7 @@ impl Geometry {
         tally: Option<&Traversal>,
     ) {
         hits.clear();
-        if !self.all_packed() {
+        if !self.all_packed() && !self.is_small() {
             // Ray by ray, the BVH's loop compiled with the counters or without them.
             match tally {
                 Some(t) => hits.extend(rays.iter().map(|r| self.intersect_tallied(r, t))),
@@ -154,12 +155,12 @@ impl Geometry {
         match self.bvh.isa() {
             // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => unsafe { self.intersect_avx2(rays, hits) },
+            Isa::Avx2 => unsafe { self.intersect_avx2(rays, hits, &tally) },
             // SAFETY: as above.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => unsafe { self.intersect_avx512(rays, hits) },
+            Isa::Avx512 => unsafe { self.intersect_avx512(rays, hits, &tally) },
             // SAFETY: `Vec4` runs on every CPU.
-            _ => unsafe { self.intersect_in::<Vec4>(rays, hits) },
+            _ => unsafe { self.intersect_in::<Vec4>(rays, hits, &tally) },
         }
     }
 
@@ -269,7 +270,7 @@ impl Geometry {
         tally: Option<&Traversal>,
     ) {
         blocked.clear();
-        if !self.all_packed() {
+        if !self.all_packed() && !self.is_small() {
             match tally {
                 Some(t) => blocked.extend(rays.iter().map(|r| self.occluded_tallied(r, planes, t))),
                 None => blocked.extend(rays.iter().map(|r| self.occluded_tallied(r, planes, &()))),
@@ -288,10 +289,11 @@ impl Geometry {
         }
     }
 
-    /// Primitives each ray in lanes tests for its nearest hit: every packed sphere and plane.
+    /// Primitives each ray in lanes tests for its nearest hit: every packed sphere and plane,
+    /// or every triangle of a small scene ([`Geometry::is_small`]).
     #[inline]
     pub fn lane_prims(&self) -> u64 {
-        (self.sphere_each.len() + self.plane_each.len()) as u64
+        (self.sphere_each.len() + self.plane_each.len() + self.triangle_each.len()) as u64
     }
 
     /// [`Geometry::intersect_batch`] in eight AVX2 lanes.
@@ -300,9 +302,14 @@ impl Geometry {
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn intersect_avx2(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+    unsafe fn intersect_avx2(
+        &self,
+        rays: &[Ray],
+        hits: &mut Vec<Option<Hit>>,
+        tally: &Option<&Traversal>,
+    ) {
         // SAFETY: this function runs only where AVX2 was found.
-        unsafe { self.intersect_in::<super::simd::avx2::F8>(rays, hits) }
+        unsafe { self.intersect_in::<super::simd::avx2::F8>(rays, hits, tally) }
     }
 
     /// [`Geometry::occluded_batch`] in eight AVX2 lanes.
@@ -328,9 +335,14 @@ impl Geometry {
     /// The CPU must have AVX-512F.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
-    unsafe fn intersect_avx512(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+    unsafe fn intersect_avx512(
+        &self,
+        rays: &[Ray],
+        hits: &mut Vec<Option<Hit>>,
+        tally: &Option<&Traversal>,
+    ) {
         // SAFETY: this function runs only where AVX-512F was found.
-        unsafe { self.intersect_in::<super::simd::avx512::F16>(rays, hits) }
+        unsafe { self.intersect_in::<super::simd::avx512::F16>(rays, hits, tally) }
     }
 
     /// [`Geometry::occluded_batch`] in sixteen AVX-512 lanes.
@@ -364,7 +376,7 @@ impl Geometry {
         tally: &impl Tally,
     ) -> L::Mask {
         if !self.all_packed() {
-            // Ray by ray through the BVH.
+            // A small scene's triangles met in the lanes, or ray by ray through the BVH.
             let (mut v, mut lane) = ([[0.0f32; MAX_LANES]; 8], [0.0f32; MAX_LANES]);
             for (k, x) in [o[0], o[1], o[2], d[0], d[1], d[2], o_err, t_max]
                 .into_iter()
@@ -372,18 +384,24 @@ impl Geometry {
             {
                 x.write_to(&mut v[k]);
             }
+            let ray = |i: usize| Ray {
+                o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
+                d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
+                t_max: v[7][i],
+                o_err: v[6][i],
+            };
+            if self.is_small() {
+                let r = ShearLanes::new(o, d, o_err);
+                let blocked = self.blocked_small(&r, t_max, live, tally, ray);
+                // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
+                return unsafe { lane_mask::<L>(blocked) };
+            }
             let live = L::bitmask(live);
             for (i, blocked) in lane.iter_mut().enumerate().take(L::LANES) {
                 if live & (1 << i) == 0 {
                     continue;
                 }
-                let ray = Ray {
-                    o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
-                    d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
-                    t_max: v[7][i],
-                    o_err: v[6][i],
-                };
-                let hit = self.occluded_tallied(&ray, planes, tally);
+                let hit = self.occluded_tallied(&ray(i), planes, tally);
                 *blocked = if hit { 1.0 } else { 0.0 };
             }
             // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
@@ -408,18 +426,38 @@ impl Geometry {
         hit & live
     }
 
-    /// The nearest hits of `rays`, `L::LANES` at a time ([`Geometry::nearest_lanes`]).
+    /// The nearest hits of `rays`, `L::LANES` at a time ([`Geometry::nearest_lanes`], or
+    /// [`Geometry::nearest_small`] in a small scene, whose rays the lanes cannot settle go to
+    /// the one-ray query, told to `tally`).
     ///
     /// # Safety
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    unsafe fn intersect_in<L: Floats>(&self, rays: &[Ray], hits: &mut Vec<Option<Hit>>) {
+    unsafe fn intersect_in<L: Floats>(
+        &self,
+        rays: &[Ray],
+        hits: &mut Vec<Option<Hit>>,
+        tally: &Option<&Traversal>,
+    ) {
         for k in (0..rays.len()).step_by(L::LANES) {
             // SAFETY: the caller vouches for the instruction set.
             let (eight, t_max) = unsafe { chunk::<L>(rays, k) };
+            let n = (rays.len() - k).min(L::LANES);
+            if self.is_small() {
+                let (o, d, o_err) = unsafe {
+                    (
+                        L::transpose3(&eight.map(|r| &r.o)),
+                        L::transpose3(&eight.map(|r| &r.d)),
+                        L::from_array(eight.map(|r| r.o_err)),
+                    )
+                };
+                let near = self.nearest_small(&ShearLanes::new(o, d, o_err), t_max);
+                hits.extend((0..n).map(|i| self.small_hit(&near, i, eight[i], tally)));
+                continue;
+            }
             let lanes = unsafe { RayLanes::<L>::gather(&eight) };
             let rows = unsafe { self.nearest_lanes(&lanes, t_max) }.rows();
-            hits.extend((0..(rays.len() - k).min(L::LANES)).map(|i| self.lane_hit(&rows, i)));
+            hits.extend((0..n).map(|i| self.lane_hit(&rows, i)));
         }
     }
 

@@ -7,6 +7,7 @@ mod bvh;
 pub mod lanes;
 mod prim;
 mod simd;
+mod small;
 pub mod tally;
 pub mod wide;
 
@@ -18,6 +19,7 @@ pub use simd::avx2::F8;
 #[cfg(target_arch = "x86_64")]
 pub use simd::avx512::F16;
 pub use simd::{Floats, Isa, MAX_LANES, require_all_isas};
+pub use small::{SMALL_SCENE, ShearLanes, SmallNearest};
 pub use tally::{Tally, Traversal};
 pub use wide::{WideBvh, WideNode};
 
@@ -161,6 +163,9 @@ pub struct Geometry {
     /// True if the BVH holds triangles: its rays then need the watertight test's shear
     /// constants.
     pub has_triangles: bool,
+    /// In a scene of at most [`SMALL_SCENE`] primitives, all of them triangles in the BVH's
+    /// lanes, each of them, for rays in lanes ([`Geometry::nearest_small`]); empty otherwise.
+    triangle_each: Vec<small::TriangleEach>,
 }
 
 impl Geometry {
@@ -328,6 +333,11 @@ impl Geometry {
         }
         let in_bvh = for_bvh.len();
         drop(for_bvh);
+        // A small scene of triangles alone keeps each for rays in lanes.
+        let triangle_each = match others.is_empty() && spheres.is_empty() && planes.is_empty() {
+            true => small::triangle_each(&blocks),
+            false => Vec::new(),
+        };
         let slots = attrs.len();
         let sphere_items = append(&mut others, slots, spheres);
         let plane_items = append(&mut others, slots, planes);
@@ -346,6 +356,7 @@ impl Geometry {
             normals: lane_normals,
             uvs: lane_uvs,
             has_triangles,
+            triangle_each,
         }
     }
 

@@ -8,7 +8,7 @@
 
 use glam::Vec3A;
 use proptest::prelude::*;
-use rtis::accel::{Geometry, Isa, Prim, require_all_isas};
+use rtis::accel::{Geometry, Isa, Prim, SMALL_SCENE, require_all_isas};
 use rtis::geometry::{Hit, Ray};
 use rtis::shape::{Plane, Shape, Sphere, Triangle};
 
@@ -529,4 +529,123 @@ unsafe fn in_lanes<L: rtis::accel::Floats>(
         "{} lanes from ray {first}, planes {planes}",
         L::LANES
     );
+}
+
+/// A small scene (`src/accel/small.rs`): up to [`SMALL_SCENE`] triangles at scale `s`, large
+/// and small, some sharing an edge.
+fn small_scene(s: f32) -> impl Strategy<Value = Vec<Prim>> {
+    let triangle = (point(s), point(s), point(s), 0.05f32..1.0).prop_filter_map(
+        "zero area",
+        move |(a, b, c, size)| {
+            let (b, c) = (a + (b - a) * size, a + (c - a) * size);
+            let t = Triangle::new(a, b, c)?;
+            // Its neighbour across the edge `bc`, folded a little.
+            let d = b + c - a + t.n * (0.3 * size * s);
+            let pair = [t, Triangle::new(c, b, d)?];
+            Some(pair.map(|t| Prim::flat(Shape::Triangle(t))))
+        },
+    );
+    prop::collection::vec(triangle, 1..=SMALL_SCENE / 2).prop_map(|v| v.concat())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// In a small scene, rays in lanes meet every triangle (not the BVH), and each ray's
+    /// nearest hit and shadow answer are the one-ray query's, field for field.
+    #[test]
+    fn small_scenes_answer_in_lanes_as_one_ray_queries(
+        (s, prims, origins, dirs) in scale().prop_flat_map(|s| (
+            Just(s),
+            small_scene(s),
+            prop::collection::vec(point(2.0 * s), 1..40),
+            prop::collection::vec(unit(), 40),
+        ))
+    ) {
+        let g = Geometry::build(prims, Vec::new());
+        prop_assert!(g.is_small());
+        let rays = rays(&g, &origins, &dirs, s);
+        for (isa, g) in each_isa(g) {
+            let (mut hits, mut blocked) = (Vec::new(), Vec::new());
+            g.intersect_batch(&rays, &mut hits);
+            g.occluded_batch(&rays, true, &mut blocked);
+            prop_assert_eq!(hits.len(), rays.len());
+            prop_assert_eq!(blocked.len(), rays.len());
+            for (k, (ray, hit)) in rays.iter().zip(&hits).enumerate() {
+                prop_assert_eq!(bits(hit), bits(&g.intersect(ray)), "{:?}: ray {} of {}", isa, k, rays.len());
+                prop_assert_eq!(blocked[k], g.occluded(ray), "{:?}: shadow ray {} of {}", isa, k, rays.len());
+            }
+        }
+    }
+}
+
+/// A small scene seen straight down through the vertices, edges and diagonals of a
+/// tessellated square, with a second one a quarter square aside in the same plane: its rays
+/// meet edges (an edge function exactly zero, which the lanes leave to the one-ray test's
+/// top-left rule) and two triangles at the same distance (a tie, which they leave to the
+/// one-ray walk's order). Every answer is the one-ray query's, and every ray inside the first
+/// square meets it at 3.
+#[test]
+fn small_scenes_leave_edges_and_ties_to_the_one_ray_query() {
+    let n = 4;
+    let (first, second) = (
+        grid(n, Vec3A::ZERO),
+        grid(n - 1, Vec3A::new(0.25, 0.25, 0.0)),
+    );
+    assert_eq!(first.len() + second.len(), 32 + 18);
+    let mut rays = lattice_rays(n);
+    let w = 2 * n as usize + 1;
+    let on_lattice = rays.len();
+    // Rays off every edge of both squares, through both where they overlap: ties.
+    for i in 0..4 * n {
+        for j in 0..4 * n - 1 {
+            let (x, y) = (0.1 + 0.25 * i as f32, 0.3 + 0.25 * j as f32);
+            rays.push(Ray::new(Vec3A::new(x, y, 3.0), -Vec3A::Z));
+        }
+    }
+    // Both orders of the two squares: the lanes keep the later triangle of a tie, the walk
+    // the one it visits last.
+    let scenes = [[&first, &second], [&second, &first]].map(|[a, b]| [a.as_slice(), b].concat());
+    for (isa, g) in scenes
+        .into_iter()
+        .flat_map(|s| each_isa(Geometry::build(s, Vec::new())))
+    {
+        assert!(g.is_small());
+        let (mut hits, mut blocked) = (Vec::new(), Vec::new());
+        g.intersect_batch(&rays, &mut hits);
+        g.occluded_batch(&rays, true, &mut blocked);
+        for (k, (ray, hit)) in rays.iter().zip(&hits).enumerate() {
+            assert_eq!(bits(hit), bits(&g.intersect(ray)), "{isa:?}: ray {k}");
+            assert_eq!(blocked[k], g.occluded(ray), "{isa:?}: shadow ray {k}");
+            let inside =
+                k >= on_lattice || (1..w - 1).contains(&(k % w)) && (1..w - 1).contains(&(k / w));
+            if inside {
+                let t = hit.map_or(0.0, |h| h.t);
+                assert!((t - 3.0).abs() <= 1e-6, "{isa:?}: ray {k} at {t}");
+                assert!(blocked[k], "{isa:?}: shadow ray {k}");
+            }
+        }
+    }
+}
+
+/// A scene is small with up to [`SMALL_SCENE`] triangles and nothing else.
+#[test]
+fn small_scenes_hold_few_triangles_and_nothing_else() {
+    let square = |n: u32| grid(n, Vec3A::ZERO);
+    let small = |prims: Vec<Prim>| Geometry::build(prims, Vec::new()).is_small();
+    assert_eq!(square(5).len() + 14, SMALL_SCENE);
+    let mut most = square(5);
+    most.extend(square(2).into_iter().take(6));
+    most.extend(grid(2, Vec3A::Z));
+    assert_eq!(most.len(), SMALL_SCENE);
+    assert!(small(most.clone()));
+    most.push(grid(1, Vec3A::X * 9.0)[0]);
+    assert!(!small(most));
+    let mut with_sphere = square(2);
+    with_sphere.push(Prim::flat(Shape::Sphere(Sphere {
+        c: Vec3A::new(0.5, 0.5, 2.0),
+        r: 0.25,
+    })));
+    assert!(!small(with_sphere));
+    assert!(!small(Vec::new()));
 }

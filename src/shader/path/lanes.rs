@@ -22,7 +22,7 @@
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
 use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins};
-use crate::accel::{Floats, Geometry, Isa, MAX_LANES};
+use crate::accel::{Floats, Geometry, Isa, MAX_LANES, ShearLanes, Tally};
 use crate::geometry::{Hit, Ray};
 use crate::light::{Chosen, Light, LightSample, NO_LIGHT, choose_by_importance};
 use crate::material::{Material, Model, Phong};
@@ -234,12 +234,22 @@ unsafe fn round_in<L: Floats, R: Record>(
             }
             near.hit
         } else {
+            // A small scene's triangles met in the lanes, each ray's record computed alone.
+            let small = match geometry.is_small() {
+                true => {
+                    tr.traversal.prims(count as u64 * geometry.lane_prims());
+                    let r = ShearLanes::new(o, d, o_err);
+                    Some(geometry.nearest_small(&r, t_max))
+                }
+                false => None,
+            };
             let mut rows = [[0.0f32; MAX_LANES]; 8];
             for (i, hit) in hits.iter_mut().enumerate().take(count) {
                 let ray = &slots[c + i].st.ray;
-                *hit = match tr.traversal {
-                    None => geometry.intersect(ray),
-                    Some(t) => geometry.intersect_tallied(ray, t),
+                *hit = match (&small, tr.traversal) {
+                    (Some(near), t) => geometry.small_hit(near, i, ray, &t),
+                    (None, None) => geometry.intersect(ray),
+                    (None, Some(t)) => geometry.intersect_tallied(ray, t),
                 };
                 if let Some(h) = hit {
                     for x in 0..3 {
