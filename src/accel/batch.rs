@@ -11,8 +11,9 @@
 //! and keeps the parameters of the primitive it hits, so that the hit records are computed in the
 //! lanes too ([`Geometry::nearest_lanes`], which the Global shader's waves use as well); the
 //! answers are bit-identical to [`Geometry::intersect`] and [`Geometry::occluded`] in every
-//! instruction set. A small scene of triangles alone meets each of its triangles in the lanes too
-//! ([`Geometry::nearest_small`], `small.rs`); other scenes with a BVH answer ray by ray.
+//! instruction set. A small scene of triangles alone meets each of its triangles in AVX-512
+//! lanes too ([`Geometry::nearest_small`], `small.rs`); other scenes with a BVH answer ray by
+//! ray.
 //!
 //! The instruction set is the BVH's ([`super::WideBvh::isa`]): AVX-512 or AVX2 where the CPU
 //! has it. Their copies are `#[target_feature]` functions around the generic code, which has

@@ -2,7 +2,8 @@
 //! with AVX2) against one primitive at a time give what the one-ray queries give, to the bit,
 //! in every instruction set the CPU runs, on random scenes of spheres and planes (and, through
 //! the BVH, triangles) at scales from 1e-3 to 1e5, for rays from anywhere and rays leaving a
-//! hit, where the error bands decide. Coherent rays in packets through the BVH
+//! hit, where the error bands decide; small scenes of triangles in AVX-512 lanes too
+//! (`src/accel/small.rs`). Coherent rays in packets through the BVH
 //! (`Geometry::intersect_coherent`, `src/accel/wide/packet.rs`) give the one-ray hits too,
 //! shared edges and their ties included.
 
@@ -563,9 +564,9 @@ proptest! {
         ))
     ) {
         let g = Geometry::build(prims, Vec::new());
-        prop_assert!(g.is_small());
         let rays = rays(&g, &origins, &dirs, s);
         for (isa, g) in each_isa(g) {
+            prop_assert_eq!(g.is_small(), isa == Isa::Avx512);
             let (mut hits, mut blocked) = (Vec::new(), Vec::new());
             g.intersect_batch(&rays, &mut hits);
             g.occluded_batch(&rays, true, &mut blocked);
@@ -610,7 +611,7 @@ fn small_scenes_leave_edges_and_ties_to_the_one_ray_query() {
         .into_iter()
         .flat_map(|s| each_isa(Geometry::build(s, Vec::new())))
     {
-        assert!(g.is_small());
+        assert_eq!(g.is_small(), isa == Isa::Avx512);
         let (mut hits, mut blocked) = (Vec::new(), Vec::new());
         g.intersect_batch(&rays, &mut hits);
         g.occluded_batch(&rays, true, &mut blocked);
@@ -628,11 +629,25 @@ fn small_scenes_leave_edges_and_ties_to_the_one_ray_query() {
     }
 }
 
-/// A scene is small with up to [`SMALL_SCENE`] triangles and nothing else.
+/// A scene is small with up to [`SMALL_SCENE`] triangles and nothing else, where its queries
+/// run in AVX-512 lanes.
 #[test]
 fn small_scenes_hold_few_triangles_and_nothing_else() {
+    require_all_isas();
+    if !Isa::Avx512.available() {
+        let mut g = Geometry::build(grid(2, Vec3A::ZERO), Vec::new());
+        for isa in Isa::all_available() {
+            assert!(g.bvh.set_isa(isa));
+            assert!(!g.is_small(), "{isa:?}");
+        }
+        return;
+    }
     let square = |n: u32| grid(n, Vec3A::ZERO);
-    let small = |prims: Vec<Prim>| Geometry::build(prims, Vec::new()).is_small();
+    let small = |prims: Vec<Prim>| {
+        let mut g = Geometry::build(prims, Vec::new());
+        assert!(g.bvh.set_isa(Isa::Avx512));
+        g.is_small()
+    };
     assert_eq!(square(5).len() + 14, SMALL_SCENE);
     let mut most = square(5);
     most.extend(square(2).into_iter().take(6));
