@@ -32,8 +32,9 @@ pub const SMALL_SCENE: usize = 64;
 pub struct TriangleEach {
     /// Its primitive (`4 * block + lane`).
     prim: u32,
-    /// `v[j][axis]`: coordinate `axis` of vertex `j`.
-    v: [[f32; 3]; 3],
+    /// `v[j][axis]`: coordinate `axis` of vertex `j` (and a fourth, zero, for
+    /// [`Floats::pick`]).
+    v: [[f32; 4]; 3],
     /// `|v[0][axis]|`, the first vertex's share of the self-intersection band.
     v0_abs: [f32; 3],
     /// The unit normal, [`Block::normals`]'s to the bit.
@@ -58,7 +59,7 @@ pub fn triangle_each(blocks: &[Block]) -> Vec<TriangleEach> {
             let n = [n[0][lane], n[1][lane], n[2][lane]];
             out.push(TriangleEach {
                 prim: (4 * b + lane) as u32,
-                v,
+                v: v.map(|[x, y, z]| [x, y, z, 0.0]),
                 v0_abs: v[0].map(f32::abs),
                 n,
                 n_abs: n.map(f32::abs),
@@ -84,18 +85,10 @@ impl<M: Copy> Axis<M> {
     }
 }
 
-/// Coordinate `k` of vertex `vertex`, splatted, less `o` (the ray's coordinate `k`).
+/// Each lane's coordinate `k` of vertex `vertex`, less `o` (the ray's coordinate `k`).
 #[inline(always)]
-fn relative<L: Floats>(vertex: [f32; 3], k: Axis<L::Mask>, o: L) -> L {
-    // SAFETY: `o` is a value of `L`, so the CPU runs its instruction set.
-    let v = unsafe {
-        [
-            L::splat(vertex[0]),
-            L::splat(vertex[1]),
-            L::splat(vertex[2]),
-        ]
-    };
-    k.of(v) - o
+fn relative<L: Floats>(vertex: &[f32; 4], k: L::Axis, o: L) -> L {
+    L::pick(vertex, k) - o
 }
 
 /// Rays in lanes with the constants of the watertight test, as [`crate::geometry::BvhRay::sheared`]
@@ -105,7 +98,7 @@ pub struct ShearLanes<L: Floats> {
     d: [L; 3],
     o_err: L,
     /// The axes `kx`, `ky` and `kz`: `kz` where `|d|` is largest, the others after it.
-    k: [Axis<L::Mask>; 3],
+    k: [L::Axis; 3],
     /// `o[kx]`, `o[ky]` and `o[kz]`.
     o_k: [L; 3],
     /// `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`, each as the one-ray test computes it.
@@ -145,7 +138,11 @@ impl<L: Floats> ShearLanes<L> {
             o_abs: [o[0].abs(), o[1].abs(), o[2].abs()],
             d,
             o_err,
-            k: [kx, ky, kz],
+            k: [
+                L::axis(kx.x, kx.y),
+                L::axis(ky.x, ky.y),
+                L::axis(kz.x, kz.y),
+            ],
             o_k: [kx.of(o), ky.of(o), kz.of(o)],
             shear: [kx.of(d) * sz, ky.of(d) * sz, sz],
         }
@@ -174,16 +171,16 @@ impl TriangleEach {
         // Vertices relative to the origin, sheared so the ray runs along +z.
         let v = &self.v;
         let (az, bz, cz) = (
-            relative(v[0], kz, r.o_k[2]),
-            relative(v[1], kz, r.o_k[2]),
-            relative(v[2], kz, r.o_k[2]),
+            relative(&v[0], kz, r.o_k[2]),
+            relative(&v[1], kz, r.o_k[2]),
+            relative(&v[2], kz, r.o_k[2]),
         );
-        let ax = relative(v[0], kx, r.o_k[0]) - sx * az;
-        let ay = relative(v[0], ky, r.o_k[1]) - sy * az;
-        let bx = relative(v[1], kx, r.o_k[0]) - sx * bz;
-        let by = relative(v[1], ky, r.o_k[1]) - sy * bz;
-        let cx = relative(v[2], kx, r.o_k[0]) - sx * cz;
-        let cy = relative(v[2], ky, r.o_k[1]) - sy * cz;
+        let ax = relative(&v[0], kx, r.o_k[0]) - sx * az;
+        let ay = relative(&v[0], ky, r.o_k[1]) - sy * az;
+        let bx = relative(&v[1], kx, r.o_k[0]) - sx * bz;
+        let by = relative(&v[1], ky, r.o_k[1]) - sy * bz;
+        let cx = relative(&v[2], kx, r.o_k[0]) - sx * cz;
+        let cy = relative(&v[2], ky, r.o_k[1]) - sy * cz;
         // Edge functions: all of one sign inside.
         let u = cx * by - cy * bx;
         let v = ax * cy - ay * cx;

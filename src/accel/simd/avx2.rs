@@ -278,4 +278,14 @@ unsafe impl Floats for F8 {
     fn bitmask(m: M8) -> u32 {
         unsafe { _mm256_movemask_ps(m.0) as u32 }
     }
+    type Axis = (M8, M8);
+    #[inline(always)]
+    fn axis(x: M8, y: M8) -> (M8, M8) {
+        (x, y)
+    }
+    #[inline(always)]
+    fn pick(v: &[f32; 4], (x, y): (M8, M8)) -> Self {
+        let [a, b, c, _] = v.map(|t| F8(unsafe { _mm256_set1_ps(t) }));
+        Self::select(x, a, Self::select(y, b, c))
+    }
 }

@@ -223,6 +223,36 @@ unsafe impl Floats for F16 {
     fn bitmask(m: M16) -> u32 {
         u32::from(m.0)
     }
+    type Axis = Axis16;
+    #[inline(always)]
+    fn axis(x: M16, y: M16) -> Axis16 {
+        // An `M16` comes only from comparing `F16`s, so AVX-512F was found.
+        unsafe {
+            let (zero, one, two) = (
+                _mm512_set1_epi32(0),
+                _mm512_set1_epi32(1),
+                _mm512_set1_epi32(2),
+            );
+            Axis16(_mm512_mask_blend_epi32(
+                x.0,
+                _mm512_mask_blend_epi32(y.0, two, one),
+                zero,
+            ))
+        }
+    }
+    #[inline(always)]
+    fn pick(v: &[f32; 4], axis: Axis16) -> Self {
+        // The four values in every 128-bit quarter (one load), then each lane's by its index.
+        // The load reads the 16 bytes of `v`.
+        unsafe {
+            let table = _mm512_broadcast_f32x4(_mm_loadu_ps(v.as_ptr()));
+            F16(_mm512_permutexvar_ps(axis.0, table))
+        }
+    }
 }
+
+/// Sixteen coordinate indices (0, 1 or 2), one per lane ([`Floats::axis`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Axis16(__m512i);
 
 const _: () = assert!(MAX_LANES >= 16, "the kernels' arrays hold sixteen lanes");

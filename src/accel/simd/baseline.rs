@@ -100,6 +100,16 @@ unsafe impl Floats for Vec4 {
     fn bitmask(m: BVec4A) -> u32 {
         m.bitmask()
     }
+    type Axis = (BVec4A, BVec4A);
+    #[inline(always)]
+    fn axis(x: BVec4A, y: BVec4A) -> (BVec4A, BVec4A) {
+        (x, y)
+    }
+    #[inline(always)]
+    fn pick(v: &[f32; 4], (x, y): (BVec4A, BVec4A)) -> Self {
+        let [a, b, c, _] = v.map(Vec4::splat);
+        Vec4::select(x, a, Vec4::select(y, b, c))
+    }
 }
 
 /// Eight lanes in two `Vec4`s, lanes 0 to 3 then 4 to 7.

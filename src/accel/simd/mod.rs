@@ -227,6 +227,13 @@ pub unsafe trait Floats:
     fn all(m: Self::Mask) -> bool;
     /// The lanes of `m` as bits 0 to `LANES - 1`.
     fn bitmask(m: Self::Mask) -> u32;
+    /// A coordinate named per lane ([`Floats::axis`]), for [`Floats::pick`].
+    type Axis: Copy;
+    /// Coordinate 0 in the lanes of `x`, 1 in the others of `y`, 2 in the rest.
+    fn axis(x: Self::Mask, y: Self::Mask) -> Self::Axis;
+    /// In each lane, the coordinate of `v` (its first three values) that `axis` names there,
+    /// bits unchanged: a permutation in one instruction with AVX-512, selects elsewhere.
+    fn pick(v: &[f32; 4], axis: Self::Axis) -> Self;
 }
 
 /// For tests that compare instruction sets: panics if the environment asks for one the CPU
@@ -476,6 +483,17 @@ mod tests {
             for (axis, lane) in t.iter().enumerate() {
                 let want: Vec<u32> = (0..L::LANES).map(|i| v[i][axis].to_bits()).collect();
                 assert_eq!(lane_bits(*lane), want, "axis {axis}");
+            }
+            // `pick`: each lane's coordinate as its axis names it, bits unchanged, for every
+            // pattern of axes over the lanes (lane i's axis is digit i of k in base 3).
+            let table = [-0.0f32, f32::MIN_POSITIVE / 4.0, -f32::INFINITY, 7.0];
+            for k in 0..3usize.pow(6) {
+                let named: [usize; MAX_LANES] =
+                    std::array::from_fn(|i| k / 3usize.pow(i as u32 % 6) % 3);
+                let v = L::from_array(named.map(|a| a as f32));
+                let axis = L::axis(v.cmplt(L::splat(0.5)), v.cmplt(L::splat(1.5)));
+                let want: Vec<u32> = (0..L::LANES).map(|i| table[named[i]].to_bits()).collect();
+                assert_eq!(lane_bits(L::pick(&table, axis)), want, "axes {named:?}");
             }
         }
     }
