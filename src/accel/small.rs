@@ -186,8 +186,10 @@ impl TriangleEach {
         let v = ax * cy - ay * cx;
         let w = bx * ay - by * ax;
         let edge = !(u.cmpne(zero) & v.cmpne(zero) & w.cmpne(zero));
-        let outside = (u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero))
-            & (u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero));
+        // Outside: some edge function below zero and some above. Off the edges (none zero),
+        // that is their sign bits differing; where one is NaN, so is `t` below, which then
+        // meets nothing either way.
+        let outside = L::signs_differ(u, v, w);
         // Distance, scaled by the determinant.
         let det = u + v + w;
         let t_scaled = u * (sz * az) + v * (sz * bz) + w * (sz * cz);

@@ -278,6 +278,16 @@ unsafe impl Floats for F8 {
     fn bitmask(m: M8) -> u32 {
         unsafe { _mm256_movemask_ps(m.0) as u32 }
     }
+    #[inline(always)]
+    fn signs_differ(a: Self, b: Self, c: Self) -> M8 {
+        // A sign bit set in `(a ^ b) | (a ^ c)`, spread over its lane.
+        unsafe {
+            let x = _mm256_or_ps(_mm256_xor_ps(a.0, b.0), _mm256_xor_ps(a.0, c.0));
+            M8(_mm256_castsi256_ps(_mm256_srai_epi32::<31>(
+                _mm256_castps_si256(x),
+            )))
+        }
+    }
     type Axis = (M8, M8);
     #[inline(always)]
     fn axis(x: M8, y: M8) -> (M8, M8) {

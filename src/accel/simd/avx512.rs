@@ -223,6 +223,15 @@ unsafe impl Floats for F16 {
     fn bitmask(m: M16) -> u32 {
         u32::from(m.0)
     }
+    #[inline(always)]
+    fn signs_differ(a: Self, b: Self, c: Self) -> M16 {
+        // A sign bit set in `(a ^ b) | (a ^ c)`.
+        unsafe {
+            let (a, b, c) = (a.bits(), b.bits(), c.bits());
+            let x = _mm512_or_si512(_mm512_xor_si512(a, b), _mm512_xor_si512(a, c));
+            M16(_mm512_test_epi32_mask(x, sign_bits()))
+        }
+    }
     type Axis = Axis16;
     #[inline(always)]
     fn axis(x: M16, y: M16) -> Axis16 {

@@ -100,6 +100,13 @@ unsafe impl Floats for Vec4 {
     fn bitmask(m: BVec4A) -> u32 {
         m.bitmask()
     }
+    #[inline(always)]
+    fn signs_differ(a: Self, b: Self, c: Self) -> BVec4A {
+        let sign = |v: Vec4| v.to_array().map(|x| x.to_bits() >> 31);
+        let (a, b, c) = (sign(a), sign(b), sign(c));
+        let d = |i: usize| a[i] != b[i] || a[i] != c[i];
+        BVec4A::new(d(0), d(1), d(2), d(3))
+    }
     type Axis = (BVec4A, BVec4A);
     #[inline(always)]
     fn axis(x: BVec4A, y: BVec4A) -> (BVec4A, BVec4A) {

@@ -227,6 +227,9 @@ pub unsafe trait Floats:
     fn all(m: Self::Mask) -> bool;
     /// The lanes of `m` as bits 0 to `LANES - 1`.
     fn bitmask(m: Self::Mask) -> u32;
+    /// Lanes where the sign bits of `a`, `b` and `c` are not all the same (zeros and NaN by
+    /// their sign bits too).
+    fn signs_differ(a: Self, b: Self, c: Self) -> Self::Mask;
     /// A coordinate named per lane ([`Floats::axis`]), for [`Floats::pick`].
     type Axis: Copy;
     /// Coordinate 0 in the lanes of `x`, 1 in the others of `y`, 2 in the rest.
@@ -439,6 +442,18 @@ mod tests {
                     same!(|p, q| Floats::abs(p));
                     same!(|p, q| Floats::copysign(p, q));
                     same!(|p, q| Floats::max(p, q));
+                    // `signs_differ` against the sign bits read lane by lane (with `-p`, a
+                    // lane always differs).
+                    for c in [xv, yv, -xv] {
+                        let got = L::bitmask(L::signs_differ(xv, yv, c));
+                        let mut cv = [0.0f32; MAX_LANES];
+                        c.write_to(&mut cv);
+                        let want = (0..L::LANES).fold(0, |m, i| {
+                            let s = [x[i], y[i], cv[i]].map(|v| v.to_bits() >> 31);
+                            m | (u32::from(s[0] != s[1] || s[0] != s[2]) << i)
+                        });
+                        assert_eq!(got, want, "{x:?} {y:?}");
+                    }
                     let masks = |p: L, q: L| {
                         [p.cmpge(q), p.cmple(q), p.cmpgt(q), p.cmplt(q), p.cmpne(q)].map(L::bitmask)
                     };
