@@ -2,8 +2,8 @@
 //!
 //! A scene made of at most [`SMALL_SCENE`] triangles and nothing else (Mitsuba's Cornell box:
 //! its walls and cubes) is answered faster by meeting every triangle than by walking its BVH:
-//! a shader that holds rays in lanes (the path tracer's waves, `shader/path/lanes.rs`)
-//! tests each triangle, splatted across the lanes, against a ray per lane, where the walk tests
+//! a shader that holds rays in lanes (the path tracer's waves, `shader/path/lanes.rs`, and the
+//! Global shader's, through the batched queries of `batch.rs`) tests each triangle, splatted across the lanes, against a ray per lane, where the walk tests
 //! one ray at a time, with a branch per node and per leaf. Only AVX-512's sixteen lanes pay
 //! for it ([`Geometry::is_small`]): with fewer, the scene's rays walk the BVH.
 //!
@@ -15,7 +15,9 @@
 //! back, for the one-ray query to answer: an edge function exactly zero (the scalar test's
 //! top-left rule and its double-precision retry), and, for the nearest hit, two triangles met
 //! at the same distance (the walk's order picks one). Every answer is therefore the one-ray
-//! query's to the bit.
+//! query's to the bit, given that the walk reaches every leaf holding a hit within the ray's
+//! reach: its box tests are widened for their own rounding (`wide.rs`), and the tests here
+//! compare the two on random scenes, grazing and spawned rays included.
 
 use super::block::Block;
 use super::lanes::array;
@@ -72,12 +74,12 @@ pub fn triangle_each(blocks: &[Block]) -> Vec<TriangleEach> {
 /// An axis chosen per lane: lanes of `x` take coordinate 0, lanes of `y` coordinate 1, the
 /// others coordinate 2.
 #[derive(Clone, Copy)]
-struct Axis<M> {
+struct AxisMasks<M> {
     x: M,
     y: M,
 }
 
-impl<M: Copy> Axis<M> {
+impl<M: Copy> AxisMasks<M> {
     /// Each lane's coordinate of `v`.
     #[inline(always)]
     fn of<L: Floats<Mask = M>>(self, v: [L; 3]) -> L {
@@ -117,7 +119,7 @@ impl<L: Floats> ShearLanes<L> {
         let a = [d[0].abs(), d[1].abs(), d[2].abs()];
         let y_over_x = a[1].cmpgt(a[0]);
         let z = a[2].cmpgt(L::select(y_over_x, a[1], a[0]));
-        let kz = Axis {
+        let kz = AxisMasks {
             x: !z & !y_over_x,
             y: !z & y_over_x,
         };
@@ -125,11 +127,11 @@ impl<L: Floats> ShearLanes<L> {
         let down = kz.of(d).cmplt(zero);
         let (z0, z1) = (kz.x, kz.y);
         let z2 = !(z0 | z1);
-        let kx = Axis {
+        let kx = AxisMasks {
             x: (z1 & down) | (z2 & !down),
             y: (z0 & !down) | (z2 & down),
         };
-        let ky = Axis {
+        let ky = AxisMasks {
             x: (z1 & !down) | (z2 & down),
             y: (z0 & down) | (z2 & !down),
         };
@@ -216,10 +218,18 @@ impl TriangleEach {
                 L::splat(gamma(5)),
             )
         };
+        // SAFETY: as above.
+        let v0_abs = unsafe {
+            [
+                L::splat(self.v0_abs[0]),
+                L::splat(self.v0_abs[1]),
+                L::splat(self.v0_abs[2]),
+            ]
+        };
         let reach = [
-            unsafe { L::splat(self.v0_abs[0]) } + r.o_abs[0],
-            unsafe { L::splat(self.v0_abs[1]) } + r.o_abs[1],
-            unsafe { L::splat(self.v0_abs[2]) } + r.o_abs[2],
+            v0_abs[0] + r.o_abs[0],
+            v0_abs[1] + r.o_abs[1],
+            v0_abs[2] + r.o_abs[2],
         ];
         let band = g5 * (an[0] * reach[0] + an[1] * reach[1] + an[2] * reach[2])
             + (an[0] + an[1] + an[2]) * r.o_err;
@@ -263,7 +273,10 @@ impl Geometry {
         let (mut t, mut slot) = (t_max, none);
         // Lanes that met a triangle, that met two at their nearest distance, and that need the
         // one-ray test.
+        // (No lane is both below and above itself: no lane set, NaN included.)
         let no = t_max.cmplt(t_max) & t_max.cmpgt(t_max);
+        // (An edge anywhere sends the lane alone, even beyond its nearest hit: rare, and
+        // never wrong.)
         let (mut found, mut tied, mut edge) = (no, no, no);
         for (j, tri) in self.triangle_each.iter().enumerate() {
             let met = tri.test(r, t);
@@ -317,6 +330,7 @@ impl Geometry {
         tally: &impl Tally,
         ray: impl Fn(usize) -> Ray,
     ) -> u32 {
+        // No lane blocked or on an edge yet (no lane is both below and above itself).
         let mut hit = t_max.cmplt(t_max) & t_max.cmpgt(t_max);
         let mut edge = hit;
         let asked = L::bitmask(live).count_ones() as u64;
@@ -330,6 +344,7 @@ impl Geometry {
                 break;
             }
         }
+        // The lanes met in the lanes, and those an edge left unsure asked alone.
         let (mut blocked, mut unsure) = (L::bitmask(hit & live), L::bitmask(edge & !hit & live));
         while unsure != 0 {
             let i = unsure.trailing_zeros() as usize;

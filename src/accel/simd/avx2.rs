@@ -295,7 +295,14 @@ unsafe impl Floats for F8 {
     }
     #[inline(always)]
     fn pick(v: &[f32; 4], (x, y): (M8, M8)) -> Self {
-        let [a, b, c, _] = v.map(|t| F8(unsafe { _mm256_set1_ps(t) }));
+        // SAFETY: an `M8` exists, so AVX2 was found.
+        let (a, b, c) = unsafe {
+            (
+                F8(_mm256_set1_ps(v[0])),
+                F8(_mm256_set1_ps(v[1])),
+                F8(_mm256_set1_ps(v[2])),
+            )
+        };
         Self::select(x, a, Self::select(y, b, c))
     }
 }

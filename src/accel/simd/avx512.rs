@@ -25,7 +25,9 @@ pub struct M16(__mmask16);
 // SAFETY (of the `unsafe` blocks from here on): an `F16` exists, so AVX-512F was found (the
 // only constructors are the unsafe `Floats::splat`, `from_slice`, `from_array` and
 // `transpose3`, and the operations below, which take a value). The intrinsics only compute on
-// registers, except the marked loads and stores. `M16` is a plain bit set.
+// registers, except the marked loads and stores. `M16` is a plain bit set, and `Axis16` sixteen
+// indices, but each is made only from `F16`s (comparisons, then `Floats::axis`), so it too
+// shows that AVX-512F was found.
 macro_rules! binary {
     ($trait:ident, $method:ident, $intrinsic:ident) => {
         impl $trait for F16 {
@@ -226,6 +228,7 @@ unsafe impl Floats for F16 {
     #[inline(always)]
     fn signs_differ(a: Self, b: Self, c: Self) -> M16 {
         // A sign bit set in `(a ^ b) | (a ^ c)`.
+        // SAFETY: an `F16` exists (see above).
         unsafe {
             let (a, b, c) = (a.bits(), b.bits(), c.bits());
             let x = _mm512_or_si512(_mm512_xor_si512(a, b), _mm512_xor_si512(a, c));
@@ -235,7 +238,7 @@ unsafe impl Floats for F16 {
     type Axis = Axis16;
     #[inline(always)]
     fn axis(x: M16, y: M16) -> Axis16 {
-        // An `M16` comes only from comparing `F16`s, so AVX-512F was found.
+        // SAFETY: an `M16` comes only from comparing `F16`s, so AVX-512F was found.
         unsafe {
             let (zero, one, two) = (
                 _mm512_set1_epi32(0),
@@ -252,7 +255,8 @@ unsafe impl Floats for F16 {
     #[inline(always)]
     fn pick(v: &[f32; 4], axis: Axis16) -> Self {
         // The four values in every 128-bit quarter (one load), then each lane's by its index.
-        // The load reads the 16 bytes of `v`.
+        // SAFETY: an `Axis16` comes only from `F16`s (see above); the load reads the 16
+        // bytes of `v`.
         unsafe {
             let table = _mm512_broadcast_f32x4(_mm_loadu_ps(v.as_ptr()));
             F16(_mm512_permutexvar_ps(axis.0, table))

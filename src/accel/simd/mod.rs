@@ -155,7 +155,8 @@ pub trait Lanes8: Copy {
 /// Making a value from nothing (`splat`, `from_slice`, `from_array`, `transpose3`) runs the
 /// set's instructions, so only
 /// callers that checked the CPU may do it; every other operation takes a value, whose existence
-/// shows that the check was made.
+/// shows that the check was made: a vector, or a mask or an axis, which are made only from
+/// vectors (comparisons, [`Floats::axis`]).
 pub unsafe trait Floats:
     Copy
     + std::ops::Add<Output = Self>

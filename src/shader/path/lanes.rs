@@ -132,8 +132,9 @@ fn textured(tr: &Tracer, material: u32, hit: &Hit) -> Option<Phong> {
 }
 
 /// One round of a wave: trace each path's ray of `slots` and shade the vertex it meets, the
-/// rays in chunks of lanes ([`Geometry::nearest_lanes`] in a scene without a BVH, else each
-/// with the one-ray query), the diffuse
+/// rays in chunks of lanes ([`Geometry::nearest_lanes`] in a scene without a BVH,
+/// [`Geometry::nearest_small`] in a small scene of triangles, else each with the one-ray
+/// query), the diffuse
 /// vertices ([`Diffuse`]) in those lanes, the others with the one-ray [`super::step`] (its
 /// random stream swapped into `tr`). Each path adds its vertex's light to its recorder and
 /// takes its next ray (counted); `alive[k]` (one per slot) says whether path `k` goes on.
