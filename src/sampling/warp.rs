@@ -16,14 +16,20 @@ pub fn uniform_sphere(u1: f32, u2: f32) -> Vec3A {
 /// map pbrt-v4 uses): a point `b0 v0 + b1 v1 + b2 v2` is uniform in area.
 #[inline]
 pub fn uniform_triangle(u1: f32, u2: f32) -> [f32; 3] {
-    let (b0, b1) = if u1 < u2 {
-        let b0 = u1 / 2.0;
-        (b0, u2 - b0)
-    } else {
-        let b1 = u2 / 2.0;
-        (u1 - b1, b1)
-    };
+    // Both halves computed and one kept by a select, not a branch: `u1 < u2` is a coin toss
+    // to the branch predictor.
+    let (h1, h2) = (u1 / 2.0, u2 / 2.0);
+    let lower = u1 < u2;
+    let b0 = select(lower, h1, u1 - h2);
+    let b1 = select(lower, u2 - h1, h2);
     [b0, b1, (1.0 - b0 - b1).max(0.0)]
+}
+
+/// `a` if `c`, else `b`, without a branch (as a conditional move).
+#[inline(always)]
+fn select(c: bool, a: f32, b: f32) -> f32 {
+    let m = (c as u32).wrapping_neg();
+    f32::from_bits((a.to_bits() & m) | (b.to_bits() & !m))
 }
 
 /// A uniform point on the unit disk by Shirley and Chiu's concentric map ("A Low Distortion Map
