@@ -17,7 +17,8 @@
 //! (`tests/integration/path_waves.rs`). A spot or directional light's incident light
 //! (`Light::incident`) and an area-light or environment sample run the scalar code lane by
 //! lane (`surface::sample_area_light` or `EnvironmentLight::sample`, `light_ray` on
-//! `Interaction::flat`, and, once its shadow ray has been tested in lanes, `light_weighted`).
+//! `Interaction::flat`); its shadow ray is tested in lanes, and its weight (`light_weighted`:
+//! the diffuse reflectance, the power heuristic against `brdf_pdf`) is computed in lanes too.
 
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
@@ -30,7 +31,7 @@ use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling, Streams
 use crate::shader::Tracer;
 use crate::shader::record::{Record, Technique};
 use crate::shader::surface::{
-    Interaction, SHADOW_END, diffuse_probability, light_ray, light_weighted, sample_area_light,
+    Interaction, SHADOW_END, diffuse_probability, light_ray, sample_area_light,
 };
 use crate::stats::RayKind;
 use glam::Vec3A;
@@ -512,7 +513,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
             false => [term[0] / w, term[1] / w, term[2] / w],
         };
         // The lanes that chose an area light take its term.
-        let term = unsafe { area.terms(tr, at, (wo, n), mis, false) };
+        let term = unsafe { area.terms(tr, &surface, mis, false) };
         let lanes = unsafe { lane_mask::<L>(area.lanes) };
         [
             L::select(lanes, term[0], point[0]),
@@ -562,7 +563,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
                 area.sample(tr, at, (i, slots[i].st.ray.d), c, (u1[i], u2[i]), &mut rng);
             }
         }
-        let area = unsafe { area.terms(tr, at, (wo, n), mis, true) };
+        let area = unsafe { area.terms(tr, &surface, mis, true) };
         [sum[0] + area[0], sum[1] + area[1], sum[2] + area[2]]
     };
     // Each path adds `beta` times its vertex's light.
@@ -758,10 +759,10 @@ impl AreaRays {
         self.tested |= 1 << i;
     }
 
-    /// The samples' terms `L_e r V w / (pmf pdf)` at the vertices of `at` seen from `wo` with
-    /// shading normals `n` (`light_term`: the shadow rays tested in lanes, then each visible
-    /// sample weighted lane by lane), zero in the lanes without a sample. With `summed`, each
-    /// term as `area_lights` returns it for one sample: added to zero and divided by one.
+    /// The samples' terms `L_e r V w / (pmf pdf)` at the vertices of `at` (`light_term`: the
+    /// shadow rays tested in lanes, then each visible sample weighted, `light_weighted`, in
+    /// lanes too), zero in the lanes without a sample. With `summed`, each term as
+    /// `area_lights` returns it for one sample: added to zero and divided by one.
     ///
     /// # Safety
     /// The CPU must run `L`'s instruction set.
@@ -769,22 +770,19 @@ impl AreaRays {
     unsafe fn terms<L: Floats>(
         &self,
         tr: &mut Tracer,
-        at: &Vertices<L>,
-        (wo, n): ([L; 3], [L; 3]),
+        at: &Surface<L>,
         mis: Option<Sampling>,
         summed: bool,
     ) -> [L; 3] {
         // SAFETY: the caller's; so for every `unsafe` block below, each makes values of `L`.
-        let zero = unsafe { L::splat(0.0) };
-        if self.lanes == 0 {
+        let (zero, one) = unsafe { (L::splat(0.0), L::splat(1.0)) };
+        // (Without a column, no lane has a sample: each term is zero, summed or not.)
+        let Some(c) = self.columns.as_ref().filter(|_| self.lanes != 0) else {
             return [zero; 3];
-        }
-        // The shadow rays, in lanes (the columns are there if a lane has one).
-        let (mut blocked, c) = (0u32, self.columns.as_ref());
-        if let Some(c) = c
-            && tr.effects.shadows
-            && self.tested != 0
-        {
+        };
+        // The shadow rays, in lanes.
+        let mut blocked = 0u32;
+        if tr.effects.shadows && self.tested != 0 {
             let load = |row: usize| unsafe { L::from_slice(&c.ray[row]) };
             let segments = (
                 [load(0), load(1), load(2)],
@@ -799,33 +797,89 @@ impl AreaRays {
             blocked = L::bitmask(hidden);
             tr.count_shadow_lanes(segments, self.tested);
         }
-        // The visible samples' weights.
-        let (wo, n) = (wo.map(|x| array(x)), n.map(|x| array(x)));
-        let mut term = [[0.0f32; MAX_LANES]; 3];
-        for i in Bits(self.lanes) {
-            let mut l = Vec3A::ZERO;
-            if let (Some((_, phong)), Some(c)) = (&at.materials[i], c)
-                && self.tested & !blocked & (1 << i) != 0
-            {
-                let at = |v: &[[f32; MAX_LANES]; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
-                let sample = (at(&c.wi), at(&c.le), c.pdf[i]);
-                l = light_weighted(tr.model, (at(&wo), at(&n)), phong, sample, mis);
-            }
-            if summed {
-                l = (Vec3A::ZERO + l) / 1.0;
-            }
-            for (row, x) in term.iter_mut().zip(l.to_array()) {
-                row[i] = x;
-            }
+        // The visible samples' terms, `light_weighted`: `L_e r(wi, wo) w / pdf` with
+        // `r = f max(cos, 0)` (the diffuse BRDF, or the course's reflectance; zero where `wi`
+        // or, under the Physical model, `wo` is below) and `w` the power heuristic against the
+        // BRDF-sampled direction's density under MIS (else 1). The pdf holds the light's
+        // chance.
+        let seen = unsafe { lane_mask::<L>(self.tested & !blocked) };
+        let (wi, le, pdf) = unsafe {
+            (
+                [
+                    L::from_slice(&c.wi[0]),
+                    L::from_slice(&c.wi[1]),
+                    L::from_slice(&c.wi[2]),
+                ],
+                [
+                    L::from_slice(&c.le[0]),
+                    L::from_slice(&c.le[1]),
+                    L::from_slice(&c.le[2]),
+                ],
+                L::from_slice(&c.pdf),
+            )
+        };
+        let cos = dot(wi, at.n);
+        let above = cos.cmpgt(zero) & at.wo_above;
+        let r = [
+            L::select(above, at.f[0], zero) * cos.max(zero),
+            L::select(above, at.f[1], zero) * cos.max(zero),
+            L::select(above, at.f[2], zero) * cos.max(zero),
+        ];
+        let w = match mis {
+            Some(sampling) => unsafe { power_heuristic(pdf, brdf_pdf(cos, sampling)) },
+            None => one,
+        };
+        let k = w / pdf;
+        let mut term = [
+            L::select(seen, le[0] * r[0] * k, zero),
+            L::select(seen, le[1] * r[1] * k, zero),
+            L::select(seen, le[2] * r[2] * k, zero),
+        ];
+        if summed {
+            term = [
+                (zero + term[0]) / one,
+                (zero + term[1]) / one,
+                (zero + term[2]) / one,
+            ];
         }
-        unsafe {
-            [
-                L::from_array(term[0]),
-                L::from_array(term[1]),
-                L::from_array(term[2]),
-            ]
-        }
+        term
     }
+}
+
+/// `brdf_pdf` of a diffuse surface (every lane's material reflects diffusely only) in lanes,
+/// from the cosines `cos` of the directions with the shading normal: zero below the surface.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn brdf_pdf<L: Floats>(cos: L, sampling: Sampling) -> L {
+    // SAFETY: the caller's.
+    let zero = unsafe { L::splat(0.0) };
+    let pdf = match sampling {
+        Sampling::Uniform => unsafe { L::splat(crate::sampling::hemisphere::UNIFORM_PDF) },
+        // `cosine_pdf`.
+        Sampling::Cosine => cos.max(zero) * unsafe { L::splat(FRAC_1_PI) },
+        // The diffuse lobe's share is one.
+        Sampling::Brdf => cos / unsafe { L::splat(PI) },
+    };
+    L::select(cos.cmple(zero), zero, pdf)
+}
+
+/// `sampling::power_heuristic` in lanes: `pdf^2 / (pdf^2 + other^2)`, scaled by the larger
+/// (`f32::max`: the other where one is NaN), one where `pdf` is infinite, zero where the larger
+/// is not positive or is infinite.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn power_heuristic<L: Floats>(pdf: L, other: L) -> L {
+    // SAFETY: the caller's.
+    let (zero, one, inf) = unsafe { (L::splat(0.0), L::splat(1.0), L::splat(f32::INFINITY)) };
+    let (pdf_nan, other_nan) = (pdf.cmpne(pdf), other.cmpne(other));
+    let m = L::select(pdf_nan, other, L::select(other_nan, pdf, pdf.max(other)));
+    let (a, b) = ((pdf / m) * (pdf / m), (other / m) * (other / m));
+    let w = L::select(m.cmple(zero) | !m.abs().cmpne(inf), zero, a / (a + b));
+    L::select(!pdf.abs().cmpne(inf), one, w)
 }
 
 /// The numbers `one_light` and `area_lights` draw for a light sample, in lanes: `u` (53 bits)
