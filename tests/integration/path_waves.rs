@@ -227,7 +227,8 @@ fn light_strategies() -> Vec<String> {
 }
 
 /// Area lights in the waves: an emitting sphere among packed primitives, and a rectangle light
-/// in a scene of triangles (in a BVH), with point lights or without, over
+/// in a scene of triangles (in a BVH; one-sided, and two-sided once), with point lights or
+/// without, over
 /// the strategies (light sampling, BRDF sampling, MIS; one light by power or by importance, or
 /// all), both samplings, both models, and the effects that skip work.
 #[test]
@@ -260,6 +261,13 @@ fn waves_give_the_one_ray_pixels_with_area_lights() {
     // (A smooth triangle, and a textured rectangle light, among them.)
     agrees(&s, "sphere light, meshes, textured light");
     let shader = "Path(rr_depth: 1, sampling: Brdf, lights: Mis, lights_per_vertex: All)";
+    // Mitsuba's light two-sided: the ceiling, 0.01 above it, sees its back.
+    let two_sided = triangle_box(shader, "", false).replace("two_sided: false", "two_sided: true");
+    assert!(
+        two_sided.contains("two_sided: true"),
+        "mitsuba-cornell.ron changed"
+    );
+    agrees(&rtis::extract(&scene(&two_sided)), "box, two-sided light");
     let course = lit_room(shader, "").replace("model: Physical", "model: Course");
     assert!(course.contains("model: Course"));
     agrees(&rtis::extract(&scene(&course)), "sphere light, Course");

@@ -17,15 +17,20 @@
 //! (`tests/integration/path_waves.rs`). A spot or directional light's incident light
 //! (`Light::incident`) and an area-light or environment sample run the scalar code lane by
 //! lane (`surface::sample_area_light` or `EnvironmentLight::sample`, `light_ray` on
-//! `Interaction::flat`); its shadow ray is tested in lanes, and its weight (`light_weighted`:
-//! the diffuse reflectance, the power heuristic against `brdf_pdf`) is computed in lanes too.
+//! `Interaction::flat`), except, where every light has its term at each vertex
+//! (`area_lights`), the point on an untextured triangle light, which is sampled in lanes
+//! (`AreaLight::sample`'s operations); its shadow ray is tested in
+//! lanes, and its weight (`light_weighted`: the diffuse reflectance, the power heuristic
+//! against `brdf_pdf`) is computed in lanes too.
 
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
 use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES, ShearLanes, Tally};
 use crate::geometry::{Hit, Ray};
-use crate::light::{Chosen, Light, LightSample, NO_LIGHT, choose_by_importance};
+use crate::light::{
+    AreaLight, Chosen, Emitting, Light, LightSample, NO_LIGHT, choose_by_importance,
+};
 use crate::material::{Material, Model, Phong};
 use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling, Streams};
 use crate::shader::Tracer;
@@ -33,6 +38,7 @@ use crate::shader::record::{Record, Technique};
 use crate::shader::surface::{
     Interaction, SHADOW_END, diffuse_probability, light_ray, sample_area_light,
 };
+use crate::shape::Triangle;
 use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
@@ -557,10 +563,25 @@ unsafe fn shade_in<L: Floats, R: Record>(
         if sample_area && tr.effects.emission && !tr.emitters.is_empty() {
             let (u, u1, u2) = light_numbers(&mut rng, L::LANES);
             let place = choice_places(tr.emitters.cdf(), &u, L::LANES);
+            // An untextured triangle light's point is sampled in lanes, every other light's
+            // lane by lane.
+            let mut on = TrianglePoints::default();
             for i in Bits(shaded) {
                 // (The point lights take no part in this choice.)
                 let c = tr.emitters.chosen(place[i] as usize);
-                area.sample(tr, at, (i, slots[i].st.ray.d), c, (u1[i], u2[i]), &mut rng);
+                match lane_triangle(&c) {
+                    Some((t, light, pmf)) => on.put(i, t, light, pmf),
+                    None => {
+                        area.sample(tr, at, (i, slots[i].st.ray.d), c, (u1[i], u2[i]), &mut rng)
+                    }
+                }
+            }
+            if on.lanes != 0 {
+                let samples = unsafe { on.sample::<L>(p_, &u1, &u2) };
+                for i in Bits(on.lanes) {
+                    let ls = samples.get(i);
+                    area.record(tr, at, i, slots[i].st.ray.d, ls, on.pmf[i]);
+                }
             }
         }
         let area = unsafe { area.terms(tr, &surface, mis, true) };
@@ -880,6 +901,156 @@ unsafe fn power_heuristic<L: Floats>(pdf: L, other: L) -> L {
     let (a, b) = ((pdf / m) * (pdf / m), (other / m) * (other / m));
     let w = L::select(m.cmple(zero) | !m.abs().cmpne(inf), zero, a / (a + b));
     L::select(!pdf.abs().cmpne(inf), one, w)
+}
+
+/// The triangle and light of `chosen`, and its chance, if it is an untextured triangle light
+/// (sampled in lanes, [`TrianglePoints`]).
+#[inline(always)]
+fn lane_triangle<'a>(chosen: &Chosen<'a>) -> Option<(&'a Triangle, &'a AreaLight, f32)> {
+    match chosen {
+        Chosen::Area(light, pmf) => match &light.shape {
+            Emitting::Triangle(t) if light.texture.is_none() => Some((t, *light, *pmf)),
+            _ => None,
+        },
+        Chosen::Environment(..) | Chosen::Point(..) => None,
+    }
+}
+
+/// The lanes' triangle lights, a column per coordinate, to sample a point on each in lanes
+/// (`AreaLight::sample` of an untextured triangle).
+#[derive(Default)]
+struct TrianglePoints {
+    /// Lanes (bits) that chose one.
+    lanes: u32,
+    /// `v[3 j + axis]`: coordinate `axis` of vertex `j`.
+    v: [[f32; MAX_LANES]; 9],
+    /// Unit normal.
+    n: [[f32; MAX_LANES]; 3],
+    /// Radiance.
+    radiance: [[f32; MAX_LANES]; 3],
+    /// Area.
+    area: [f32; MAX_LANES],
+    /// Lanes (bits) whose light emits from both sides.
+    two_sided: u32,
+    /// The chance of each lane's light.
+    pmf: [f32; MAX_LANES],
+}
+
+/// [`TrianglePoints::sample`]'s samples, a column per coordinate.
+struct TriangleSamples {
+    wi: [[f32; MAX_LANES]; 3],
+    dist: [f32; MAX_LANES],
+    le: [[f32; MAX_LANES]; 3],
+    pdf: [f32; MAX_LANES],
+    /// Lanes (bits) with a sample (a point apart from the vertex, of some density).
+    valid: u32,
+}
+
+impl TriangleSamples {
+    /// Lane `i`'s sample, as `AreaLight::sample` returns it.
+    #[inline(always)]
+    fn get(&self, i: usize) -> Option<LightSample> {
+        let at = |v: &[[f32; MAX_LANES]; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
+        (self.valid & (1 << i) != 0).then(|| LightSample {
+            wi: at(&self.wi),
+            dist: self.dist[i],
+            le: at(&self.le),
+            pdf: self.pdf[i],
+            uv: glam::Vec2::ZERO,
+        })
+    }
+}
+
+impl TrianglePoints {
+    /// Lane `i` samples triangle `t` of `light`, chosen with chance `pmf`.
+    #[inline(always)]
+    fn put(&mut self, i: usize, t: &Triangle, light: &AreaLight, pmf: f32) {
+        self.lanes |= 1 << i;
+        for j in 0..3 {
+            for axis in 0..3 {
+                self.v[3 * j + axis][i] = t.v[j][axis];
+            }
+        }
+        for axis in 0..3 {
+            self.n[axis][i] = t.n[axis];
+            self.radiance[axis][i] = light.emitter.radiance[axis];
+        }
+        self.area[i] = light.area();
+        self.two_sided |= u32::from(light.emitter.two_sided) << i;
+        self.pmf[i] = pmf;
+    }
+
+    /// Each lane's sample from the point `p` with the numbers `u1`, `u2`, as
+    /// `AreaLight::sample` computes it for a triangle: a uniform point (`uniform_triangle`),
+    /// the unit direction and distance to it, the density per solid angle
+    /// (`area_to_solid_angle`: `d^2 / (A |cos|)`, where positive and finite), and the radiance
+    /// towards `p` (zero from a one-sided light's back).
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn sample<L: Floats>(
+        &self,
+        p: [L; 3],
+        u1: &[f32; MAX_LANES],
+        u2: &[f32; MAX_LANES],
+    ) -> TriangleSamples {
+        // SAFETY: the caller's; so for every `unsafe` block below, each makes values of `L`.
+        let (zero, one, two) = unsafe { (L::splat(0.0), L::splat(1.0), L::splat(2.0)) };
+        let load = |row: &[f32; MAX_LANES]| unsafe { L::from_slice(row) };
+        let (u1, u2) = (load(u1), load(u2));
+        // `uniform_triangle` (Heitz 2019): the barycentrics.
+        let (h1, h2) = (u1 / two, u2 / two);
+        let lower = u1.cmplt(u2);
+        let b0 = L::select(lower, h1, u1 - h2);
+        let b1 = L::select(lower, u2 - h1, h2);
+        let b2 = (one - b0 - b1).max(zero);
+        // The point, `b0 v0 + b1 v1 + b2 v2`, and the direction towards it.
+        let v: [L; 9] = unsafe {
+            [
+                L::from_slice(&self.v[0]),
+                L::from_slice(&self.v[1]),
+                L::from_slice(&self.v[2]),
+                L::from_slice(&self.v[3]),
+                L::from_slice(&self.v[4]),
+                L::from_slice(&self.v[5]),
+                L::from_slice(&self.v[6]),
+                L::from_slice(&self.v[7]),
+                L::from_slice(&self.v[8]),
+            ]
+        };
+        let q = [
+            b0 * v[0] + b1 * v[3] + b2 * v[6],
+            b0 * v[1] + b1 * v[4] + b2 * v[7],
+            b0 * v[2] + b1 * v[5] + b2 * v[8],
+        ];
+        let to = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+        let d2 = dot(to, to);
+        let dist = d2.sqrt();
+        let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
+        // `area_to_solid_angle`.
+        let nq = [load(&self.n[0]), load(&self.n[1]), load(&self.n[2])];
+        let cos_q = dot(nq, wi).abs();
+        let pdf = d2 / (load(&self.area) * cos_q);
+        let inf = unsafe { L::splat(f32::INFINITY) };
+        let finite = d2.abs().cmplt(inf) & pdf.abs().cmplt(inf);
+        let valid = d2.cmpne(zero) & cos_q.cmpgt(zero) & finite & pdf.cmpgt(zero);
+        // `emitted`: towards `-wi`, from the front or from both sides.
+        let front = dot(nq, [-wi[0], -wi[1], -wi[2]]).cmpgt(zero);
+        let lit = unsafe { lane_mask::<L>(self.two_sided) } | front;
+        let le = [
+            L::select(lit, load(&self.radiance[0]), zero),
+            L::select(lit, load(&self.radiance[1]), zero),
+            L::select(lit, load(&self.radiance[2]), zero),
+        ];
+        TriangleSamples {
+            wi: [array(wi[0]), array(wi[1]), array(wi[2])],
+            dist: array(dist),
+            le: [array(le[0]), array(le[1]), array(le[2])],
+            pdf: array(pdf),
+            valid: L::bitmask(valid) & self.lanes,
+        }
+    }
 }
 
 /// The numbers `one_light` and `area_lights` draw for a light sample, in lanes: `u` (53 bits)
