@@ -258,8 +258,15 @@ fn waves_give_the_one_ray_pixels_with_area_lights() {
     assert!(mixed.contains("normals:"), "room() changed");
     let s = rtis::extract(&scene(&mixed));
     assert!(!s.geometry.bvh.is_empty());
-    // (A smooth triangle, and a textured rectangle light, among them.)
+    // (A smooth triangle, and a textured rectangle light, among them; with every light at
+    // each vertex too, where untextured triangle lights are sampled in lanes.)
     agrees(&s, "sphere light, meshes, textured light");
+    let all = mixed.replace("lights_per_vertex: One", "lights_per_vertex: All");
+    assert!(all.contains("lights_per_vertex: All"));
+    agrees(
+        &rtis::extract(&scene(&all)),
+        "sphere light, meshes, textured light, all",
+    );
     let shader = "Path(rr_depth: 1, sampling: Brdf, lights: Mis, lights_per_vertex: All)";
     // Mitsuba's light two-sided: the ceiling, 0.01 above it, sees its back.
     let two_sided = triangle_box(shader, "", false).replace("two_sided: false", "two_sided: true");

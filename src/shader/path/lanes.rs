@@ -797,7 +797,8 @@ impl AreaRays {
     ) -> [L; 3] {
         // SAFETY: the caller's; so for every `unsafe` block below, each makes values of `L`.
         let (zero, one) = unsafe { (L::splat(0.0), L::splat(1.0)) };
-        // (Without a column, no lane has a sample: each term is zero, summed or not.)
+        // (Without a column, no lane has a shadow ray to test, `tested` is empty: each term
+        // is zero, summed or not.)
         let Some(c) = self.columns.as_ref().filter(|_| self.lanes != 0) else {
             return [zero; 3];
         };
