@@ -377,36 +377,36 @@ impl Geometry {
         tally: &impl Tally,
     ) -> L::Mask {
         if !self.all_packed() {
-            // A small scene's triangles met in the lanes, or ray by ray through the BVH.
-            let (mut v, mut lane) = ([[0.0f32; MAX_LANES]; 8], [0.0f32; MAX_LANES]);
-            for (k, x) in [o[0], o[1], o[2], d[0], d[1], d[2], o_err, t_max]
-                .into_iter()
-                .enumerate()
-            {
-                x.write_to(&mut v[k]);
-            }
-            let ray = |i: usize| Ray {
-                o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
-                d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
-                t_max: v[7][i],
-                o_err: v[6][i],
+            // A small scene's triangles met in the lanes, which leave to the one-ray query only
+            // the lanes they cannot settle; in other scenes, every live lane through the BVH.
+            let (mut blocked, mut alone) = match self.is_small() {
+                true => self.blocked_small(&ShearLanes::new(o, d, o_err), t_max, live, tally),
+                false => (0, L::bitmask(live)),
             };
-            if self.is_small() {
-                let r = ShearLanes::new(o, d, o_err);
-                let blocked = self.blocked_small(&r, t_max, live, tally, ray);
-                // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
-                return unsafe { lane_mask::<L>(blocked) };
-            }
-            let live = L::bitmask(live);
-            for (i, blocked) in lane.iter_mut().enumerate().take(L::LANES) {
-                if live & (1 << i) == 0 {
-                    continue;
+            if alone != 0 {
+                let mut v = [[0.0f32; MAX_LANES]; 8];
+                for (k, x) in [o[0], o[1], o[2], d[0], d[1], d[2], o_err, t_max]
+                    .into_iter()
+                    .enumerate()
+                {
+                    x.write_to(&mut v[k]);
                 }
-                let hit = self.occluded_tallied(&ray(i), planes, tally);
-                *blocked = if hit { 1.0 } else { 0.0 };
+                while alone != 0 {
+                    let i = alone.trailing_zeros() as usize;
+                    alone &= alone - 1;
+                    let ray = Ray {
+                        o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
+                        d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
+                        t_max: v[7][i],
+                        o_err: v[6][i],
+                    };
+                    if self.occluded_tallied(&ray, planes, tally) {
+                        blocked |= 1 << i;
+                    }
+                }
             }
             // SAFETY: `t_max` is a value of `L`, so the CPU runs `L`'s instruction set.
-            return unsafe { L::from_array(lane).cmpne(L::splat(0.0)) };
+            return unsafe { lane_mask::<L>(blocked) };
         }
         let lanes = RayLanes::from_parts(o, d, o_err);
         // No lane blocked yet (nothing is below itself, NaN included).

@@ -318,9 +318,9 @@ impl Geometry {
     }
 
     /// Which rays in `r`, of the lanes of `live`, are blocked within `t_max` by the
-    /// triangles of a small scene ([`Geometry::is_small`]), as [`Geometry::occluded`] answers:
-    /// the lanes met in the lanes, and the lanes they could not settle asked of the one-ray
-    /// query (`ray(i)` gives lane `i`'s ray). Bit `i` for lane `i`.
+    /// triangles of a small scene ([`Geometry::is_small`]), as [`Geometry::occluded`] answers,
+    /// as far as the lanes can tell: the lanes met, and the live lanes an edge left unsure,
+    /// which the one-ray query answers ([`Geometry::occluded_lanes`]). Bit `i` for lane `i`.
     #[inline(always)]
     pub fn blocked_small<L: Floats>(
         &self,
@@ -328,8 +328,7 @@ impl Geometry {
         t_max: L,
         live: L::Mask,
         tally: &impl Tally,
-        ray: impl Fn(usize) -> Ray,
-    ) -> u32 {
+    ) -> (u32, u32) {
         // No lane blocked or on an edge yet (no lane is both below and above itself).
         let mut hit = t_max.cmplt(t_max) & t_max.cmpgt(t_max);
         let mut edge = hit;
@@ -344,15 +343,6 @@ impl Geometry {
                 break;
             }
         }
-        // The lanes met in the lanes, and those an edge left unsure asked alone.
-        let (mut blocked, mut unsure) = (L::bitmask(hit & live), L::bitmask(edge & !hit & live));
-        while unsure != 0 {
-            let i = unsure.trailing_zeros() as usize;
-            unsure &= unsure - 1;
-            if self.occluded_tallied(&ray(i), true, tally) {
-                blocked |= 1 << i;
-            }
-        }
-        blocked
+        (L::bitmask(hit & live), L::bitmask(edge & !hit & live))
     }
 }

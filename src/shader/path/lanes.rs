@@ -569,7 +569,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
             for i in Bits(shaded) {
                 // (The point lights take no part in this choice.)
                 let c = tr.emitters.chosen(place[i] as usize);
-                match lane_triangle(&c) {
+                match untextured_triangle(&c) {
                     Some((t, light, pmf)) => on.put(i, t, light, pmf),
                     None => {
                         area.sample(tr, at, (i, slots[i].st.ray.d), c, (u1[i], u2[i]), &mut rng)
@@ -907,7 +907,7 @@ unsafe fn power_heuristic<L: Floats>(pdf: L, other: L) -> L {
 /// The triangle and light of `chosen`, and its chance, if it is an untextured triangle light
 /// (sampled in lanes, [`TrianglePoints`]).
 #[inline(always)]
-fn lane_triangle<'a>(chosen: &Chosen<'a>) -> Option<(&'a Triangle, &'a AreaLight, f32)> {
+fn untextured_triangle<'a>(chosen: &Chosen<'a>) -> Option<(&'a Triangle, &'a AreaLight, f32)> {
     match chosen {
         Chosen::Area(light, pmf) => match &light.shape {
             Emitting::Triangle(t) if light.texture.is_none() => Some((t, *light, *pmf)),
