@@ -19,9 +19,12 @@ call has compiled its kernels, rtis's render from its first pixel to its last as
 reports it; neither counts loading the scene, building its BVH or writing the image), samples
 per second, RMSE against the reference and the
 renderer's own RMSE (the reference's noise taken out), and the time each needs to reach the
-smallest own error (RMSE falls as 1/sqrt(spp)). rtis renders with the same estimator as
-Mitsuba's `path` (one light sample per vertex, MIS with the BSDF sample) and with its other
-strategies: every point light at every vertex, one by importance, light or BSDF sampling alone.
+smallest own error (RMSE falls as 1/sqrt(spp); exactly so for independent samplers, while a
+low-discrepancy sampler's falls faster, so its row's time is exact only where its error is the
+smallest). rtis renders with the same estimator as Mitsuba's `path` (one light sample per
+vertex, MIS with the BSDF sample) and with its other strategies: every point light at every
+vertex, one by importance, light or BSDF sampling alone, and its Sobol' sampler (on the area box
+beside Mitsuba's own `ldsampler`).
 
 Setup (once):
     .venv/bin/pip install mitsuba numpy
@@ -134,15 +137,18 @@ FULL = (PHYSICAL
                  '(name: "glass ball",  shape: Sphere(center: (1, 0, 2), radius: 1),           material: Transmissive(ior: 1.1))'))
 assert FULL.count("Mirror(") == 1 and FULL.count("Transmissive(") == 1, "cornell-physical.ron changed"
 AREA = open(os.path.join(ROOT, "scenes/mitsuba-cornell.ron")).read()
+# (label, what the shader adds, the film's sampler): rtis's independent sampler unless named.
 POINT_STRATEGIES = [
-    ("rtis Path, one light (same strategy)", "lights_per_vertex: One"),
-    ("rtis Path, all lights", "lights_per_vertex: All"),
-    ("rtis Path, one by importance", "lights_per_vertex: Importance"),
+    ("rtis Path, one light (same strategy)", "lights_per_vertex: One", None),
+    ("rtis Path, all lights", "lights_per_vertex: All", None),
+    ("rtis Path, one by importance", "lights_per_vertex: Importance", None),
+    ("rtis Path, all lights, Sobol' sampler", "lights_per_vertex: All", "Sobol"),
 ]
 AREA_STRATEGIES = [
-    ("rtis Path, MIS (same strategy)", "lights: Mis"),
-    ("rtis Path, light sampling", "lights: Light"),
-    ("rtis Path, BSDF sampling", "lights: Brdf"),
+    ("rtis Path, MIS (same strategy)", "lights: Mis", None),
+    ("rtis Path, light sampling", "lights: Light", None),
+    ("rtis Path, BSDF sampling", "lights: Brdf", None),
+    ("rtis Path, MIS, Sobol' sampler", "lights: Mis", "Sobol"),
 ]
 
 
@@ -151,10 +157,14 @@ def rtis_runs(text, strategies, spp, d):
     image), the scene file written once into the folder `d`."""
     rtis = os.path.join(ROOT, "target/release/rtis")
     runs = []
-    for k, (label, strategy) in enumerate(strategies):
+    for k, (label, strategy, sampler) in enumerate(strategies):
         scene_file = os.path.join(d, f"scene{k}.ron")
+        scene = text.replace("sampling: Brdf)", f"sampling: Brdf, {strategy})")
+        if sampler:
+            assert scene.count("spp: 64),") == 1, "the scene's film changed"
+            scene = scene.replace("spp: 64),", f"spp: 64, sampler: {sampler}),")
         with open(scene_file, "w") as f:
-            f.write(text.replace("sampling: Brdf)", f"sampling: Brdf, {strategy})"))
+            f.write(scene)
 
         def run(scene_file=scene_file):
             out, stats = os.path.join(d, "rtis.exr"), os.path.join(d, "stats.json")
@@ -169,7 +179,7 @@ def rtis_runs(text, strategies, spp, d):
     return runs
 
 
-def mitsuba_run(mi, scene, spp, variant):
+def mitsuba_run(mi, scene, spp, variant, label=None):
     """Mitsuba's run: a function that renders once and returns (seconds, image); its kernels
     are compiled first, outside the timing, by a render at the same spp (a kernel depends on
     it: `render` coalesces its passes from 4 spp on and folds the spp into the kernel) whose
@@ -182,7 +192,7 @@ def mitsuba_run(mi, scene, spp, variant):
         img = np.array(mi.render(scene, spp=spp))
         return time.perf_counter() - t, img
 
-    return ("Mitsuba 3 " + variant, run)
+    return (label or "Mitsuba 3 " + variant, run)
 
 
 def compare(name, mi, args):
@@ -215,6 +225,11 @@ def measure(name, mi, args, tmp):
             noise = json.load(f)["noise_rmse"]
         size = (128, 128)
         runs = [mitsuba_run(mi, mi.load_dict(area_scene(mi, args.spp)), args.spp, args.variant)]
+        # Mitsuba with its own low-discrepancy sampler too, beside rtis's Sobol' sampler.
+        ld = area_scene(mi, args.spp)
+        ld["sensor"]["sampler"] = {"type": "ldsampler", "sample_count": args.spp}
+        runs.append(mitsuba_run(mi, mi.load_dict(ld), args.spp, args.variant,
+                                f"Mitsuba 3 {args.variant}, ldsampler"))
         runs += rtis_runs(AREA, AREA_STRATEGIES, args.spp, tmp)
     seconds = [[] for _ in runs]
     errors = [None for _ in runs]
@@ -227,7 +242,8 @@ def measure(name, mi, args, tmp):
             seconds[k].append(t)
             if errors[k] is None:
                 # rtis's camera is left-handed: its image is Mitsuba's mirrored left-right.
-                errors[k] = rmse(img if k == 0 else img[:, ::-1, :], ref)
+                mitsuba = runs[k][0].startswith("Mitsuba")
+                errors[k] = rmse(img if mitsuba else img[:, ::-1, :], ref)
     return size, noise, [(label, s, e) for (label, _), s, e in zip(runs, seconds, errors)]
 
 

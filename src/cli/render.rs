@@ -197,7 +197,7 @@ pub fn load_overridden(
         height,
         spp: over.spp.unwrap_or(film.spp),
         transfer: transfer.unwrap_or(film.transfer),
-        filter: film.filter,
+        ..*film
     };
     *film = overridden
         .checked()

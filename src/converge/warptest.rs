@@ -598,7 +598,33 @@ pub fn disk_case(name: &str, warp: fn(f32, f32) -> (f32, f32)) -> Case {
     }
 }
 
-/// Every sampler rtis uses: the thin lens's points, uniform and cosine hemisphere, the Phong lobe at three exponents,
+/// Cells a side of [`sobol_case`]'s grid on the unit square.
+const SQUARE_CELLS: usize = 16;
+
+/// The Sobol' sampler's 2D points (`sampling::Sobol`) against the uniform density on the unit
+/// square: each draw a point of a random seed, pixel, sample (up to `MAX_SPP`) and dimension
+/// (up to 63), so that the draws are independent and each is one point of some sample, which
+/// Owen scrambling makes uniform. (A pixel's points together are stratified, far more even
+/// than chance: `sampling::sobol`'s own tests check that.)
+pub fn sobol_case() -> Case {
+    let bins = SQUARE_CELLS * SQUARE_CELLS;
+    Case {
+        name: "Sobol' sampler (a point of any sample and dimension)".to_string(),
+        draw: Box::new(move |s: &mut Sampler| {
+            let seed = s.next_u32() as u64;
+            let (pixel, sample) = (s.next_u32() as u64, s.next_below(crate::render::MAX_SPP));
+            let mut p = crate::sampling::Sobol::new(seed, pixel, sample as u64);
+            p.skip(s.next_below(64));
+            let (x, y) = p.next_2d();
+            let cell = |u: f32| ((u * SQUARE_CELLS as f32) as usize).min(SQUARE_CELLS - 1);
+            Some(cell(y) * SQUARE_CELLS + cell(x))
+        }),
+        expected: vec![1.0 / bins as f64; bins],
+        columns: SQUARE_CELLS,
+    }
+}
+
+/// Every sampler rtis uses: the Sobol' sampler's points, the thin lens's points, uniform and cosine hemisphere, the Phong lobe at three exponents,
 /// the BRDF mixture of Path at two materials and views, the Fresnel choice of glass, the
 /// area-light samplers, the microfacet reflection samplers ([`microfacet_cases`]) and the
 /// BSDFs' ([`bsdf_cases`]).
@@ -609,6 +635,7 @@ pub fn cases() -> Vec<Case> {
         shininess: 1.0,
     };
     vec![
+        sobol_case(),
         disk_case("thin lens (concentric disk)", warp::concentric_disk),
         direction_case("uniform hemisphere", white, Vec3A::Z, Sampling::Uniform),
         direction_case("cosine hemisphere", white, Vec3A::Z, Sampling::Cosine),

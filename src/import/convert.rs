@@ -807,7 +807,7 @@ fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
     }
     // The film and the sampler.
     let (mut width, mut height, mut filter) = (768i64, 576i64, "Gaussian(stddev: 0.5)".to_string());
-    let mut spp = 4i64;
+    let (mut spp, mut sampler) = (4i64, "");
     for (k, child) in o.children.iter().enumerate() {
         if o.children[..k].iter().any(|c| c.tag == child.tag) {
             return Err(child
@@ -845,6 +845,23 @@ fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
                 let mut s = Props::new(child, paths);
                 spp = s.integer("sample_count", 4)?;
                 s.integer("seed", 0)?;
+                // Mitsuba's stratified and low-discrepancy samplers become rtis's Sobol' one
+                // (their `jitter` and `strength` read and left: its points are scrambled).
+                sampler = match child.kind.as_str() {
+                    "independent" => "",
+                    "stratified" | "multijitter" | "orthogonal" | "ldsampler" => {
+                        s.boolean("jitter", true)?;
+                        s.integer("strength", 2)?;
+                        ", sampler: Sobol"
+                    }
+                    _ => {
+                        return Err(unsupported(
+                            child,
+                            "samplers: independent, and stratified, multijitter, orthogonal and \
+                             ldsampler (as rtis's Sobol')",
+                        ));
+                    }
+                };
                 s.done()?;
             }
             _ => {
@@ -930,7 +947,7 @@ fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
         _ => String::new(),
     };
     p.done()?;
-    let film = format!("(width: {width}, height: {height}, spp: {spp}, filter: {filter})");
+    let film = format!("(width: {width}, height: {height}, spp: {spp}, filter: {filter}{sampler})");
     let camera = format!(
         "Perspective(position: {}, look_at: {}, up: {}, fov: {}{lens_text}, handedness: {handedness})",
         vec3(position),

@@ -161,7 +161,7 @@ pub fn trace_sample<R: Record>(
 pub fn camera_ray(scene: &RenderScene, col: u32, row: u32, s: u32) -> (Ray, Sampler) {
     let film = &scene.film;
     let pixel = row as u64 * film.width as u64 + col as u64;
-    let mut sampler = Sampler::new(scene.seed, pixel, s as u64);
+    let mut sampler = Sampler::of(film.sampler, scene.seed, pixel, s as u64);
     let (dx, dy) = film
         .filter
         .place(pixel_sample(s, film.spp, scene.seed ^ pixel, &mut sampler));

@@ -6,7 +6,7 @@ use crate::camera::Camera;
 use crate::effects::Effects;
 use crate::light::{Emitters, Light};
 use crate::material::{Material, Model};
-use crate::sampling::{PixelFilter, Sampler};
+use crate::sampling::{PixelFilter, Sampler, SamplerKind};
 use crate::shader::{RayAudit, Shader, Tracer};
 use crate::stats::RayStats;
 use crate::texture::{Footprint, MaterialTextures};
@@ -33,6 +33,8 @@ pub struct Film {
     pub transfer: Transfer,
     /// Where in and around its pixel each sample goes ([`PixelFilter`]).
     pub filter: PixelFilter,
+    /// Where each sample's random numbers come from.
+    pub sampler: SamplerKind,
 }
 
 impl Default for Film {
@@ -44,6 +46,7 @@ impl Default for Film {
             spp: 1,
             transfer: Transfer::Srgb,
             filter: PixelFilter::Box,
+            sampler: SamplerKind::Independent,
         }
     }
 }

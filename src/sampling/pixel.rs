@@ -23,6 +23,11 @@ pub fn pixel_sample(i: u32, spp: u32, perm_seed: u64, rng: &mut Sampler) -> (f32
         return (0.5, 0.5);
     }
     let (jx, jy) = rng.next_2d();
+    if let Sampler::Sobol(_) = rng {
+        // A pixel's Sobol' points of one 2D draw are stratified already: a (0,m,2)-net for
+        // `2^m` samples, finer than any grid.
+        return (jx, jy);
+    }
     let m = (spp as f64).sqrt() as u32;
     if m * m == spp {
         let (cx, cy) = (i % m, i / m);

@@ -1,4 +1,4 @@
-//! The per-pixel random number generator.
+//! The independent sampler: a per-sample stream of PCG32 numbers.
 
 /// A deterministic stream of uniform numbers for one (scene seed, pixel, sample) triple.
 ///
@@ -6,9 +6,9 @@
 /// order tiles run, so renders are bit-identical for any thread count. The generator is
 /// O'Neill's PCG32 (XSH RR 64/32: "PCG: A Family of Simple Fast Space-Efficient Statistically
 /// Good Algorithms for Random Number Generation", 2014), the numbers of `rand_pcg::Pcg32`;
-/// [`Streams`] draws several of them side by side.
-#[derive(Clone)]
-pub struct Sampler {
+/// [`PcgLanes`] draws several of them side by side.
+#[derive(Clone, Debug)]
+pub struct Pcg32 {
     /// The LCG's state.
     state: u64,
     /// The LCG's increment (odd): which of PCG32's streams.
@@ -34,13 +34,13 @@ fn output(state: u64) -> u32 {
 
 /// `next_f32` of 32 random bits: the top 24 on a grid of `2^-24`.
 #[inline(always)]
-fn to_f32(x: u32) -> f32 {
+pub(super) fn to_f32(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// `next_f64` of two draws: 53 bits on a grid of `2^-53`.
 #[inline(always)]
-fn to_f64(a: u32, b: u32) -> f64 {
+pub(super) fn to_f64(a: u32, b: u32) -> f64 {
     let bits = ((a as u64) << 21) ^ (b as u64 >> 11);
     bits as f64 * (1.0 / (1u64 << 53) as f64)
 }
@@ -53,18 +53,18 @@ pub fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-impl Sampler {
+impl Pcg32 {
     /// The stream for sample `sample` of pixel `pixel` (row-major index) under `seed`.
     pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
         let state = mix(mix(mix(seed) ^ pixel) ^ sample.rotate_left(32));
-        Sampler::pcg32(state, 0x0a02_bdbf_7bb3_c0a7)
+        Pcg32::seeded(state, 0x0a02_bdbf_7bb3_c0a7)
     }
 
     /// PCG32 seeded as its reference `pcg32_srandom_r(initstate, initseq)` seeds it (and
     /// `rand_pcg::Pcg32::new`).
-    fn pcg32(initstate: u64, initseq: u64) -> Self {
+    fn seeded(initstate: u64, initseq: u64) -> Self {
         let inc = (initseq << 1) | 1;
-        Sampler {
+        Pcg32 {
             state: step(initstate.wrapping_add(inc), inc),
             inc,
         }
@@ -105,29 +105,29 @@ impl Sampler {
     }
 }
 
-/// Up to [`Streams::MAX`] samplers drawn side by side, lane `i` advancing as sampler `i`'s
-/// own [`Sampler`] methods would: the same numbers, in lanes. Each draw is a loop over fixed
+/// Up to [`PcgLanes::MAX`] samplers drawn side by side, lane `i` advancing as sampler `i`'s
+/// own [`Pcg32`] methods would: the same numbers, in lanes. Each draw is a loop over fixed
 /// arrays without branches, which the compiler turns into the SIMD instructions of the
 /// function it is inlined in (Path's lanes, `shader::path::lanes`).
 #[derive(Clone, Copy)]
-pub struct Streams {
-    state: [u64; Streams::MAX],
-    inc: [u64; Streams::MAX],
+pub struct PcgLanes {
+    state: [u64; PcgLanes::MAX],
+    inc: [u64; PcgLanes::MAX],
 }
 
-impl Streams {
+impl PcgLanes {
     /// The most lanes.
     pub const MAX: usize = 16;
 
-    /// The streams of `samplers` (at most [`Streams::MAX`]), lane `i` from `samplers[i]`;
+    /// The streams of `samplers` (at most [`PcgLanes::MAX`]), lane `i` from `samplers[i]`;
     /// lanes past them hold a stream of their own that nobody reads.
     #[inline(always)]
-    pub fn load<'a>(samplers: impl Iterator<Item = &'a Sampler>) -> Streams {
-        let mut s = Streams {
-            state: [0; Streams::MAX],
-            inc: [1; Streams::MAX],
+    pub fn load<'a>(samplers: impl Iterator<Item = &'a Pcg32>) -> PcgLanes {
+        let mut s = PcgLanes {
+            state: [0; PcgLanes::MAX],
+            inc: [1; PcgLanes::MAX],
         };
-        for (i, sampler) in samplers.take(Streams::MAX).enumerate() {
+        for (i, sampler) in samplers.take(PcgLanes::MAX).enumerate() {
             (s.state[i], s.inc[i]) = (sampler.state, sampler.inc);
         }
         s
@@ -135,17 +135,17 @@ impl Streams {
 
     /// Lane `i`'s sampler, where it has got to.
     #[inline(always)]
-    pub fn sampler(&self, i: usize) -> Sampler {
-        Sampler {
+    pub fn sampler(&self, i: usize) -> Pcg32 {
+        Pcg32 {
             state: self.state[i],
             inc: self.inc[i],
         }
     }
 
-    /// [`Sampler::next_u32`] in the first `lanes` lanes.
+    /// [`Pcg32::next_u32`] in the first `lanes` lanes.
     #[inline(always)]
-    pub fn next_u32(&mut self, lanes: usize) -> [u32; Streams::MAX] {
-        let mut out = [0; Streams::MAX];
+    pub fn next_u32(&mut self, lanes: usize) -> [u32; PcgLanes::MAX] {
+        let mut out = [0; PcgLanes::MAX];
         let lanes_of = out.iter_mut().zip(&mut self.state).zip(&self.inc);
         for ((out, state), &inc) in lanes_of.take(lanes) {
             let old = *state;
@@ -155,13 +155,20 @@ impl Streams {
         out
     }
 
-    /// [`Sampler::next_f32`] in the first `lanes` lanes.
+    /// [`Pcg32::next_f32`] in the first `lanes` lanes.
     #[inline(always)]
-    pub fn next_f32(&mut self, lanes: usize) -> [f32; Streams::MAX] {
+    pub fn next_f32(&mut self, lanes: usize) -> [f32; PcgLanes::MAX] {
         self.next_u32(lanes).map(to_f32)
     }
 
-    /// [`Sampler::next_f64`] in lane `i` alone (a draw the other lanes do not make).
+    /// [`Pcg32::next_2d`] in the first `lanes` lanes: the two coordinates' arrays.
+    #[inline(always)]
+    pub fn next_2d(&mut self, lanes: usize) -> ([f32; PcgLanes::MAX], [f32; PcgLanes::MAX]) {
+        let x = self.next_f32(lanes);
+        (x, self.next_f32(lanes))
+    }
+
+    /// [`Pcg32::next_f64`] in lane `i` alone (a draw the other lanes do not make).
     #[inline(always)]
     pub fn next_f64_at(&mut self, i: usize) -> f64 {
         let mut s = self.sampler(i);
@@ -170,9 +177,9 @@ impl Streams {
         x
     }
 
-    /// [`Sampler::next_f64`] in the first `lanes` lanes.
+    /// [`Pcg32::next_f64`] in the first `lanes` lanes.
     #[inline(always)]
-    pub fn next_f64(&mut self, lanes: usize) -> [f64; Streams::MAX] {
+    pub fn next_f64(&mut self, lanes: usize) -> [f64; PcgLanes::MAX] {
         let (a, b) = (self.next_u32(lanes), self.next_u32(lanes));
         std::array::from_fn(|i| to_f64(a[i], b[i]))
     }
@@ -185,7 +192,7 @@ mod tests {
     /// The first outputs of PCG32's reference demo (`pcg32-demo`, seeded with 42 and 54).
     #[test]
     fn pcg32_gives_the_reference_numbers() {
-        let mut s = Sampler::pcg32(42, 54);
+        let mut s = Pcg32::seeded(42, 54);
         let got: Vec<u32> = (0..6).map(|_| s.next_u32()).collect();
         assert_eq!(
             got,
@@ -195,12 +202,12 @@ mod tests {
         );
     }
 
-    /// `Streams` draws each lane's numbers: the samplers' own, lane by lane, in every width.
+    /// `PcgLanes` draws each lane's numbers: the samplers' own, lane by lane, in every width.
     #[test]
     fn streams_draw_each_samplers_numbers() {
         for lanes in [4, 8, 16] {
-            let samplers: Vec<Sampler> = (0..lanes).map(|k| Sampler::new(7, k, 3 * k)).collect();
-            let mut streams = Streams::load(samplers.iter());
+            let samplers: Vec<Pcg32> = (0..lanes).map(|k| Pcg32::new(7, k, 3 * k)).collect();
+            let mut streams = PcgLanes::load(samplers.iter());
             let mut own = samplers.clone();
             for _ in 0..5 {
                 let (u, x, y) = (

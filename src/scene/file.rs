@@ -37,7 +37,7 @@ use std::sync::Arc;
 pub use crate::material::Model;
 pub use crate::material::microfacet::{Distribution, NormalSampling};
 pub use crate::render::output::Transfer;
-pub use crate::sampling::{LightSampling, LightsPerVertex, PixelFilter, Sampling};
+pub use crate::sampling::{LightSampling, LightsPerVertex, PixelFilter, SamplerKind, Sampling};
 
 /// Largest hemisphere sample count of the Global shader.
 pub const MAX_GLOBAL_SAMPLES: u32 = 1 << 16;
@@ -109,6 +109,20 @@ pub struct FilmFields {
     transfer: Transfer,
     #[serde(default)]
     filter: FilterDesc,
+    #[serde(default)]
+    sampler: SamplerDesc,
+}
+
+/// A sampler as written: where each sample's random numbers come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub enum SamplerDesc {
+    /// Independent uniform numbers (the default), as Mitsuba 3's `independent`.
+    #[default]
+    Independent,
+    /// Padded, Owen-scrambled Sobol' points, as pbrt-v4's `PaddedSobolSampler`: every draw
+    /// stratified over a pixel's samples (best with a power-of-two `spp`).
+    Sobol,
 }
 
 /// A pixel filter as written.
@@ -148,6 +162,10 @@ impl TryFrom<FilmFields> for FilmDesc {
             height: f.height.0,
             spp: f.spp.0,
             transfer: f.transfer,
+            sampler: match f.sampler {
+                SamplerDesc::Independent => SamplerKind::Independent,
+                SamplerDesc::Sobol => SamplerKind::Sobol,
+            },
             filter: match f.filter {
                 FilterDesc::Box => PixelFilter::Box,
                 FilterDesc::Gaussian { stddev } if stddev.0 <= 8.0 => PixelFilter::Gaussian {
@@ -173,6 +191,10 @@ impl From<FilmDesc> for FilmFields {
             height: Count(f.height),
             spp: Count(f.spp),
             transfer: f.transfer,
+            sampler: match f.sampler {
+                SamplerKind::Independent => SamplerDesc::Independent,
+                SamplerKind::Sobol => SamplerDesc::Sobol,
+            },
             filter: match f.filter {
                 PixelFilter::Box => FilterDesc::Box,
                 PixelFilter::Gaussian { stddev } => FilterDesc::Gaussian {

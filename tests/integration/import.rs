@@ -63,6 +63,28 @@ fn sensor_film_and_sampler() {
         )),
         "{text}"
     );
+    // Mitsuba's stratified and low-discrepancy samplers are rtis's Sobol' sampler; another
+    // sampler is refused where it is written.
+    for kind in ["stratified", "multijitter", "orthogonal", "ldsampler"] {
+        let xml = scene(&format!(
+            r#"<sensor type="perspective">
+                 <sampler type="{kind}"><integer name="sample_count" value="64"/><boolean name="jitter" value="false"/></sampler>
+               </sensor>"#
+        ));
+        let text = import(kind, &xml).unwrap();
+        assert!(
+            text.contains("spp: 64, filter: Gaussian(stddev: 0.5), sampler: Sobol)"),
+            "{kind}: {text}"
+        );
+        let s = rtis::extract(&crate::common::scene(&text));
+        assert_eq!(s.film.sampler, rtis::sampling::SamplerKind::Sobol, "{kind}");
+    }
+    let e = import(
+        "other",
+        &scene(r#"<sensor type="perspective"><sampler type="halton"/></sensor>"#),
+    )
+    .unwrap_err();
+    assert!(e.contains("halton") && e.contains("ldsampler"), "{e}");
     // Mitsuba's default filter is a Gaussian, and a film 768x576.
     let text = import("defaults", &scene(r#"<sensor type="perspective"/>"#)).unwrap();
     assert!(

@@ -463,3 +463,45 @@ fn waves_apply_only_where_the_lanes_shade() {
     let text = triangle_box(path, "", false);
     assert!(waves::applies(&rtis::extract(&scene(&text))));
 }
+
+/// The Sobol' sampler in the waves: its draws in lanes (`Streams::Sobol`) are each path's own,
+/// 1D and 2D draws alike (a light sample's point and the next direction are 2D points, not
+/// two 1D ones), so the waves give the one-ray pixels with it too: point lights, an emitting
+/// sphere and Mitsuba's box under each light strategy, and an image sky.
+#[test]
+fn waves_give_the_one_ray_pixels_with_the_sobol_sampler() {
+    let _limit = common::deadline(240);
+    let sobol = |text: String| {
+        let with = text.replacen("spp: 150)", "spp: 150, sampler: Sobol)", 1);
+        assert!(with.contains("sampler: Sobol"), "the film changed");
+        let s = rtis::extract(&scene(&with));
+        assert_eq!(s.film.sampler, rtis::sampling::SamplerKind::Sobol);
+        s
+    };
+    for per_vertex in ["One", "All", "Importance"] {
+        let shader = format!("Path(rr_depth: 1, sampling: Brdf, lights_per_vertex: {per_vertex})");
+        agrees(&sobol(room(&shader, "")), &format!("Sobol, {shader}"));
+    }
+    for lights in ["Mis", "Light", "Brdf"] {
+        for per_vertex in ["One", "All"] {
+            let shader = format!(
+                "Path(rr_depth: 1, sampling: Brdf, lights: {lights}, lights_per_vertex: {per_vertex})"
+            );
+            agrees(
+                &sobol(lit_room(&shader, "")),
+                &format!("Sobol, {shader}, sphere light"),
+            );
+            agrees(
+                &sobol(triangle_box(&shader, "", true)),
+                &format!("Sobol, {shader}, box, point light true"),
+            );
+        }
+    }
+    let sky = common::scenes_dir().join("assets/sky.exr");
+    let shader = "Path(max_depth: 3, rr_depth: 2, sampling: Cosine, lights: Mis)";
+    let text = open_room(shader, "").replace(
+        "entities: [",
+        &format!("entities: [\n            (light: Environment(image: {sky:?})),"),
+    );
+    agrees(&sobol(text), "Sobol, image sky");
+}

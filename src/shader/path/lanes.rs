@@ -610,7 +610,7 @@ unsafe fn shade_in<L: Floats, R: Record>(
     // The next direction: cosine-weighted about the shading normal (`hemisphere::cosine` in
     // the frame of `Frame::from_normal`); its numbers drawn in lanes.
     let brdf = p.sampling == Sampling::Brdf;
-    let (u1, u2) = (rng.next_f32(L::LANES), rng.next_f32(L::LANES));
+    let (u1, u2) = rng.next_2d(L::LANES);
     if brdf {
         // `sample_phong` compares a number with the diffuse share, 1 here: the cosine lobe.
         rng.next_u32(L::LANES);
@@ -1062,8 +1062,8 @@ fn light_numbers(
     lanes: usize,
 ) -> ([f64; MAX_LANES], [f32; MAX_LANES], [f32; MAX_LANES]) {
     let u = rng.next_f64(lanes);
-    let u1 = rng.next_f32(lanes);
-    (u, u1, rng.next_f32(lanes))
+    let (u1, u2) = rng.next_2d(lanes);
+    (u, u1, u2)
 }
 
 /// The most lights [`choice_places`] counts through; past them, a binary search per lane.

@@ -1,0 +1,165 @@
+//! The samplers: where a sample's random numbers come from, one variant per file
+//! (`rng.rs`, `sobol.rs`), and their lanes.
+
+use super::rng::{Pcg32, PcgLanes};
+use super::sobol::{Sobol, SobolLanes};
+
+/// Which sampler a render draws its numbers from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SamplerKind {
+    /// Independent uniform numbers (PCG32), as Mitsuba 3's `independent` (the default).
+    #[default]
+    Independent,
+    /// Padded, Owen-scrambled Sobol' points: each draw stratified over a pixel's samples, as
+    /// pbrt-v4's `PaddedSobolSampler`.
+    Sobol,
+}
+
+/// One camera sample's random numbers: a stream that depends only on (scene seed, pixel,
+/// sample), never on which thread renders the pixel or in which order tiles run, so renders
+/// are bit-identical for any thread count.
+#[derive(Clone, Debug)]
+pub enum Sampler {
+    /// [`SamplerKind::Independent`].
+    Independent(Pcg32),
+    /// [`SamplerKind::Sobol`].
+    Sobol(Sobol),
+}
+
+impl Sampler {
+    /// The independent stream of sample `sample` of pixel `pixel` (row-major index) under
+    /// `seed`.
+    pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
+        Sampler::Independent(Pcg32::new(seed, pixel, sample))
+    }
+
+    /// The stream of sample `sample` of pixel `pixel` under `seed` from the sampler `kind`.
+    pub fn of(kind: SamplerKind, seed: u64, pixel: u64, sample: u64) -> Self {
+        match kind {
+            SamplerKind::Independent => Sampler::new(seed, pixel, sample),
+            SamplerKind::Sobol => Sampler::Sobol(Sobol::new(seed, pixel, sample)),
+        }
+    }
+
+    /// 32 random bits.
+    #[inline]
+    pub fn next_u32(&mut self) -> u32 {
+        match self {
+            Sampler::Independent(s) => s.next_u32(),
+            Sampler::Sobol(s) => s.next_u32(),
+        }
+    }
+
+    /// A uniform number in `[0, 1)` with 24 random bits.
+    #[inline]
+    pub fn next_f32(&mut self) -> f32 {
+        match self {
+            Sampler::Independent(s) => s.next_f32(),
+            Sampler::Sobol(s) => s.next_f32(),
+        }
+    }
+
+    /// A uniform number in `[0, 1)` with 53 random bits, for choices among many options whose
+    /// probabilities are finer than `next_f32`'s grid of 2^-24.
+    #[inline]
+    pub fn next_f64(&mut self) -> f64 {
+        match self {
+            Sampler::Independent(s) => s.next_f64(),
+            Sampler::Sobol(s) => s.next_f64(),
+        }
+    }
+
+    /// Two uniform numbers in `[0, 1)`: a 2D point.
+    #[inline]
+    pub fn next_2d(&mut self) -> (f32, f32) {
+        match self {
+            Sampler::Independent(s) => s.next_2d(),
+            Sampler::Sobol(s) => s.next_2d(),
+        }
+    }
+
+    /// A uniform integer in `[0, n)` for `n > 0`.
+    #[inline]
+    pub fn next_below(&mut self, n: u32) -> u32 {
+        ((self.next_u32() as u64 * n as u64) >> 32) as u32
+    }
+}
+
+/// Up to [`Streams::MAX`] samplers of one kind drawn side by side, lane `i` drawing as
+/// sampler `i`'s own [`Sampler`] methods would: the same numbers, in lanes.
+#[derive(Clone, Copy)]
+pub enum Streams {
+    /// Independent streams.
+    Independent(PcgLanes),
+    /// Sobol' streams.
+    Sobol(SobolLanes),
+}
+
+impl Streams {
+    /// The most lanes.
+    pub const MAX: usize = 16;
+
+    /// The streams of `samplers` (at most [`Streams::MAX`]), lane `i` from `samplers[i]`, of
+    /// the first one's kind (a render's samplers are all of its film's kind); lanes past them
+    /// draw numbers that nobody reads.
+    #[inline(always)]
+    pub fn load<'a>(samplers: impl Iterator<Item = &'a Sampler> + Clone) -> Streams {
+        match samplers.clone().next() {
+            Some(Sampler::Sobol(_)) => {
+                Streams::Sobol(SobolLanes::load(samplers.map(|s| match s {
+                    Sampler::Sobol(s) => s,
+                    Sampler::Independent(_) => panic!("a wave of samples of two samplers"),
+                })))
+            }
+            _ => Streams::Independent(PcgLanes::load(samplers.map(|s| match s {
+                Sampler::Independent(s) => s,
+                Sampler::Sobol(_) => panic!("a wave of samples of two samplers"),
+            }))),
+        }
+    }
+
+    /// Lane `i`'s sampler, where it has got to.
+    #[inline(always)]
+    pub fn sampler(&self, i: usize) -> Sampler {
+        match self {
+            Streams::Independent(s) => Sampler::Independent(s.sampler(i)),
+            Streams::Sobol(s) => Sampler::Sobol(s.sampler(i)),
+        }
+    }
+
+    /// [`Sampler::next_u32`] in the first `lanes` lanes.
+    #[inline(always)]
+    pub fn next_u32(&mut self, lanes: usize) -> [u32; Streams::MAX] {
+        match self {
+            Streams::Independent(s) => s.next_u32(lanes),
+            Streams::Sobol(s) => s.next_u32(lanes),
+        }
+    }
+
+    /// [`Sampler::next_f64`] in the first `lanes` lanes.
+    #[inline(always)]
+    pub fn next_f64(&mut self, lanes: usize) -> [f64; Streams::MAX] {
+        match self {
+            Streams::Independent(s) => s.next_f64(lanes),
+            Streams::Sobol(s) => s.next_f64(lanes),
+        }
+    }
+
+    /// [`Sampler::next_f64`] in lane `i` alone (a draw the other lanes do not make).
+    #[inline(always)]
+    pub fn next_f64_at(&mut self, i: usize) -> f64 {
+        match self {
+            Streams::Independent(s) => s.next_f64_at(i),
+            Streams::Sobol(s) => s.next_f64_at(i),
+        }
+    }
+
+    /// [`Sampler::next_2d`] in the first `lanes` lanes: the two coordinates' arrays.
+    #[inline(always)]
+    pub fn next_2d(&mut self, lanes: usize) -> ([f32; Streams::MAX], [f32; Streams::MAX]) {
+        match self {
+            Streams::Independent(s) => s.next_2d(lanes),
+            Streams::Sobol(s) => s.next_2d(lanes),
+        }
+    }
+}
