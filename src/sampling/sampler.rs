@@ -42,7 +42,7 @@ impl Sampler {
     }
 
     /// 32 random bits.
-    #[inline]
+    #[inline(always)]
     pub fn next_u32(&mut self) -> u32 {
         match self {
             Sampler::Independent(s) => s.next_u32(),
@@ -51,7 +51,7 @@ impl Sampler {
     }
 
     /// A uniform number in `[0, 1)` with 24 random bits.
-    #[inline]
+    #[inline(always)]
     pub fn next_f32(&mut self) -> f32 {
         match self {
             Sampler::Independent(s) => s.next_f32(),
@@ -61,7 +61,7 @@ impl Sampler {
 
     /// A uniform number in `[0, 1)` with 53 random bits, for choices among many options whose
     /// probabilities are finer than `next_f32`'s grid of 2^-24.
-    #[inline]
+    #[inline(always)]
     pub fn next_f64(&mut self) -> f64 {
         match self {
             Sampler::Independent(s) => s.next_f64(),
@@ -70,7 +70,7 @@ impl Sampler {
     }
 
     /// Two uniform numbers in `[0, 1)`: a 2D point.
-    #[inline]
+    #[inline(always)]
     pub fn next_2d(&mut self) -> (f32, f32) {
         match self {
             Sampler::Independent(s) => s.next_2d(),
@@ -79,7 +79,7 @@ impl Sampler {
     }
 
     /// A uniform integer in `[0, n)` for `n > 0`.
-    #[inline]
+    #[inline(always)]
     pub fn next_below(&mut self, n: u32) -> u32 {
         ((self.next_u32() as u64 * n as u64) >> 32) as u32
     }

@@ -110,9 +110,11 @@ pub fn point_2d(key: u32, index: u32, dim: u32) -> (u32, u32) {
 /// dimension's seed (below the point's 32 digits, the scramble would draw them at random too).
 #[inline(always)]
 fn low_bits(bits: u32, key: u32, dim: u32) -> u32 {
-    hash(bits ^ seeds(key, dim).2)
+    hash(bits ^ seeds(key, dim).2) & ((1 << 21) - 1)
 }
 
+// The draws are not inlined, so that `Sampler`'s, which `match` on the sampler, stay small
+// enough to inline for the independent sampler.
 impl Sobol {
     /// The points of sample `sample` of pixel `pixel` (row-major index) under `seed`.
     pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
@@ -129,7 +131,7 @@ impl Sobol {
     }
 
     /// The next dimension's 1D point, 32 bits.
-    #[inline]
+    #[inline(never)]
     pub fn next_u32(&mut self) -> u32 {
         let x = point_1d(self.key, self.index, self.dim);
         self.dim += 1;
@@ -137,13 +139,13 @@ impl Sobol {
     }
 
     /// The next dimension's 1D point in `[0, 1)`, 24 bits.
-    #[inline]
+    #[inline(never)]
     pub fn next_f32(&mut self) -> f32 {
         to_f32(self.next_u32())
     }
 
     /// The next dimension's 1D point in `[0, 1)`, 53 bits.
-    #[inline]
+    #[inline(never)]
     pub fn next_f64(&mut self) -> f64 {
         let (key, dim) = (self.key, self.dim);
         let x = self.next_u32();
@@ -151,7 +153,7 @@ impl Sobol {
     }
 
     /// The next dimension's 2D point in `[0, 1)^2`.
-    #[inline]
+    #[inline(never)]
     pub fn next_2d(&mut self) -> (f32, f32) {
         let (x, y) = point_2d(self.key, self.index, self.dim);
         self.dim += 1;
@@ -202,7 +204,11 @@ impl SobolLanes {
     #[inline(always)]
     pub fn next_u32(&mut self, lanes: usize) -> [u32; Self::MAX] {
         let mut out = [0; Self::MAX];
-        let lanes_of = out.iter_mut().zip(&self.key).zip(&self.index).zip(&mut self.dim);
+        let lanes_of = out
+            .iter_mut()
+            .zip(&self.key)
+            .zip(&self.index)
+            .zip(&mut self.dim);
         for (((out, &key), &index), dim) in lanes_of.take(lanes) {
             *out = point_1d(key, index, *dim);
             *dim += 1;
@@ -210,14 +216,22 @@ impl SobolLanes {
         out
     }
 
-    /// [`Sobol::next_f64`] in the first `lanes` lanes.
+    /// [`Sobol::next_f64`] in the first `lanes` lanes. `to_f64(x, y << 11)` is
+    /// `(x 2^21 + y) 2^-53` for `y < 2^21`, a number of 53 bits, so it is `x 2^-32 + y 2^-53`
+    /// exactly: two conversions of 32-bit numbers, which AVX-512F has in lanes.
     #[inline(always)]
     pub fn next_f64(&mut self, lanes: usize) -> [f64; Self::MAX] {
         let mut out = [0.0; Self::MAX];
-        for (i, out) in out.iter_mut().enumerate().take(lanes) {
-            let mut s = self.sampler(i);
-            *out = s.next_f64();
-            self.dim[i] = s.dim;
+        let lanes_of = out
+            .iter_mut()
+            .zip(&self.key)
+            .zip(&self.index)
+            .zip(&mut self.dim);
+        for (((out, &key), &index), dim) in lanes_of.take(lanes) {
+            let x = point_1d(key, index, *dim);
+            let y = low_bits(x, key, *dim);
+            *out = x as f64 * (1.0 / (1u64 << 32) as f64) + y as f64 * (1.0 / (1u64 << 53) as f64);
+            *dim += 1;
         }
         out
     }
