@@ -10,7 +10,7 @@ use crate::material::microfacet::{Microfacet, NormalSampling};
 use crate::material::{Material, Model};
 use crate::render::inspect::{Firefly, Inspect, inspect};
 use crate::render::{RenderScene, film::Image, render};
-use crate::sampling::{LightSampling, LightsPerVertex, Sampling};
+use crate::sampling::{LightSampling, LightsPerVertex, SamplerKind, Sampling};
 use crate::shader::{Global, Path, Shader};
 use crate::texture::{TexelFilter, TextureKind, mip_levels};
 use std::fmt::Write as _;
@@ -31,6 +31,8 @@ pub struct Rung {
     pub normals: Option<NormalSampling>,
     /// The lookup every image texture uses in this rung, if not its own.
     pub texture_filter: Option<TexelFilter>,
+    /// The sampler of this rung, if not the film's.
+    pub sampler: Option<SamplerKind>,
 }
 
 /// The result of one rung.
@@ -80,8 +82,9 @@ pub fn reference_shader() -> Shader {
 /// sampling only), so that the plot shows what MIS buys; with point lights only, two or more of
 /// them, under the Physical model, one spp ladder per light choice (every light at every
 /// vertex, one by power, one by importance), so that the plot shows what each choice costs.
-/// With rough materials, one more spp ladder samples every microfacet distribution's full
-/// normals instead of the visible ones.
+/// One more spp ladder draws the first curve's strategy from the other sampler (Sobol' points
+/// for a film of independent numbers, and the reverse). With rough materials, one more spp
+/// ladder samples every microfacet distribution's full normals instead of the visible ones.
 pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
     let mut rungs = Vec::new();
     let rung = |family: &str, label: String, shader, spp| Rung {
@@ -91,6 +94,7 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
         spp,
         normals: None,
         texture_filter: None,
+        sampler: None,
     };
     // Image textures: the scene's shader at growing spp with every image looked up bilinearly
     // (unfiltered) and trilinearly (by the footprint), against the supersampled reference.
@@ -138,10 +142,23 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
             } else {
                 vec![("Path", p)]
             };
+            // The first curve's strategy with the other sampler: what stratified numbers buy
+            // (or, where the film asks for Sobol' points, what independent ones cost).
+            let (other, name) = match scene.film.sampler {
+                SamplerKind::Independent => (SamplerKind::Sobol, "Path Sobol'"),
+                SamplerKind::Sobol => (SamplerKind::Independent, "Path independent"),
+            };
+            let first = curves[0].1;
             for (family, path) in curves {
                 for spp in [1, 4, 16, 64, 256] {
                     rungs.push(rung(family, format!("spp={spp}"), Shader::Path(path), spp));
                 }
+            }
+            for spp in [1, 4, 16, 64, 256] {
+                rungs.push(Rung {
+                    sampler: Some(other),
+                    ..rung(name, format!("spp={spp}"), Shader::Path(first), spp)
+                });
             }
             // Rough materials: the same spp ladder with every microfacet sampler drawing all
             // normals instead of the visible ones, to show what visible normals buy.
@@ -336,6 +353,9 @@ pub fn sweep(
             for m in s.materials.iter_mut().filter_map(microfacet_mut) {
                 m.sampling = normals;
             }
+        }
+        if let Some(sampler) = r.sampler {
+            s.film.sampler = sampler;
         }
         if let Some(filter) = r.texture_filter {
             for t in s.textures.iter_mut() {

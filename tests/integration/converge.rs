@@ -4,6 +4,7 @@ use crate::common::scene;
 use rtis::RenderScene;
 use rtis::converge::{self, metrics};
 use rtis::render::{film::Image, render};
+use rtis::sampling::SamplerKind;
 
 fn small_box() -> RenderScene {
     let mut s = rtis::scene::load_default();
@@ -102,7 +103,21 @@ fn path_ladder_for_path_scenes() {
     let s = scene("Scene(film: (width: 8, height: 8), shader: Path(), entities: [])");
     let rungs = converge::ladder(&rtis::extract(&s));
     assert!(rungs.iter().all(|r| r.family.starts_with("Path")));
-    assert_eq!(rungs.len(), 9);
+    // An spp curve, the same with the Sobol' sampler, and a depth curve.
+    assert_eq!(rungs.len(), 5 + 5 + 4);
+    let sobol: Vec<_> = rungs.iter().filter(|r| r.family == "Path Sobol'").collect();
+    assert_eq!(sobol.len(), 5);
+    assert!(sobol.iter().all(|r| r.sampler == Some(SamplerKind::Sobol)));
+    // A film of Sobol' points gets an independent curve instead.
+    let s =
+        scene("Scene(film: (width: 8, height: 8, sampler: Sobol), shader: Path(), entities: [])");
+    let rungs = converge::ladder(&rtis::extract(&s));
+    let independent = rungs.iter().filter(|r| r.family == "Path independent");
+    assert!(
+        independent
+            .map(|r| r.sampler)
+            .eq([Some(SamplerKind::Independent); 5])
+    );
 }
 
 #[test]
@@ -319,10 +334,15 @@ fn light_choice_curves_for_point_lit_path_scenes() {
     ));
     let rungs = converge::ladder(&s);
     let families: Vec<&str> = rungs.iter().map(|r| r.family.as_str()).collect();
-    for f in ["Path all lights", "Path one light", "Path by importance"] {
+    for f in [
+        "Path all lights",
+        "Path one light",
+        "Path by importance",
+        "Path Sobol'",
+    ] {
         assert_eq!(families.iter().filter(|&&x| x == f).count(), 5, "{f}");
     }
-    assert_eq!(rungs.len(), 3 * 5 + 4);
+    assert_eq!(rungs.len(), 4 * 5 + 4);
     let reference = render(
         &converge::with_settings(&s, converge::reference_shader(), 1024),
         &|| {},
@@ -343,6 +363,11 @@ fn light_choice_curves_for_point_lit_path_scenes() {
         err("Path one light"),
         err("Path by importance"),
     );
-    eprintln!("RMSE at 16 spp: all {all:.5}, one {one:.5}, importance {importance:.5}");
+    let sobol = err("Path Sobol'");
+    eprintln!(
+        "RMSE at 16 spp: all {all:.5}, one {one:.5}, importance {importance:.5}, all with Sobol' points {sobol:.5}"
+    );
     assert!(importance < 0.5 * one, "{rows:#?}");
+    // The Sobol' curve draws every light at every vertex too, from stratified numbers.
+    assert!(sobol < all, "{rows:#?}");
 }
