@@ -275,7 +275,7 @@ pub fn reference_half(scene: &RenderScene, spp: u32, h: u64) -> RenderScene {
 /// A key that changes whenever anything that affects the reference image changes.
 pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
     let text = format!(
-        "reference v3 (two independent halves)|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        "reference v3 (two independent halves)|{:?}|{:?}|{:?}|{:?}|{:?}|{}x{}|{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
         scene.camera,
         scene.geometry.prims().collect::<Vec<_>>(),
         scene.materials,
@@ -287,6 +287,7 @@ pub fn reference_key(scene: &RenderScene, spp: u32) -> u64 {
         scene.seed,
         scene.model,
         scene.film.filter,
+        scene.film.sampler,
         scene.textures,
         scene.geometry.uvs,
         scene.emitters.environment,

@@ -787,6 +787,34 @@ pub fn convert(
     Ok(Converted { text, warnings })
 }
 
+/// The sample count Mitsuba 3's sampler `kind` takes for `sample_count` `n` (measured with its
+/// `sample_count()`): `stratified` the next square, `multijitter` a grid of `floor(sqrt(n))`
+/// rows and as many columns as `n` needs, `orthogonal` the next square of a prime (at least 4),
+/// `ldsampler` the next power of four (at least 4); `n` itself otherwise.
+fn mitsuba_sample_count(kind: &str, n: i64) -> i64 {
+    let n = n.max(1);
+    let root = |n: i64| (1..).find(|r: &i64| r * r >= n).unwrap_or(n);
+    match kind {
+        "stratified" => root(n).pow(2),
+        "multijitter" => {
+            let rows = (1..).take_while(|r: &i64| r * r <= n).last().unwrap_or(1);
+            rows * ((n + rows - 1) / rows)
+        }
+        "orthogonal" => {
+            let prime = |p: i64| p >= 2 && (2..p).take_while(|d| d * d <= p).all(|d| p % d != 0);
+            (root(n).max(2)..).find(|&p| prime(p)).unwrap_or(2).pow(2)
+        }
+        "ldsampler" => {
+            let mut c = 4;
+            while c < n {
+                c *= 4;
+            }
+            c
+        }
+        _ => n,
+    }
+}
+
 /// A sensor: the film's text and the camera's.
 fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
     let mut p = Props::new(o, paths);
@@ -846,12 +874,21 @@ fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
                 spp = s.integer("sample_count", 4)?;
                 s.integer("seed", 0)?;
                 // Mitsuba's stratified and low-discrepancy samplers become rtis's Sobol' one
-                // (their `jitter` and `strength` read and left: its points are scrambled).
-                sampler = match child.kind.as_str() {
+                // (their `jitter` and `strength` read and left: its points are scrambled),
+                // with their sample counts rounded up as Mitsuba 3 rounds them.
+                let kind = child.kind.as_str();
+                if matches!(kind, "stratified" | "multijitter" | "orthogonal") {
+                    s.boolean("jitter", true)?;
+                }
+                if kind == "orthogonal" {
+                    s.integer("strength", 2)?;
+                }
+                sampler = match kind {
                     "independent" => "",
                     "stratified" | "multijitter" | "orthogonal" | "ldsampler" => {
-                        s.boolean("jitter", true)?;
-                        s.integer("strength", 2)?;
+                        if (1..=1 << 20).contains(&spp) {
+                            spp = mitsuba_sample_count(kind, spp);
+                        }
                         ", sampler: Sobol"
                     }
                     _ => {

@@ -88,6 +88,9 @@ pub fn fingerprint(scene: &RenderScene) -> u64 {
     if f.filter != crate::sampling::PixelFilter::Box {
         let _ = write!(h, "|{:?}", f.filter);
     }
+    if f.sampler != crate::sampling::SamplerKind::Independent {
+        let _ = write!(h, "|{:?}", f.sampler);
+    }
     // Path's samples have been exact sums of their contributions since the image split by
     // technique: passes of earlier versions (each sample rounded once) are refused, never
     // mixed.

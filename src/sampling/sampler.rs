@@ -100,20 +100,27 @@ impl Streams {
     pub const MAX: usize = 16;
 
     /// The streams of `samplers` (at most [`Streams::MAX`]), lane `i` from `samplers[i]`, of
-    /// the first one's kind (a render's samplers are all of its film's kind); lanes past them
-    /// draw numbers that nobody reads.
+    /// the first one's kind; lanes past them draw numbers that nobody reads.
+    ///
+    /// # Panics
+    /// If the samplers are of two kinds: a render's samplers all come from `camera_ray`, of
+    /// its film's kind, so a mixed wave is a caller's bug, refused rather than drawn from
+    /// numbers of the wrong kind. (Ruling it out by type would make the tracer and the waves
+    /// generic over the sampler.)
     #[inline(always)]
     pub fn load<'a>(samplers: impl Iterator<Item = &'a Sampler> + Clone) -> Streams {
+        const MIXED: &str =
+            "a wave of samples of two samplers: a render's samplers all come from its film's kind";
         match samplers.clone().next() {
             Some(Sampler::Sobol(_)) => {
                 Streams::Sobol(SobolLanes::load(samplers.map(|s| match s {
                     Sampler::Sobol(s) => s,
-                    Sampler::Independent(_) => panic!("a wave of samples of two samplers"),
+                    Sampler::Independent(_) => panic!("{MIXED}"),
                 })))
             }
             _ => Streams::Independent(PcgLanes::load(samplers.map(|s| match s {
                 Sampler::Independent(s) => s,
-                Sampler::Sobol(_) => panic!("a wave of samples of two samplers"),
+                Sampler::Sobol(_) => panic!("{MIXED}"),
             }))),
         }
     }

@@ -1,6 +1,5 @@
 //! The Sobol' sampler: padded, Owen-scrambled Sobol' points (Burley, "Practical Hash-based
-//! Owen Scrambling", JCGT 9(4), 2020), as pbrt-v4's `PaddedSobolSampler` and Mitsuba 3's
-//! low-discrepancy samplers use them.
+//! Owen Scrambling", JCGT 9(4), 2020), as pbrt-v4's `PaddedSobolSampler` uses them.
 //!
 //! Each draw of a sample is a dimension of its own (one per call, whatever the call draws).
 //! Dimension `d` of sample `i` of a pixel takes the point of index `j` of Sobol's first two
@@ -26,8 +25,10 @@ use super::rng::{mix, to_f32, to_f64};
 /// dimensions it has drawn.
 #[derive(Clone, Copy, Debug)]
 pub struct Sobol {
-    /// The (seed, pixel) hash every dimension's seeds derive from.
-    key: u32,
+    /// The (seed, pixel) hash every dimension's seeds derive from, 64 bits in two halves (so
+    /// that two pixels share their points in every dimension with probability `2^-64`, not
+    /// `2^-32`: millions of pixels would hold hundreds of such pairs).
+    key: [u32; 2],
     /// The sample's index among its pixel's.
     index: u32,
     /// The next dimension.
@@ -80,9 +81,11 @@ fn sobol_second_reversed(j: u32) -> u32 {
 }
 
 /// The seeds of dimension `dim` under `key`: the index shuffle's and the two coordinates'.
+/// The dimension is spread by the golden ratio's 32 bits; the two salts are arbitrary odd
+/// constants (Eiserloh's noise constants) that tell the coordinates' seeds apart.
 #[inline(always)]
-fn seeds(key: u32, dim: u32) -> (u32, u32, u32) {
-    let s = hash(key ^ dim.wrapping_mul(0x9e37_79b9));
+fn seeds(key: [u32; 2], dim: u32) -> (u32, u32, u32) {
+    let s = hash(key[0] ^ hash(key[1] ^ dim.wrapping_mul(0x9e37_79b9)));
     (s, hash(s ^ 0x68e3_1da4), hash(s ^ 0xb529_7a4d))
 }
 
@@ -90,7 +93,7 @@ fn seeds(key: u32, dim: u32) -> (u32, u32, u32) {
 /// first Sobol' dimension (the van der Corput sequence: `j` reversed) of the shuffled index
 /// `j`, scrambled (`owen(j.reverse_bits())`, its two reversals cancelled).
 #[inline(always)]
-pub fn point_1d(key: u32, index: u32, dim: u32) -> u32 {
+pub fn point_1d(key: [u32; 2], index: u32, dim: u32) -> u32 {
     let (shuffle, sx, _) = seeds(key, dim);
     let j = owen(index, shuffle);
     laine_karras(j, sx).reverse_bits()
@@ -99,7 +102,7 @@ pub fn point_1d(key: u32, index: u32, dim: u32) -> u32 {
 /// The 2D point of sample `index` in dimension `dim` under `key`: Sobol's first two
 /// dimensions of the shuffled index, each scrambled.
 #[inline(always)]
-pub fn point_2d(key: u32, index: u32, dim: u32) -> (u32, u32) {
+pub fn point_2d(key: [u32; 2], index: u32, dim: u32) -> (u32, u32) {
     let (shuffle, sx, sy) = seeds(key, dim);
     let j = owen(index, shuffle);
     let x = laine_karras(j, sx).reverse_bits();
@@ -109,7 +112,7 @@ pub fn point_2d(key: u32, index: u32, dim: u32) -> (u32, u32) {
 /// 21 more bits for a 53-bit fraction after the 32 of `bits`: a hash of them and the
 /// dimension's seed (below the point's 32 digits, the scramble would draw them at random too).
 #[inline(always)]
-fn low_bits(bits: u32, key: u32, dim: u32) -> u32 {
+fn low_bits(bits: u32, key: [u32; 2], dim: u32) -> u32 {
     hash(bits ^ seeds(key, dim).2) & ((1 << 21) - 1)
 }
 
@@ -119,7 +122,10 @@ impl Sobol {
     /// The points of sample `sample` of pixel `pixel` (row-major index) under `seed`.
     pub fn new(seed: u64, pixel: u64, sample: u64) -> Self {
         Sobol {
-            key: mix(mix(seed) ^ pixel) as u32,
+            key: {
+                let k = mix(mix(seed) ^ pixel);
+                [k as u32, (k >> 32) as u32]
+            },
             index: sample as u32,
             dim: 0,
         }
@@ -127,14 +133,14 @@ impl Sobol {
 
     /// Skip `dims` dimensions, as that many draws would.
     pub fn skip(&mut self, dims: u32) {
-        self.dim += dims;
+        self.dim = self.dim.wrapping_add(dims);
     }
 
     /// The next dimension's 1D point, 32 bits.
     #[inline(never)]
     pub fn next_u32(&mut self) -> u32 {
         let x = point_1d(self.key, self.index, self.dim);
-        self.dim += 1;
+        self.dim = self.dim.wrapping_add(1);
         x
     }
 
@@ -156,7 +162,7 @@ impl Sobol {
     #[inline(never)]
     pub fn next_2d(&mut self) -> (f32, f32) {
         let (x, y) = point_2d(self.key, self.index, self.dim);
-        self.dim += 1;
+        self.dim = self.dim.wrapping_add(1);
         (to_f32(x), to_f32(y))
     }
 }
@@ -166,7 +172,8 @@ impl Sobol {
 /// where they are inlined.
 #[derive(Clone, Copy)]
 pub struct SobolLanes {
-    key: [u32; SobolLanes::MAX],
+    /// Each lane's key, its two halves in two arrays.
+    key: [[u32; SobolLanes::MAX]; 2],
     index: [u32; SobolLanes::MAX],
     dim: [u32; SobolLanes::MAX],
 }
@@ -180,12 +187,13 @@ impl SobolLanes {
     #[inline(always)]
     pub fn load<'a>(samplers: impl Iterator<Item = &'a Sobol>) -> SobolLanes {
         let mut s = SobolLanes {
-            key: [0; Self::MAX],
+            key: [[0; Self::MAX]; 2],
             index: [0; Self::MAX],
             dim: [0; Self::MAX],
         };
         for (i, sampler) in samplers.take(Self::MAX).enumerate() {
-            (s.key[i], s.index[i], s.dim[i]) = (sampler.key, sampler.index, sampler.dim);
+            (s.key[0][i], s.key[1][i]) = (sampler.key[0], sampler.key[1]);
+            (s.index[i], s.dim[i]) = (sampler.index, sampler.dim);
         }
         s
     }
@@ -194,24 +202,30 @@ impl SobolLanes {
     #[inline(always)]
     pub fn sampler(&self, i: usize) -> Sobol {
         Sobol {
-            key: self.key[i],
+            key: [self.key[0][i], self.key[1][i]],
             index: self.index[i],
             dim: self.dim[i],
         }
+    }
+
+    /// Each of the first `lanes` lanes' (key, index, dimension), its dimension then moved on.
+    #[inline(always)]
+    fn draw(&mut self, lanes: usize) -> impl Iterator<Item = ([u32; 2], u32, u32)> + '_ {
+        let keys = self.key[0].iter().zip(&self.key[1]);
+        let lanes_of = keys.zip(&self.index).zip(&mut self.dim).take(lanes);
+        lanes_of.map(|(((&k0, &k1), &index), dim)| {
+            let d = *dim;
+            *dim = d.wrapping_add(1);
+            ([k0, k1], index, d)
+        })
     }
 
     /// [`Sobol::next_u32`] in the first `lanes` lanes.
     #[inline(always)]
     pub fn next_u32(&mut self, lanes: usize) -> [u32; Self::MAX] {
         let mut out = [0; Self::MAX];
-        let lanes_of = out
-            .iter_mut()
-            .zip(&self.key)
-            .zip(&self.index)
-            .zip(&mut self.dim);
-        for (((out, &key), &index), dim) in lanes_of.take(lanes) {
-            *out = point_1d(key, index, *dim);
-            *dim += 1;
+        for (out, (key, index, dim)) in out.iter_mut().zip(self.draw(lanes)) {
+            *out = point_1d(key, index, dim);
         }
         out
     }
@@ -222,16 +236,10 @@ impl SobolLanes {
     #[inline(always)]
     pub fn next_f64(&mut self, lanes: usize) -> [f64; Self::MAX] {
         let mut out = [0.0; Self::MAX];
-        let lanes_of = out
-            .iter_mut()
-            .zip(&self.key)
-            .zip(&self.index)
-            .zip(&mut self.dim);
-        for (((out, &key), &index), dim) in lanes_of.take(lanes) {
-            let x = point_1d(key, index, *dim);
-            let y = low_bits(x, key, *dim);
+        for (out, (key, index, dim)) in out.iter_mut().zip(self.draw(lanes)) {
+            let x = point_1d(key, index, dim);
+            let y = low_bits(x, key, dim);
             *out = x as f64 * (1.0 / (1u64 << 32) as f64) + y as f64 * (1.0 / (1u64 << 53) as f64);
-            *dim += 1;
         }
         out
     }
@@ -249,11 +257,9 @@ impl SobolLanes {
     #[inline(always)]
     pub fn next_2d(&mut self, lanes: usize) -> ([f32; Self::MAX], [f32; Self::MAX]) {
         let (mut x, mut y) = ([0.0; Self::MAX], [0.0; Self::MAX]);
-        let lanes_of = x.iter_mut().zip(&mut y).zip(&self.key).zip(&self.index);
-        for ((((x, y), &key), &index), dim) in lanes_of.zip(&mut self.dim).take(lanes) {
-            let (a, b) = point_2d(key, index, *dim);
+        for ((x, y), (key, index, dim)) in x.iter_mut().zip(&mut y).zip(self.draw(lanes)) {
+            let (a, b) = point_2d(key, index, dim);
             (*x, *y) = (to_f32(a), to_f32(b));
-            *dim += 1;
         }
         (x, y)
     }
@@ -341,6 +347,41 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Dimensions are padded, not aligned: a pixel's 64 samples' numbers in dimension `d` and
+    /// `d + 1` pair up as independent numbers would, filling about `1 - 1/e` of an 8 x 8 grid
+    /// (a set stratified jointly, as dimensions sharing their shuffle would be, fills all 64
+    /// cells or a diagonal of 8). And pixels draw different points.
+    #[test]
+    fn dimensions_and_pixels_are_independent() {
+        let (mut filled, mut cells) = (0, 0);
+        for pixel in 0..40u64 {
+            for d in [0u32, 5, 31] {
+                let mut seen = [false; 64];
+                for i in 0..64u32 {
+                    let s = Sobol::new(9, pixel, i as u64);
+                    let (a, b) = (point_1d(s.key, i, d), point_1d(s.key, i, d + 1));
+                    assert_ne!(a, b, "pixel {pixel}, dims {d} and {}", d + 1);
+                    seen[((a >> 29) * 8 + (b >> 29)) as usize] = true;
+                }
+                filled += seen.iter().filter(|&&x| x).count();
+                cells += 64;
+            }
+        }
+        let share = filled as f64 / cells as f64;
+        // 120 sets of 64: the share's standard deviation is about 0.003 around 0.634.
+        assert!(
+            (share - 0.634).abs() < 0.03,
+            "share of cells filled {share}"
+        );
+        let points: std::collections::HashSet<(u32, u32)> = (0..10_000u64)
+            .map(|pixel| {
+                let s = Sobol::new(9, pixel, 0);
+                point_2d(s.key, 0, 0)
+            })
+            .collect();
+        assert_eq!(points.len(), 10_000, "two pixels drew the same point");
     }
 
     /// `SobolLanes` draws each lane's own numbers.

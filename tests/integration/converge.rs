@@ -137,6 +137,12 @@ fn reference_key_tracks_the_scene() {
         converge::reference_key(&a, 64),
         converge::reference_key(&b, 64)
     );
+    let mut c = a.clone();
+    c.film.sampler = SamplerKind::Sobol;
+    assert_ne!(
+        converge::reference_key(&a, 64),
+        converge::reference_key(&c, 64)
+    );
 }
 
 /// The reference draws from streams independent of every rung: a Path rung with as many

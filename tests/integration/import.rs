@@ -63,22 +63,64 @@ fn sensor_film_and_sampler() {
         )),
         "{text}"
     );
-    // Mitsuba's stratified and low-discrepancy samplers are rtis's Sobol' sampler; another
-    // sampler is refused where it is written.
-    for kind in ["stratified", "multijitter", "orthogonal", "ldsampler"] {
-        let xml = scene(&format!(
-            r#"<sensor type="perspective">
-                 <sampler type="{kind}"><integer name="sample_count" value="64"/><boolean name="jitter" value="false"/></sampler>
-               </sensor>"#
-        ));
-        let text = import(kind, &xml).unwrap();
-        assert!(
-            text.contains("spp: 64, filter: Gaussian(stddev: 0.5), sampler: Sobol)"),
-            "{kind}: {text}"
-        );
+    // Mitsuba's stratified and low-discrepancy samplers are rtis's Sobol' sampler, with the
+    // sample counts Mitsuba 3.9 gives them (its `sample_count()` for the counts on the left);
+    // another sampler is refused where it is written.
+    let counts = [1, 2, 3, 5, 8, 10, 16, 17, 64, 100];
+    for (kind, want, jitter) in [
+        ("independent", [1, 2, 3, 5, 8, 10, 16, 17, 64, 100], false),
+        ("stratified", [1, 4, 4, 9, 9, 16, 16, 25, 64, 100], true),
+        ("multijitter", [1, 2, 3, 6, 8, 12, 16, 20, 64, 100], true),
+        ("orthogonal", [4, 4, 4, 9, 9, 25, 25, 25, 121, 121], true),
+        ("ldsampler", [4, 4, 4, 16, 16, 16, 16, 64, 64, 256], false),
+    ] {
+        for (n, want) in counts.into_iter().zip(want) {
+            let jitter = if jitter {
+                r#"<boolean name="jitter" value="false"/>"#
+            } else {
+                ""
+            };
+            let xml = scene(&format!(
+                r#"<sensor type="perspective">
+                     <sampler type="{kind}"><integer name="sample_count" value="{n}"/>{jitter}</sampler>
+                   </sensor>"#
+            ));
+            let text = import(kind, &xml).unwrap();
+            let sampler = if kind == "independent" {
+                ""
+            } else {
+                ", sampler: Sobol"
+            };
+            assert!(
+                text.contains(&format!(
+                    "spp: {want}, filter: Gaussian(stddev: 0.5){sampler})"
+                )),
+                "{kind} {n}: {text}"
+            );
+        }
+        let text = import(
+            kind,
+            &scene(
+                r#"<sensor type="perspective"><sampler type="KIND"/></sensor>"#
+                    .replace("KIND", kind)
+                    .as_str(),
+            ),
+        )
+        .unwrap();
         let s = rtis::extract(&crate::common::scene(&text));
-        assert_eq!(s.film.sampler, rtis::sampling::SamplerKind::Sobol, "{kind}");
+        let want = match kind {
+            "independent" => rtis::sampling::SamplerKind::Independent,
+            _ => rtis::sampling::SamplerKind::Sobol,
+        };
+        assert_eq!(s.film.sampler, want, "{kind}");
     }
+    // `jitter` belongs to the stratified samplers: on an `ldsampler` it is not read.
+    let e = import(
+        "ld-jitter",
+        &scene(r#"<sensor type="perspective"><sampler type="ldsampler"><boolean name="jitter" value="true"/></sampler></sensor>"#),
+    )
+    .unwrap_err();
+    assert!(e.contains("jitter"), "{e}");
     let e = import(
         "other",
         &scene(r#"<sensor type="perspective"><sampler type="halton"/></sensor>"#),

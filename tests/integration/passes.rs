@@ -94,6 +94,12 @@ fn merge_refuses_gaps_overlaps_and_strangers() {
     let q = passes(&moved, 3);
     let e = Pass::merge(vec![p[0].clone(), q[1].clone()]).unwrap_err();
     assert!(e.contains("different renders: scene fingerprints"), "{e}");
+    // Another sampler: the same scene drawing Sobol' points.
+    let mut sobol = t.clone();
+    sobol.film.sampler = SamplerKind::Sobol;
+    let q = passes(&sobol, 3);
+    let e = Pass::merge(vec![p[0].clone(), q[1].clone()]).unwrap_err();
+    assert!(e.contains("different renders: scene fingerprints"), "{e}");
 }
 
 /// Through the command line: three pass files merged equal the plain render's EXR bytes; a
