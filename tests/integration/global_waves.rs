@@ -60,7 +60,7 @@ fn rays(rs: &RenderScene, count: usize, seed: u64) -> Vec<Ray> {
 /// `L_i` of every ray in `order`, as bits, with the rays it counted.
 fn trace(rs: &RenderScene, g: &Global, rays: &[Ray], order: Order) -> (Vec<[u32; 3]>, RayStats) {
     let mut stats = RayStats::default();
-    let mut tr = rs.tracer(Sampler::new(1, 2, 3), &mut stats);
+    let mut tr = rs.tracer(Sampler::of(rs.film.sampler, 1, 2, 3), &mut stats);
     assert!(order.applies(&tr, g), "{order:?} does not apply");
     let l = incident_all(&mut tr, g, rays, order);
     (
@@ -131,6 +131,22 @@ fn unsampled_emitter_seen_by(name: &str, rs: &RenderScene, count: usize) {
         "{name}: the emitters are never seen"
     );
     agree_on(name, rs, &g, count);
+}
+
+/// The Sobol' sampler: the waves draw each node's numbers in the walk's order, so they give
+/// its bits with Sobol' points too (each draw a dimension of its own), at depths 1 to 3.
+#[test]
+fn waves_give_the_depth_first_bits_with_the_sobol_sampler() {
+    let cornell = scenes_dir().join("cornell.ron");
+    let cornell = cornell.to_str().unwrap();
+    for d in 1..=3 {
+        let text = format!(
+            "Scene(extends: {cornell:?}, film: (width: 720, height: 576, sampler: Sobol), shader: Global(samples: 4, max_depth: {d}, ambient: (0.3, 0.3, 0.3)))"
+        );
+        let rs = rtis::extract(&scene(&text));
+        assert_eq!(rs.film.sampler, rtis::sampling::SamplerKind::Sobol);
+        agree(&format!("Sobol', D = {d}"), &rs);
+    }
 }
 
 /// The course's box under every depth from 1 to 8, with glass and mirror chains, and with
