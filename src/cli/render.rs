@@ -13,6 +13,7 @@ use rtis::render::pass::{self, Pass};
 use rtis::render::progressive::{self, Ending};
 use rtis::render::tev::Display;
 use rtis::render::{self, Film, output};
+use rtis::sampling::SamplerKind;
 use rtis::stats::RayStats;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -135,6 +136,18 @@ pub struct Overrides {
     /// Override the scene's random seed.
     #[arg(long)]
     seed: Option<u64>,
+    /// Override the film's sampler: independent numbers, or Sobol' points.
+    #[arg(long, value_enum)]
+    sampler: Option<SamplerChoice>,
+}
+
+/// `--sampler`: the film's `sampler`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SamplerChoice {
+    /// Independent uniform numbers (PCG32).
+    Independent,
+    /// Padded, Owen-scrambled Sobol' points.
+    Sobol,
 }
 
 /// `--isa` of `rtis render`.
@@ -182,8 +195,8 @@ pub fn film_size(scene: (u32, u32), width: Option<u32>, height: Option<u32>) -> 
     }
 }
 
-/// The scene at `path` (the embedded box if none) with the command line's film size, spp and
-/// seed (`over`) and transfer, where given.
+/// The scene at `path` (the embedded box if none) with the command line's film size, spp,
+/// sampler and seed (`over`) and transfer, where given.
 pub fn load_overridden(
     path: Option<&Path>,
     over: Overrides,
@@ -197,6 +210,11 @@ pub fn load_overridden(
         height,
         spp: over.spp.unwrap_or(film.spp),
         transfer: transfer.unwrap_or(film.transfer),
+        sampler: match over.sampler {
+            Some(SamplerChoice::Independent) => SamplerKind::Independent,
+            Some(SamplerChoice::Sobol) => SamplerKind::Sobol,
+            None => film.sampler,
+        },
         ..*film
     };
     *film = overridden

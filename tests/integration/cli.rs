@@ -498,3 +498,44 @@ fn check_and_render_estimate_the_same_rays() {
     }
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// `--sampler sobol` renders what a film of `sampler: Sobol` renders, to the byte, and not what
+/// the independent sampler renders.
+#[test]
+fn sampler_override_is_the_films_sampler() {
+    let d = tmp("sampler");
+    let scene = d.join("sobol.ron");
+    std::fs::write(
+        &scene,
+        format!(
+            "Scene(extends: {:?}, film: (width: 24, height: 20, spp: 16, sampler: Sobol))",
+            common::scenes_dir().join("mitsuba-cornell.ron")
+        ),
+    )
+    .unwrap();
+    let plain = common::scenes_dir().join("mitsuba-cornell.ron");
+    let render = |name: &str, args: &[&str]| {
+        let out = d.join(name);
+        let mut all = vec!["render", "-o", out.to_str().unwrap()];
+        all.extend_from_slice(args);
+        let o = rtis(&all);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(&out).unwrap()
+    };
+    let film = render("film.exr", &[scene.to_str().unwrap()]);
+    let size = ["--width", "24", "--height", "20", "--spp", "16"];
+    let mut args = vec![plain.to_str().unwrap()];
+    args.extend_from_slice(&size);
+    let independent = render("independent.exr", &args);
+    args.extend_from_slice(&["--sampler", "sobol"]);
+    let flag = render("flag.exr", &args);
+    assert_eq!(film, flag, "--sampler sobol against the film's sampler");
+    assert_ne!(film, independent);
+    let o = rtis(&["render", plain.to_str().unwrap(), "--sampler", "halton"]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("halton"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
