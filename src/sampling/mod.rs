@@ -17,7 +17,7 @@ pub use erf::erf_inv;
 pub use filter::PixelFilter;
 pub use pixel::pixel_sample;
 pub use rng::{Pcg32, PcgLanes, mix};
-pub use sampler::{Sampler, SamplerKind, Streams};
+pub use sampler::{LANES, Sampler, SamplerKind, Streams, WithStreams};
 pub use sobol::{Sobol, SobolLanes};
 pub use strategy::{LightSampling, LightsPerVertex, Sampling, power_heuristic};
 pub use trig::sin_cos_turns;

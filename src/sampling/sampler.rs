@@ -78,6 +78,16 @@ impl Sampler {
         }
     }
 
+    /// Run `work` with the [`Streams`] of this sampler's kind: the one `match` on the kind
+    /// that code drawing in lanes needs, compiled for each kind.
+    #[inline(always)]
+    pub fn with_streams<W: WithStreams>(&self, work: W) -> W::Out {
+        match self {
+            Sampler::Independent(_) => work.run::<PcgLanes>(),
+            Sampler::Sobol(_) => work.run::<SobolLanes>(),
+        }
+    }
+
     /// A uniform integer in `[0, n)` for `n > 0`.
     #[inline(always)]
     pub fn next_below(&mut self, n: u32) -> u32 {
@@ -85,88 +95,120 @@ impl Sampler {
     }
 }
 
-/// Up to [`Streams::MAX`] samplers of one kind drawn side by side, lane `i` drawing as
-/// sampler `i`'s own [`Sampler`] methods would: the same numbers, in lanes.
-#[derive(Clone, Copy)]
-pub enum Streams {
-    /// Independent streams.
-    Independent(PcgLanes),
-    /// Sobol' streams.
-    Sobol(SobolLanes),
-}
-
-impl Streams {
-    /// The most lanes.
-    pub const MAX: usize = 16;
-
-    /// The streams of `samplers` (at most [`Streams::MAX`]), lane `i` from `samplers[i]`, of
-    /// the first one's kind; lanes past them draw numbers that nobody reads.
+/// Up to [`LANES`] samplers of one kind drawn side by side, lane `i` drawing as sampler `i`'s
+/// own [`Sampler`] methods would: the same numbers, in lanes. Each kind's lanes are a type of
+/// their own ([`PcgLanes`], [`SobolLanes`]), so that code drawing in lanes is compiled for
+/// each kind without a `match` per draw (`shader::path::lanes` picks the kind once per chunk).
+pub trait Streams: Copy {
+    /// The streams of `samplers` (at most [`LANES`]), lane `i` from `samplers[i]`; lanes past
+    /// them draw numbers that nobody reads.
     ///
     /// # Panics
-    /// If the samplers are of two kinds: a render's samplers all come from `camera_ray`, of
+    /// If a sampler is of another kind: a render's samplers all come from `camera_ray`, of
     /// its film's kind, so a mixed wave is a caller's bug, refused rather than drawn from
     /// numbers of the wrong kind. (Ruling it out by type would make the tracer and the waves
     /// generic over the sampler.)
-    #[inline(always)]
-    pub fn load<'a>(samplers: impl Iterator<Item = &'a Sampler> + Clone) -> Streams {
-        const MIXED: &str =
-            "a wave of samples of two samplers: a render's samplers all come from its film's kind";
-        match samplers.clone().next() {
-            Some(Sampler::Sobol(_)) => {
-                Streams::Sobol(SobolLanes::load(samplers.map(|s| match s {
-                    Sampler::Sobol(s) => s,
-                    Sampler::Independent(_) => panic!("{MIXED}"),
-                })))
-            }
-            _ => Streams::Independent(PcgLanes::load(samplers.map(|s| match s {
-                Sampler::Independent(s) => s,
-                Sampler::Sobol(_) => panic!("{MIXED}"),
-            }))),
-        }
-    }
+    fn load<'a>(samplers: impl Iterator<Item = &'a Sampler>) -> Self;
 
     /// Lane `i`'s sampler, where it has got to.
-    #[inline(always)]
-    pub fn sampler(&self, i: usize) -> Sampler {
-        match self {
-            Streams::Independent(s) => Sampler::Independent(s.sampler(i)),
-            Streams::Sobol(s) => Sampler::Sobol(s.sampler(i)),
-        }
-    }
+    fn sampler(&self, i: usize) -> Sampler;
 
     /// [`Sampler::next_u32`] in the first `lanes` lanes.
-    #[inline(always)]
-    pub fn next_u32(&mut self, lanes: usize) -> [u32; Streams::MAX] {
-        match self {
-            Streams::Independent(s) => s.next_u32(lanes),
-            Streams::Sobol(s) => s.next_u32(lanes),
-        }
-    }
+    fn next_u32(&mut self, lanes: usize) -> [u32; LANES];
 
     /// [`Sampler::next_f64`] in the first `lanes` lanes.
-    #[inline(always)]
-    pub fn next_f64(&mut self, lanes: usize) -> [f64; Streams::MAX] {
-        match self {
-            Streams::Independent(s) => s.next_f64(lanes),
-            Streams::Sobol(s) => s.next_f64(lanes),
-        }
-    }
+    fn next_f64(&mut self, lanes: usize) -> [f64; LANES];
 
     /// [`Sampler::next_f64`] in lane `i` alone (a draw the other lanes do not make).
-    #[inline(always)]
-    pub fn next_f64_at(&mut self, i: usize) -> f64 {
-        match self {
-            Streams::Independent(s) => s.next_f64_at(i),
-            Streams::Sobol(s) => s.next_f64_at(i),
-        }
-    }
+    fn next_f64_at(&mut self, i: usize) -> f64;
 
     /// [`Sampler::next_2d`] in the first `lanes` lanes: the two coordinates' arrays.
+    fn next_2d(&mut self, lanes: usize) -> ([f32; LANES], [f32; LANES]);
+}
+
+/// Work to run with the [`Streams`] of a sampler's kind ([`Sampler::with_streams`]): a
+/// generic method, which a closure cannot have.
+pub trait WithStreams {
+    /// What the work gives.
+    type Out;
+
+    /// Run the work with the streams type `S`.
+    fn run<S: Streams>(self) -> Self::Out;
+}
+
+/// The most lanes [`Streams`] draw in.
+pub const LANES: usize = 16;
+
+/// [`Streams::load`]'s refusal of a wave of two samplers.
+const MIXED: &str =
+    "a wave of samples of two samplers: a render's samplers all come from its film's kind";
+
+impl Streams for PcgLanes {
     #[inline(always)]
-    pub fn next_2d(&mut self, lanes: usize) -> ([f32; Streams::MAX], [f32; Streams::MAX]) {
-        match self {
-            Streams::Independent(s) => s.next_2d(lanes),
-            Streams::Sobol(s) => s.next_2d(lanes),
-        }
+    fn load<'a>(samplers: impl Iterator<Item = &'a Sampler>) -> Self {
+        PcgLanes::load(samplers.map(|s| match s {
+            Sampler::Independent(s) => s,
+            Sampler::Sobol(_) => panic!("{MIXED}"),
+        }))
+    }
+
+    #[inline(always)]
+    fn sampler(&self, i: usize) -> Sampler {
+        Sampler::Independent(PcgLanes::sampler(self, i))
+    }
+
+    #[inline(always)]
+    fn next_u32(&mut self, lanes: usize) -> [u32; LANES] {
+        PcgLanes::next_u32(self, lanes)
+    }
+
+    #[inline(always)]
+    fn next_f64(&mut self, lanes: usize) -> [f64; LANES] {
+        PcgLanes::next_f64(self, lanes)
+    }
+
+    #[inline(always)]
+    fn next_f64_at(&mut self, i: usize) -> f64 {
+        PcgLanes::next_f64_at(self, i)
+    }
+
+    #[inline(always)]
+    fn next_2d(&mut self, lanes: usize) -> ([f32; LANES], [f32; LANES]) {
+        PcgLanes::next_2d(self, lanes)
+    }
+}
+
+impl Streams for SobolLanes {
+    #[inline(always)]
+    fn load<'a>(samplers: impl Iterator<Item = &'a Sampler>) -> Self {
+        SobolLanes::load(samplers.map(|s| match s {
+            Sampler::Sobol(s) => s,
+            Sampler::Independent(_) => panic!("{MIXED}"),
+        }))
+    }
+
+    #[inline(always)]
+    fn sampler(&self, i: usize) -> Sampler {
+        Sampler::Sobol(SobolLanes::sampler(self, i))
+    }
+
+    #[inline(always)]
+    fn next_u32(&mut self, lanes: usize) -> [u32; LANES] {
+        SobolLanes::next_u32(self, lanes)
+    }
+
+    #[inline(always)]
+    fn next_f64(&mut self, lanes: usize) -> [f64; LANES] {
+        SobolLanes::next_f64(self, lanes)
+    }
+
+    #[inline(always)]
+    fn next_f64_at(&mut self, i: usize) -> f64 {
+        SobolLanes::next_f64_at(self, i)
+    }
+
+    #[inline(always)]
+    fn next_2d(&mut self, lanes: usize) -> ([f32; LANES], [f32; LANES]) {
+        SobolLanes::next_2d(self, lanes)
     }
 }

@@ -464,7 +464,7 @@ fn waves_apply_only_where_the_lanes_shade() {
     assert!(waves::applies(&rtis::extract(&scene(&text))));
 }
 
-/// The Sobol' sampler in the waves: its draws in lanes (`Streams::Sobol`) are each path's own,
+/// The Sobol' sampler in the waves: its draws in lanes (`SobolLanes`) are each path's own,
 /// 1D and 2D draws alike (a light sample's point and the next direction are 2D points, not
 /// two 1D ones), so the waves give the one-ray pixels with it too: point lights, an emitting
 /// sphere and Mitsuba's box under each light strategy, and an image sky.

@@ -32,7 +32,7 @@ use crate::light::{
     AreaLight, Chosen, Emitting, Light, LightSample, NO_LIGHT, choose_by_importance,
 };
 use crate::material::{Material, Model, Phong};
-use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling, Streams};
+use crate::sampling::{LightSampling, LightsPerVertex, Sampler, Sampling, Streams, WithStreams};
 use crate::shader::Tracer;
 use crate::shader::record::{Record, Technique};
 use crate::shader::surface::{
@@ -322,16 +322,18 @@ unsafe fn round_in<L: Floats, R: Record>(
                 hits: &hits,
                 materials: &materials,
             };
-            unsafe {
-                shade_in::<L, R>(
-                    tr,
-                    p,
-                    &mut slots[c..c + count],
-                    shaded,
-                    &at,
-                    &mut alive[c..],
-                )
-            };
+            // The chunk's streams in lanes of their sampler's kind: the shading compiled for
+            // each, with no `match` per draw.
+            let chunk = &mut slots[c..c + count];
+            let kind = chunk[0].sampler.clone();
+            kind.with_streams(Shade {
+                tr: &mut *tr,
+                p,
+                slots: chunk,
+                shaded,
+                at: &at,
+                alive: &mut alive[c..],
+            });
         }
     }
 }
@@ -353,13 +355,44 @@ struct Vertices<'h, L> {
     materials: &'h [Option<(u32, Phong)>; MAX_LANES],
 }
 
+/// [`shade_in`]'s arguments, run with the streams of the chunk's sampler
+/// ([`Sampler::with_streams`]).
+struct Shade<'a, 'h, 't, L, R> {
+    tr: &'a mut Tracer<'t>,
+    p: &'a Path,
+    slots: &'a mut [PathSlot<R>],
+    shaded: u32,
+    at: &'a Vertices<'h, L>,
+    alive: &'a mut [bool],
+}
+
+impl<L: Floats, R: Record> WithStreams for Shade<'_, '_, '_, L, R> {
+    type Out = ();
+
+    #[inline(always)]
+    fn run<S: Streams>(self) {
+        // SAFETY: `at` holds values of `L`, so the CPU runs `L`'s instruction set (a `Shade`
+        // is made only in `round_in`, whose caller vouches for it).
+        unsafe {
+            shade_in::<L, R, S>(
+                self.tr,
+                self.p,
+                self.slots,
+                self.shaded,
+                self.at,
+                self.alive,
+            )
+        }
+    }
+}
+
 /// Shade the vertices of `at` in the lanes of `shaded` (lane `i` is path `slots[i]`, which
 /// adds its light to its recorder and takes its next ray; `alive[i]` says whether it goes on).
 ///
 /// # Safety
 /// The CPU must run `L`'s instruction set.
 #[inline(always)]
-unsafe fn shade_in<L: Floats, R: Record>(
+unsafe fn shade_in<L: Floats, R: Record, S: Streams>(
     tr: &mut Tracer,
     p: &Path,
     slots: &mut [PathSlot<R>],
@@ -375,8 +408,8 @@ unsafe fn shade_in<L: Floats, R: Record>(
     let live = unsafe { lane_mask::<L>(shaded) };
     // The paths' random streams, drawn in lanes; the shaded lanes' are written back before
     // the scalar code draws again (`scatter_diffuse`'s roulette).
-    let mut rng = Streams::load(slots.iter().map(|s| &s.sampler));
-    let keep = |rng: &Streams, slots: &mut [PathSlot<R>]| {
+    let mut rng = S::load(slots.iter().map(|s| &s.sampler));
+    let keep = |rng: &S, slots: &mut [PathSlot<R>]| {
         for i in Bits(shaded) {
             slots[i].sampler = rng.sampler(i);
         }
@@ -725,14 +758,14 @@ impl AreaRays {
     /// two more numbers of the lane's stream in `rng` (`environment_sample`); a point light
     /// has its term apart (`light_term`).
     #[inline(always)]
-    fn sample<L>(
+    fn sample<L, S: Streams>(
         &mut self,
         tr: &Tracer,
         at: &Vertices<L>,
         (i, d): (usize, Vec3A),
         chosen: Chosen,
         u: (f32, f32),
-        rng: &mut Streams,
+        rng: &mut S,
     ) {
         match chosen {
             Chosen::Area(light, pmf) => {
@@ -1057,8 +1090,8 @@ impl TrianglePoints {
 /// The numbers `one_light` and `area_lights` draw for a light sample, in lanes: `u` (53 bits)
 /// chooses the light, `u1` and `u2` a point on an area light.
 #[inline(always)]
-fn light_numbers(
-    rng: &mut Streams,
+fn light_numbers<S: Streams>(
+    rng: &mut S,
     lanes: usize,
 ) -> ([f64; MAX_LANES], [f32; MAX_LANES], [f32; MAX_LANES]) {
     let u = rng.next_f64(lanes);
