@@ -12,7 +12,7 @@ use rtis::light::Sky;
 use rtis::material::microfacet::Microfacet;
 use rtis::material::{Bsdf, Coating};
 use rtis::render::estimate::{self, human_seconds};
-use rtis::sampling::PixelFilter;
+use rtis::sampling::{PixelFilter, SamplerKind};
 use rtis::scene::Scene;
 use rtis::shader::Shader;
 use rtis::texture::{MaterialTextures, Texture, TextureKind};
@@ -253,9 +253,13 @@ pub fn to_ron(scene: &Scene) -> String {
         PixelFilter::Box => String::new(),
         PixelFilter::Gaussian { stddev } => format!(", filter: Gaussian(stddev: {})", num(stddev)),
     };
+    let sampler = match f.sampler {
+        SamplerKind::Independent => "",
+        SamplerKind::Sobol => ", sampler: Sobol",
+    };
     let _ = writeln!(
         out,
-        "    film: (width: {}, height: {}, spp: {}, transfer: {:?}{filter}),",
+        "    film: (width: {}, height: {}, spp: {}, transfer: {:?}{filter}{sampler}),",
         f.width, f.height, f.spp, f.transfer
     );
     let c = &s.camera;

@@ -120,8 +120,8 @@ impl RenderArgs {
     }
 }
 
-/// The film size, spp and seed of a render where the command line overrides the scene's (the
-/// same for `rtis replay`, whose sample depends on them).
+/// The film size, spp, sampler and seed of a render where the command line overrides the
+/// scene's (the same for `rtis replay`, whose sample depends on them).
 #[derive(Args, Debug, Clone, Copy)]
 pub struct Overrides {
     /// Override the film width in pixels (1 to 32768; alone, the height keeps the aspect ratio).

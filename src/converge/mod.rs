@@ -144,11 +144,11 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
             };
             // The first curve's strategy with the other sampler: what stratified numbers buy
             // (or, where the film asks for Sobol' points, what independent ones cost).
-            let (other, name) = match scene.film.sampler {
-                SamplerKind::Independent => (SamplerKind::Sobol, "Path Sobol'"),
-                SamplerKind::Sobol => (SamplerKind::Independent, "Path independent"),
+            let (other, which) = match scene.film.sampler {
+                SamplerKind::Independent => (SamplerKind::Sobol, "Sobol'"),
+                SamplerKind::Sobol => (SamplerKind::Independent, "independent"),
             };
-            let first = curves[0].1;
+            let (name, first) = (format!("{} {which}", curves[0].0), curves[0].1);
             for (family, path) in curves {
                 for spp in [1, 4, 16, 64, 256] {
                     rungs.push(rung(family, format!("spp={spp}"), Shader::Path(path), spp));
@@ -157,7 +157,7 @@ pub fn ladder(scene: &RenderScene) -> Vec<Rung> {
             for spp in [1, 4, 16, 64, 256] {
                 rungs.push(Rung {
                     sampler: Some(other),
-                    ..rung(name, format!("spp={spp}"), Shader::Path(first), spp)
+                    ..rung(&name, format!("spp={spp}"), Shader::Path(first), spp)
                 });
             }
             // Rough materials: the same spp ladder with every microfacet sampler drawing all

@@ -626,8 +626,8 @@ pub fn sobol_case() -> Case {
 
 /// Every sampler rtis uses: the Sobol' sampler's points, the thin lens's points, uniform and
 /// cosine hemisphere, the Phong lobe at three exponents, the BRDF mixture of Path at two
-/// materials and views, the Fresnel choice of glass, the area-light samplers, the microfacet reflection samplers ([`microfacet_cases`]) and the
-/// BSDFs' ([`bsdf_cases`]).
+/// materials and views, the Fresnel choice of glass, the area-light samplers, the microfacet
+/// reflection samplers ([`microfacet_cases`]) and the BSDFs' ([`bsdf_cases`]).
 pub fn cases() -> Vec<Case> {
     let white = Phong {
         kd: Vec3A::ONE,

@@ -4,8 +4,9 @@ use super::Sampler;
 
 /// The image-plane offset in `[0, 1)^2` of sample `i` of `spp` inside a pixel.
 ///
-/// One sample goes through the pixel centre. Under the Sobol' sampler, every other sample is
-/// its first 2D point (stratified over the pixel's samples already). Otherwise a square count
+/// One sample goes through the pixel centre. With more, under the Sobol' sampler each sample's
+/// offset is its first 2D point (stratified over the pixel's samples already); otherwise a
+/// square count
 /// `m^2` jitters one sample in each cell of an `m x m` grid; any other count uses
 /// Latin-hypercube (n-rooks) strata, one row and one column of an `spp x spp` grid per sample,
 /// with the column order shuffled per pixel by `perm_seed` so the strata stay independent.

@@ -382,6 +382,18 @@ mod tests {
             })
             .collect();
         assert_eq!(points.len(), 10_000, "two pixels drew the same point");
+        // Keys that share a half still draw apart: both halves seed every dimension.
+        for half in [0, 1] {
+            let (mut a, mut b) = ([0x1234_5678, 0x9abc_def0], [0x1234_5678, 0x9abc_def0]);
+            b[half] ^= 1;
+            assert!(
+                (0..8).any(|d| point_2d(a, 0, d) != point_2d(b, 0, d)),
+                "half {half}"
+            );
+            a[1 - half] = 7;
+            b[1 - half] = 7;
+            assert!((0..8).any(|d| point_1d(a, 3, d) != point_1d(b, 3, d)));
+        }
     }
 
     /// `SobolLanes` draws each lane's own numbers.

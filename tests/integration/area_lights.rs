@@ -404,9 +404,10 @@ proptest! {
 ///
 /// With either sampler: the Sobol' sampler's images agree too, and its squared error against
 /// the reference over the pixels away from the light is below 0.8 of the independent one's
-/// (measured at 32 spp: 0.65 here, 0.67 with seeds 1 and 2; at 64 spp 0.62). Beside the light (within a
-/// pixel of one above 1.2) the error is that of long paths in the 0.01 gap between the light
-/// and the ceiling, which a 32-point set stratifies little, and its share swings with the seed.
+/// (measured at 32 spp: 0.65 here, 0.67 with seeds 1 and 2; at 64 spp 0.62). Beside the
+/// light (within a pixel of one above 1.2) the error is that of long paths in the 0.01 gap
+/// between the light and the ceiling, which a 32-point set stratifies little, and its share
+/// swings with the seed.
 #[test]
 fn mitsuba_cornell_box_with_an_area_light() {
     let reference = common::mitsuba_reference("mitsuba_cornell_area_128_spp4096.exr");

@@ -146,7 +146,21 @@ fn check_output_reads_back_as_the_same_scene() {
         .unwrap()
         .map(|e| e.unwrap().path());
     let textured = ["texture.ron", "texture_rough.ron"].map(|f| Path::new("tests/data").join(f));
-    for path in scenes.chain(textured) {
+    // A film of Sobol' points, which no scene in `scenes/` asks for.
+    std::fs::create_dir_all(d.join("own")).unwrap();
+    let sobol = d.join("own").join("sobol.ron");
+    std::fs::write(
+        &sobol,
+        "Scene(film: (width: 8, height: 6, spp: 4, sampler: Sobol), entities: [])",
+    )
+    .unwrap();
+    let first = rtis(&["check", sobol.to_str().unwrap()]);
+    assert!(
+        body(&first.stdout).contains("spp: 4, transfer: Srgb, sampler: Sobol)"),
+        "{}",
+        body(&first.stdout)
+    );
+    for path in scenes.chain(textured).chain([sobol]) {
         if path.extension().is_none_or(|e| e != "ron") {
             continue;
         }
@@ -531,6 +545,15 @@ fn sampler_override_is_the_films_sampler() {
     let flag = render("flag.exr", &args);
     assert_eq!(film, flag, "--sampler sobol against the film's sampler");
     assert_ne!(film, independent);
+    // And back: `--sampler independent` on the Sobol' film.
+    let back = render(
+        "back.exr",
+        &[scene.to_str().unwrap(), "--sampler", "independent"],
+    );
+    assert_eq!(
+        back, independent,
+        "--sampler independent on a film of Sobol' points"
+    );
     let o = rtis(&["render", plain.to_str().unwrap(), "--sampler", "halton"]);
     assert!(
         !o.status.success() && stderr(&o).contains("halton"),

@@ -114,6 +114,16 @@ fn sensor_film_and_sampler() {
         };
         assert_eq!(s.film.sampler, want, "{kind}");
     }
+    // A count that Mitsuba's rounding takes past rtis's limit names both counts.
+    let e = import(
+        "orthogonal-cap",
+        &scene(r#"<sensor type="perspective"><sampler type="orthogonal"><integer name="sample_count" value="1048576"/></sampler></sensor>"#),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("`sample_count` 1048576, which Mitsuba's `orthogonal` rounds up to 1062961"),
+        "{e}"
+    );
     // `jitter` belongs to the stratified samplers: on an `ldsampler` it is not read.
     let e = import(
         "ld-jitter",

@@ -371,8 +371,9 @@ impl<L: Floats, R: Record> WithStreams for Shade<'_, '_, '_, L, R> {
 
     #[inline(always)]
     fn run<S: Streams>(self) {
-        // SAFETY: `at` holds values of `L`, so the CPU runs `L`'s instruction set (a `Shade`
-        // is made only in `round_in`, whose caller vouches for it).
+        // SAFETY: `at` holds values of `L`, which only code running `L`'s instruction set can
+        // make (every `Floats` constructor is `unsafe`); and `Shade`, private to this module,
+        // is made only in `round_in`, whose caller vouches for that instruction set.
         unsafe {
             shade_in::<L, R, S>(
                 self.tr,
