@@ -153,8 +153,9 @@ AREA_STRATEGIES = [
 
 
 def rtis_runs(text, strategies, spp, d):
-    """rtis's runs: for each strategy, a function that renders it once and returns (seconds,
-    image), the scene file written once into the folder `d`."""
+    """rtis's runs: for each strategy, a function that renders it once under a seed (the
+    scene's, 0, by default) and returns (seconds, image), the scene file written once into the
+    folder `d`."""
     rtis = os.path.join(ROOT, "target/release/rtis")
     runs = []
     for k, (label, strategy, sampler) in enumerate(strategies):
@@ -166,10 +167,10 @@ def rtis_runs(text, strategies, spp, d):
         with open(scene_file, "w") as f:
             f.write(scene)
 
-        def run(scene_file=scene_file):
+        def run(seed=0, scene_file=scene_file):
             out, stats = os.path.join(d, "rtis.exr"), os.path.join(d, "stats.json")
-            subprocess.run([rtis, "render", scene_file, "--spp", str(spp), "-o", out, "--stats", stats],
-                           check=True, stderr=subprocess.DEVNULL)
+            subprocess.run([rtis, "render", scene_file, "--spp", str(spp), "--seed", str(seed), "-o", out,
+                            "--stats", stats], check=True, stderr=subprocess.DEVNULL)
             # The render's own seconds, from its first pixel to its last: as Mitsuba's are
             # timed, without loading the scene (its BVH built) and writing the image.
             with open(stats) as f:
@@ -180,16 +181,17 @@ def rtis_runs(text, strategies, spp, d):
 
 
 def mitsuba_run(mi, scene, spp, variant, label=None):
-    """Mitsuba's run: a function that renders once and returns (seconds, image); its kernels
+    """Mitsuba's run: a function that renders once under a seed (its default, 0, unless given)
+    and returns (seconds, image); its kernels
     are compiled first, outside the timing, by a render at the same spp (a kernel depends on
     it: `render` coalesces its passes from 4 spp on and folds the spp into the kernel) whose
     image is read (Dr.Jit is lazy: a render never read runs nothing, and the first timed one
     then compiled its kernels, twice the time of the others on the area box)."""
     np.array(mi.render(scene, spp=spp))
 
-    def run():
+    def run(seed=0):
         t = time.perf_counter()
-        img = np.array(mi.render(scene, spp=spp))
+        img = np.array(mi.render(scene, spp=spp, seed=seed))
         return time.perf_counter() - t, img
 
     return (label or "Mitsuba 3 " + variant, run)
@@ -204,8 +206,10 @@ def compare(name, mi, args):
 def measure(name, mi, args, tmp):
     """One scene: (width, height, reference noise RMSE, rows), each row (label, seconds of each
     round, RMSE). Each round renders Mitsuba and every rtis strategy once, Mitsuba first in
-    even rounds and last in odd ones; the images are the same in every round (fixed seeds),
-    so the RMSE is the first round's."""
+    even rounds and last in odd ones; the images are the same in every round (fixed seeds).
+    The RMSE is the root of the mean squared error of the first round's image and of
+    `--error-seeds` more renders under other seeds (ERROR_SEEDS, none the full box's reference
+    uses), untimed: one image's error swings with its few brightest pixels."""
     if name == "diffuse":
         ref = read_exr(os.path.join(ROOT, "tests/data/cornell_rtis_diffuse_360x288_dinf_spp4096.exr"))
         noise, size = 0.007, (360, 288)
@@ -232,7 +236,13 @@ def measure(name, mi, args, tmp):
                                 f"Mitsuba 3 {args.variant}, ldsampler"))
         runs += rtis_runs(AREA, AREA_STRATEGIES, args.spp, tmp)
     seconds = [[] for _ in runs]
-    errors = [None for _ in runs]
+    squared = [[] for _ in runs]
+
+    def error(k, img):
+        # rtis's camera is left-handed: its image is Mitsuba's mirrored left-right.
+        mitsuba = runs[k][0].startswith("Mitsuba")
+        squared[k].append(rmse(img if mitsuba else img[:, ::-1, :], ref) ** 2)
+
     for r in range(args.rounds):
         order = list(range(len(runs)))
         if r % 2 == 1:
@@ -240,11 +250,18 @@ def measure(name, mi, args, tmp):
         for k in order:
             t, img = runs[k][1]()
             seconds[k].append(t)
-            if errors[k] is None:
-                # rtis's camera is left-handed: its image is Mitsuba's mirrored left-right.
-                mitsuba = runs[k][0].startswith("Mitsuba")
-                errors[k] = rmse(img if mitsuba else img[:, ::-1, :], ref)
+            if r == 0:
+                error(k, img)
+    for k in range(len(runs)):
+        for seed in ERROR_SEEDS[:args.error_seeds]:
+            error(k, runs[k][1](seed)[1])
+    errors = [float(np.sqrt(np.mean(s))) for s in squared]
     return size, noise, [(label, s, e) for (label, _), s, e in zip(runs, seconds, errors)]
+
+
+# The seeds of the renders that only measure error: not 0 (the timed renders'), nor 1 and 2
+# (the halves of the full box's Mitsuba reference).
+ERROR_SEEDS = [10, 11, 12, 13, 14, 15, 16, 17]
 
 
 def interval(values):
@@ -259,6 +276,8 @@ def main():
     ap.add_argument("--reference-spp", type=int, default=1024)
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--rounds", type=int, default=5, help="renders of each renderer and strategy")
+    ap.add_argument("--error-seeds", type=int, default=3, choices=range(0, 9),
+                    help="more renders under other seeds for the RMSE (untimed)")
     args = ap.parse_args()
     if args.rounds < 1:
         sys.exit("--rounds must be at least 1")
@@ -270,7 +289,7 @@ def main():
 
     mi.set_variant(args.variant)
     report = {"spp": args.spp, "variant": args.variant, "reference_spp": args.reference_spp,
-              "rounds": args.rounds, "scenes": {}}
+              "rounds": args.rounds, "error_seeds": args.error_seeds, "scenes": {}}
     for name in args.scenes.split(","):
         (w, h), noise, rows = compare(name, mi, args)
         samples = w * h * args.spp

@@ -612,7 +612,8 @@ def mitsuba(_runs):
             )
         lines.append("")
     return "\n".join(lines + [stamp(f"`bench/mitsuba_compare.py --spp {r['spp']}` ({r['variant']}; "
-                                    f"{r['rounds']} rounds, medians; the full box's reference at "
+                                    f"{r['rounds']} rounds, medians; RMSE over {1 + r['error_seeds']} seeds; "
+                                    f"the full box's reference at "
                                     f"{r['reference_spp']} spp)")])
 
 
