@@ -466,7 +466,7 @@ pub fn environment_case(name: &str, light: EnvironmentLight) -> Case {
     Case {
         name: name.into(),
         draw: Box::new(move |s: &mut Sampler| {
-            let (u1, u2) = (s.next_f64(), s.next_f64());
+            let (u1, u2) = s.next_2d_f64();
             Some(direction_bin(light.sample(u1, u2)?.wi))
         }),
         expected,

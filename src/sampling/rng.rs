@@ -84,6 +84,13 @@ impl Pcg32 {
         to_f32(self.next_u32())
     }
 
+    /// Two numbers of [`Pcg32::next_f64`], in order.
+    #[inline]
+    pub fn next_2d_f64(&mut self) -> (f64, f64) {
+        let x = self.next_f64();
+        (x, self.next_f64())
+    }
+
     /// A uniform number in `[0, 1)` with 53 random bits (two draws), for choices among many
     /// options whose probabilities are finer than `next_f32`'s grid of 2^-24.
     #[inline]
@@ -168,13 +175,13 @@ impl PcgLanes {
         (x, self.next_f32(lanes))
     }
 
-    /// [`Pcg32::next_f64`] in lane `i` alone (a draw the other lanes do not make).
+    /// [`Pcg32::next_2d_f64`] in lane `i` alone.
     #[inline(always)]
-    pub fn next_f64_at(&mut self, i: usize) -> f64 {
+    pub fn next_2d_f64_at(&mut self, i: usize) -> (f64, f64) {
         let mut s = self.sampler(i);
-        let x = s.next_f64();
+        let v = s.next_2d_f64();
         self.state[i] = s.state;
-        x
+        v
     }
 
     /// [`Pcg32::next_f64`] in the first `lanes` lanes.
@@ -223,10 +230,9 @@ mod tests {
             }
             // A draw of one lane alone.
             let last = lanes as usize - 1;
-            assert_eq!(
-                streams.next_f64_at(last).to_bits(),
-                own[last].next_f64().to_bits()
-            );
+            let (a, b) = streams.next_2d_f64_at(last);
+            let (c, d) = own[last].next_2d_f64();
+            assert_eq!((a.to_bits(), b.to_bits()), (c.to_bits(), d.to_bits()));
             for (i, s) in own.iter().enumerate() {
                 assert_eq!(streams.sampler(i).state, s.state);
             }

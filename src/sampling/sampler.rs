@@ -69,6 +69,16 @@ impl Sampler {
         }
     }
 
+    /// A 2D point in `[0, 1)^2` with 53 random bits a coordinate, for a choice among many
+    /// cells in two dimensions (an environment map's rows and columns).
+    #[inline(always)]
+    pub fn next_2d_f64(&mut self) -> (f64, f64) {
+        match self {
+            Sampler::Independent(s) => s.next_2d_f64(),
+            Sampler::Sobol(s) => s.next_2d_f64(),
+        }
+    }
+
     /// Two uniform numbers in `[0, 1)`: a 2D point.
     #[inline(always)]
     pub fn next_2d(&mut self) -> (f32, f32) {
@@ -119,11 +129,11 @@ pub trait Streams: Copy {
     /// [`Sampler::next_f64`] in the first `lanes` lanes.
     fn next_f64(&mut self, lanes: usize) -> [f64; LANES];
 
-    /// [`Sampler::next_f64`] in lane `i` alone (a draw the other lanes do not make).
-    fn next_f64_at(&mut self, i: usize) -> f64;
-
     /// [`Sampler::next_2d`] in the first `lanes` lanes: the two coordinates' arrays.
     fn next_2d(&mut self, lanes: usize) -> ([f32; LANES], [f32; LANES]);
+
+    /// [`Sampler::next_2d_f64`] in lane `i` alone (a draw the other lanes do not make).
+    fn next_2d_f64_at(&mut self, i: usize) -> (f64, f64);
 }
 
 /// Work to run with the [`Streams`] of a sampler's kind ([`Sampler::with_streams`]): a
@@ -168,13 +178,13 @@ impl Streams for PcgLanes {
     }
 
     #[inline(always)]
-    fn next_f64_at(&mut self, i: usize) -> f64 {
-        PcgLanes::next_f64_at(self, i)
+    fn next_2d(&mut self, lanes: usize) -> ([f32; LANES], [f32; LANES]) {
+        PcgLanes::next_2d(self, lanes)
     }
 
     #[inline(always)]
-    fn next_2d(&mut self, lanes: usize) -> ([f32; LANES], [f32; LANES]) {
-        PcgLanes::next_2d(self, lanes)
+    fn next_2d_f64_at(&mut self, i: usize) -> (f64, f64) {
+        PcgLanes::next_2d_f64_at(self, i)
     }
 }
 
@@ -203,12 +213,12 @@ impl Streams for SobolLanes {
     }
 
     #[inline(always)]
-    fn next_f64_at(&mut self, i: usize) -> f64 {
-        SobolLanes::next_f64_at(self, i)
+    fn next_2d(&mut self, lanes: usize) -> ([f32; LANES], [f32; LANES]) {
+        SobolLanes::next_2d(self, lanes)
     }
 
     #[inline(always)]
-    fn next_2d(&mut self, lanes: usize) -> ([f32; LANES], [f32; LANES]) {
-        SobolLanes::next_2d(self, lanes)
+    fn next_2d_f64_at(&mut self, i: usize) -> (f64, f64) {
+        SobolLanes::next_2d_f64_at(self, i)
     }
 }

@@ -158,6 +158,19 @@ impl Sobol {
         to_f64(x, low_bits(x, key, dim) << 11)
     }
 
+    /// The next dimension's 2D point in `[0, 1)^2`, 53 bits a coordinate (the 32 of the point,
+    /// then 21 hashed as [`Sobol::next_f64`]'s).
+    pub fn next_2d_f64(&mut self) -> (f64, f64) {
+        let (key, dim) = (self.key, self.dim);
+        let (x, y) = point_2d(key, self.index, dim);
+        self.dim = self.dim.wrapping_add(1);
+        let low = low_bits(x, key, dim);
+        (
+            to_f64(x, low << 11),
+            to_f64(y, low_bits(y ^ low, key, dim) << 11),
+        )
+    }
+
     /// The next dimension's 2D point in `[0, 1)^2`.
     #[inline(never)]
     pub fn next_2d(&mut self) -> (f32, f32) {
@@ -244,13 +257,13 @@ impl SobolLanes {
         out
     }
 
-    /// [`Sobol::next_f64`] in lane `i` alone.
+    /// [`Sobol::next_2d_f64`] in lane `i` alone.
     #[inline(always)]
-    pub fn next_f64_at(&mut self, i: usize) -> f64 {
+    pub fn next_2d_f64_at(&mut self, i: usize) -> (f64, f64) {
         let mut s = self.sampler(i);
-        let x = s.next_f64();
+        let v = s.next_2d_f64();
         self.dim[i] = s.dim;
-        x
+        v
     }
 
     /// [`Sobol::next_2d`] in the first `lanes` lanes: the two coordinates' arrays.
@@ -328,6 +341,10 @@ mod tests {
                         s.dim = dim;
                         let p = point_2d(s.key, i, dim);
                         assert_eq!(p.0, point_1d(s.key, i, dim), "the 1D draw is the 2D's x");
+                        // The 53-bit draw's first 32 bits are the point's.
+                        let (x, y) = Sobol { dim, ..s }.next_2d_f64();
+                        let top = |v: f64| (v * 2f64.powi(32)) as u32;
+                        assert_eq!((top(x), top(y)), p, "the 53-bit draw");
                         p
                     })
                     .collect();
@@ -415,10 +432,9 @@ mod tests {
                 }
             }
             let last = lanes as usize - 1;
-            assert_eq!(
-                streams.next_f64_at(last).to_bits(),
-                own[last].next_f64().to_bits()
-            );
+            let (a, b) = streams.next_2d_f64_at(last);
+            let (c, d) = own[last].next_2d_f64();
+            assert_eq!((a.to_bits(), b.to_bits()), (c.to_bits(), d.to_bits()));
             for (i, s) in own.iter().enumerate() {
                 assert_eq!(streams.sampler(i).dim, s.dim);
             }

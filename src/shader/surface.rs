@@ -588,7 +588,7 @@ fn environment_sample<L: Lobe>(
     pmf: f32,
     mis: Option<Sampling>,
 ) -> Vec3A {
-    let (v1, v2) = (tr.sampler.next_f64(), tr.sampler.next_f64());
+    let (v1, v2) = tr.sampler.next_2d_f64();
     let Some(ls) = env.sample(v1, v2) else {
         return Vec3A::ZERO;
     };

@@ -774,7 +774,7 @@ impl AreaRays {
                 self.record(tr, at, i, d, ls, pmf);
             }
             Chosen::Environment(env, pmf) => {
-                let v = (rng.next_f64_at(i), rng.next_f64_at(i));
+                let v = rng.next_2d_f64_at(i);
                 self.record(tr, at, i, d, env.sample(v.0, v.1), pmf);
             }
             Chosen::Point(..) => {}
