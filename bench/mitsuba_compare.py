@@ -17,7 +17,8 @@ machine's state:
 For each it prints seconds (each renderer's render alone: Mitsuba's `render` call after a first
 call has compiled its kernels, rtis's render from its first pixel to its last as `--stats`
 reports it; neither counts loading the scene, building its BVH or writing the image), samples
-per second, RMSE against the reference and the
+per second, RMSE against the reference (over the timed image and --error-seeds more renders
+under other seeds, untimed) and the
 renderer's own RMSE (the reference's noise taken out), and the time each needs to reach the
 smallest own error (RMSE falls as 1/sqrt(spp); exactly so for independent samplers, while a
 low-discrepancy sampler's falls faster, so its row's time is exact only where its error is the
@@ -33,7 +34,7 @@ Setup (once):
 
 Usage:
     .venv/bin/python bench/mitsuba_compare.py [--spp 64] [--scenes diffuse,full,area]
-        [--reference-spp 1024] [--variant llvm_ad_rgb] [--rounds 5]
+        [--reference-spp 1024] [--variant llvm_ad_rgb] [--rounds 5] [--error-seeds 3]
 
 Each renderer and strategy renders --rounds times, the rounds interleaved (Mitsuba first in
 even rounds, last in odd ones), so that each round's ratios compare runs that saw the same
@@ -259,9 +260,9 @@ def measure(name, mi, args, tmp):
     return size, noise, [(label, s, e) for (label, _), s, e in zip(runs, seconds, errors)]
 
 
-# The seeds of the renders that only measure error: not 0 (the timed renders'), nor 1 and 2
-# (the halves of the full box's Mitsuba reference).
-ERROR_SEEDS = [10, 11, 12, 13, 14, 15, 16, 17]
+# The seeds of the renders that only measure error: none of the timed renders' (0), the full
+# box's Mitsuba reference halves' (1, 2) or the area box reference's (0 to 15).
+ERROR_SEEDS = [100, 101, 102, 103, 104, 105, 106, 107]
 
 
 def interval(values):

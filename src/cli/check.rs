@@ -244,7 +244,8 @@ fn shader(s: &Shader) -> String {
     }
 }
 
-/// The scene as RON text, every default written out (see the module documentation).
+/// The scene as RON text, every default written out but the box filter and the independent
+/// sampler (see the module documentation).
 pub fn to_ron(scene: &Scene) -> String {
     let s = &scene.settings;
     let mut out = String::from("Scene(\n");

@@ -460,7 +460,8 @@ pub fn grey_map(w: usize, h: usize, f: impl Fn(usize, usize) -> f32) -> Sky {
     }
 }
 
-/// The environment light's sampler (two 53-bit numbers), against the density it claims.
+/// The environment light's sampler (a 2D point of 53-bit coordinates), against the density it
+/// claims.
 pub fn environment_case(name: &str, light: EnvironmentLight) -> Case {
     let expected = integrate_pdf_peaked(|w| light.pdf(w) as f64);
     Case {

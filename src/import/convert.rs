@@ -886,17 +886,17 @@ fn sensor(o: &Object, paths: &Paths) -> Result<(String, String), SceneError> {
                 sampler = match kind {
                     "independent" => "",
                     "stratified" | "multijitter" | "orthogonal" | "ldsampler" => {
-                        let rounded = match (1..=1 << 20).contains(&spp) {
-                            true => mitsuba_sample_count(kind, spp),
-                            false => spp,
-                        };
-                        if rounded > 1 << 20 {
-                            return Err(child.pos.error(format!(
-                                "`sample_count` {spp}, which Mitsuba's `{kind}` rounds up to \
-                                 {rounded}: rtis takes 1 to 1048576"
-                            )));
+                        // (A count out of range already is refused below as written.)
+                        if (1..=1 << 20).contains(&spp) {
+                            let rounded = mitsuba_sample_count(kind, spp);
+                            if rounded > 1 << 20 {
+                                return Err(child.pos.error(format!(
+                                    "`sample_count` {spp}, which Mitsuba's `{kind}` rounds up \
+                                     to {rounded}: rtis takes 1 to 1048576"
+                                )));
+                            }
+                            spp = rounded;
                         }
-                        spp = rounded;
                         ", sampler: Sobol"
                     }
                     _ => {

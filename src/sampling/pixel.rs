@@ -6,10 +6,10 @@ use super::Sampler;
 ///
 /// One sample goes through the pixel centre. With more, under the Sobol' sampler each sample's
 /// offset is its first 2D point (stratified over the pixel's samples already); otherwise a
-/// square count
-/// `m^2` jitters one sample in each cell of an `m x m` grid; any other count uses
-/// Latin-hypercube (n-rooks) strata, one row and one column of an `spp x spp` grid per sample,
-/// with the column order shuffled per pixel by `perm_seed` so the strata stay independent.
+/// square count `m^2` jitters one sample in each cell of an `m x m` grid, and any other count
+/// uses Latin-hypercube (n-rooks) strata, one row and one column of an `spp x spp` grid per
+/// sample, with the column order shuffled per pixel by `perm_seed` so the strata stay
+/// independent.
 ///
 /// # Panics
 /// If `i` is not a sample of the pixel (`i >= spp`): a caller's range bug, refused here with

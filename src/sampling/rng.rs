@@ -231,8 +231,12 @@ mod tests {
             // A draw of one lane alone.
             let last = lanes as usize - 1;
             let (a, b) = streams.next_2d_f64_at(last);
+            let mut copy = own[last].clone();
             let (c, d) = own[last].next_2d_f64();
             assert_eq!((a.to_bits(), b.to_bits()), (c.to_bits(), d.to_bits()));
+            // Two `next_f64` in order: the numbers environment samples drew before it.
+            let (e, f) = (copy.next_f64(), copy.next_f64());
+            assert_eq!((c.to_bits(), d.to_bits()), (e.to_bits(), f.to_bits()));
             for (i, s) in own.iter().enumerate() {
                 assert_eq!(streams.sampler(i).state, s.state);
             }

@@ -158,8 +158,9 @@ impl Sobol {
         to_f64(x, low_bits(x, key, dim) << 11)
     }
 
-    /// The next dimension's 2D point in `[0, 1)^2`, 53 bits a coordinate (the 32 of the point,
-    /// then 21 hashed as [`Sobol::next_f64`]'s).
+    /// The next dimension's 2D point in `[0, 1)^2`, 53 bits a coordinate: the 32 of the point,
+    /// then 21 hashed, `x`'s as [`Sobol::next_f64`]'s, `y`'s from `y` and `x`'s.
+    #[inline(never)]
     pub fn next_2d_f64(&mut self) -> (f64, f64) {
         let (key, dim) = (self.key, self.dim);
         let (x, y) = point_2d(key, self.index, dim);
@@ -399,6 +400,10 @@ mod tests {
             })
             .collect();
         assert_eq!(points.len(), 10_000, "two pixels drew the same point");
+        // Keys that differ in the same bit of both halves (equal if the halves were xored)
+        // draw apart.
+        let (a, b) = ([0x1234_5678u32, 0x9abc_def0], [0x1234_5679u32, 0x9abc_def1]);
+        assert!((0..8).any(|d| point_2d(a, 0, d) != point_2d(b, 0, d)));
         // Keys that share a half still draw apart: both halves seed every dimension.
         for half in [0, 1] {
             let (mut a, mut b) = ([0x1234_5678, 0x9abc_def0], [0x1234_5678, 0x9abc_def0]);
@@ -433,8 +438,11 @@ mod tests {
             }
             let last = lanes as usize - 1;
             let (a, b) = streams.next_2d_f64_at(last);
+            let mut copy = own[last];
             let (c, d) = own[last].next_2d_f64();
             assert_eq!((a.to_bits(), b.to_bits()), (c.to_bits(), d.to_bits()));
+            // Its `x` is the 1D draw's of the same dimension.
+            assert_eq!(c.to_bits(), copy.next_f64().to_bits());
             for (i, s) in own.iter().enumerate() {
                 assert_eq!(streams.sampler(i).dim, s.dim);
             }

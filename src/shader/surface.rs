@@ -576,8 +576,9 @@ pub fn sample_area_light(
     Some(ls)
 }
 
-/// One sample of the environment light `env`, chosen with probability `pmf`, from two more
-/// 53-bit random numbers (its map's cells can be finer than f32's grid), weighed as
+/// One sample of the environment light `env`, chosen with probability `pmf`, from one more 2D
+/// point of 53-bit coordinates (`next_2d_f64`: its map's cells can be finer than f32's grid),
+/// weighed as
 /// [`area_sample`]'s.
 #[inline]
 fn environment_sample<L: Lobe>(

@@ -153,7 +153,7 @@ proptest! {
 
     /// Reciprocity where the lobes are: `wi` drawn from the BSDF itself (near the mirror or
     /// refracted direction, where random pairs rarely fall at low roughness), roughness 1e-2
-    /// to 1, indices from 5% away from 1. Same tolerance as above.
+    /// to 1, indices from 5% away from 1. Same tolerance and facet-horizon margin as above.
     #[test]
     fn every_bsdf_is_reciprocal_on_its_lobes(
         b in any_bsdf(), wo in unit(), uc in 0.0f32..1.0, u1 in 0.0f32..1.0, u2 in 0.0f32..1.0,
@@ -166,6 +166,12 @@ proptest! {
         // 1e-7 / |eta' - 1| (1e-3 at 1.0001), differs between the two orders.
         let near_one = matches!(b, Bsdf::RoughDielectric(d) if (d.eta - 1.0).abs() < 0.05 || (1.0 / d.eta - 1.0).abs() < 0.05);
         if s.delta || near_one || alpha < 1e-2 || wo.z.abs() <= 1e-2 || wi.z.abs() <= 1e-2 {
+            return Ok(());
+        }
+        // Off the horizon of the (generalised) half vector's facet, as above: 3e-2 or more
+        // (seen: 0.14% at `|wo.wm|` = 0.020 for a GGX dielectric of index 2.24).
+        let wm = (index(&b, wo) * wo + index(&b, wi) * wi).normalize_or_zero();
+        if wo.dot(wm).abs() <= 3e-2 || wi.dot(wm).abs() <= 3e-2 {
             return Ok(());
         }
         let (a, c) = (b.eval(wo, wi), b.eval(wi, wo));

@@ -124,6 +124,16 @@ fn sensor_film_and_sampler() {
         e.contains("`sample_count` 1048576, which Mitsuba's `orthogonal` rounds up to 1062961"),
         "{e}"
     );
+    // A count out of range as written is refused as written.
+    let e = import(
+        "stratified-over",
+        &scene(r#"<sensor type="perspective"><sampler type="stratified"><integer name="sample_count" value="2097152"/></sampler></sensor>"#),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("`sample_count` 2097152: rtis takes 1 to 1048576") && !e.contains("rounds"),
+        "{e}"
+    );
     // `jitter` belongs to the stratified samplers: on an `ldsampler` it is not read.
     let e = import(
         "ld-jitter",

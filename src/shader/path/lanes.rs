@@ -756,7 +756,8 @@ struct AreaColumns {
 impl AreaRays {
     /// Lane `i` of `at` (a shaded lane, whose ray has direction `d`) samples the light it
     /// chose: an area light from the random numbers `u` (`area_sample`), the environment from
-    /// two more numbers of the lane's stream in `rng` (`environment_sample`); a point light
+    /// one more 2D point of the lane's stream in `rng` (`next_2d_f64_at`, as
+    /// `environment_sample`); a point light
     /// has its term apart (`light_term`).
     #[inline(always)]
     fn sample<L, S: Streams>(
