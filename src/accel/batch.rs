@@ -101,6 +101,37 @@ unsafe fn chunk<L: Floats>(rays: &[Ray], k: usize) -> ([&Ray; MAX_LANES], L) {
 /// Segments in lanes: origins, unit directions, the origins' error bounds and the ends.
 pub type Segments<L> = ([L; 3], [L; 3], L, L);
 
+/// [`Segments`] written out as rows, to take lane by lane the rays of the lanes that go on
+/// alone (the one-ray query's, or an audit's).
+pub struct SegmentRows([[f32; MAX_LANES]; 8]);
+
+impl SegmentRows {
+    /// The rows of `segments`.
+    #[inline(always)]
+    pub fn new<L: Floats>((o, d, o_err, t_max): Segments<L>) -> Self {
+        let mut v = [[0.0f32; MAX_LANES]; 8];
+        for (row, x) in v
+            .iter_mut()
+            .zip([o[0], o[1], o[2], d[0], d[1], d[2], o_err, t_max])
+        {
+            x.write_to(row);
+        }
+        SegmentRows(v)
+    }
+
+    /// Lane `i`'s segment as a ray.
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        let v = &self.0;
+        Ray {
+            o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
+            d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
+            t_max: v[7][i],
+            o_err: v[6][i],
+        }
+    }
+}
+
 /// The leaf test of a packet's walk in [`Geometry::intersect_packet`]: ray `i`'s nearest hit
 /// in a block, the unit normal of the last one kept. A type of its own (not a closure) so that
 /// its test is inlined into the walk and compiled for the walk's instruction set.
@@ -384,23 +415,11 @@ impl Geometry {
                 false => (0, L::bitmask(live)),
             };
             if alone != 0 {
-                let mut v = [[0.0f32; MAX_LANES]; 8];
-                for (k, x) in [o[0], o[1], o[2], d[0], d[1], d[2], o_err, t_max]
-                    .into_iter()
-                    .enumerate()
-                {
-                    x.write_to(&mut v[k]);
-                }
+                let rows = SegmentRows::new((o, d, o_err, t_max));
                 while alone != 0 {
                     let i = alone.trailing_zeros() as usize;
                     alone &= alone - 1;
-                    let ray = Ray {
-                        o: glam::Vec3A::new(v[0][i], v[1][i], v[2][i]),
-                        d: glam::Vec3A::new(v[3][i], v[4][i], v[5][i]),
-                        t_max: v[7][i],
-                        o_err: v[6][i],
-                    };
-                    if self.occluded_tallied(&ray, planes, tally) {
+                    if self.occluded_tallied(&rows.ray(i), planes, tally) {
                         blocked |= 1 << i;
                     }
                 }

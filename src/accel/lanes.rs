@@ -94,6 +94,16 @@ pub fn array<L: Floats>(x: L) -> [f32; MAX_LANES] {
     a
 }
 
+/// Rows of lanes as vectors: `rows[k]`'s lanes in vector `k`.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+pub unsafe fn rows<L: Floats, const N: usize>(rows: &[[f32; MAX_LANES]; N]) -> [L; N] {
+    // SAFETY: the caller's.
+    std::array::from_fn(|k| unsafe { L::from_slice(&rows[k]) })
+}
+
 /// The lanes of the bits of `bits` as a mask.
 ///
 /// # Safety

@@ -11,7 +11,7 @@ mod small;
 pub mod tally;
 pub mod wide;
 
-pub use batch::{Nearest, NearestRows, Segments};
+pub use batch::{Nearest, NearestRows, SegmentRows, Segments};
 pub use bvh::{Bvh, Node};
 pub use prim::{FLAT, Prim};
 #[cfg(target_arch = "x86_64")]

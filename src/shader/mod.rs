@@ -118,27 +118,19 @@ impl Tracer<'_> {
     #[inline(always)]
     pub fn count_shadow_lanes<L: crate::accel::Floats>(
         &mut self,
-        (o, d, o_err, t_max): crate::accel::Segments<L>,
+        segments: crate::accel::Segments<L>,
         mask: u32,
     ) {
         self.stats.shadow += u64::from(mask.count_ones());
         let Some(audit) = self.audit else {
             return;
         };
-        let column = crate::accel::lanes::array::<L>;
-        let (o, d) = (o.map(column), d.map(column));
-        let (o_err, t_max) = (column(o_err), column(t_max));
+        let rows = crate::accel::SegmentRows::new(segments);
         let mut bits = mask;
         while bits != 0 {
             let i = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let ray = Ray {
-                o: glam::Vec3A::new(o[0][i], o[1][i], o[2][i]),
-                d: glam::Vec3A::new(d[0][i], d[1][i], d[2][i]),
-                t_max: t_max[i],
-                o_err: o_err[i],
-            };
-            audit(&ray, RayKind::Shadow);
+            audit(&rows.ray(i), RayKind::Shadow);
         }
     }
 

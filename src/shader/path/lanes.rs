@@ -25,7 +25,7 @@
 
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
-use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins};
+use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins, rows};
 use crate::accel::{Floats, Geometry, Isa, MAX_LANES, ShearLanes, Tally};
 use crate::geometry::{Hit, Ray};
 use crate::light::{
@@ -840,13 +840,8 @@ impl AreaRays {
         // The shadow rays, in lanes.
         let mut blocked = 0u32;
         if tr.effects.shadows && self.tested != 0 {
-            let load = |row: usize| unsafe { L::from_slice(&c.ray[row]) };
-            let segments = (
-                [load(0), load(1), load(2)],
-                [load(3), load(4), load(5)],
-                load(6),
-                load(7),
-            );
+            let [ox, oy, oz, dx, dy, dz, o_err, t_max] = unsafe { rows::<L, 8>(&c.ray) };
+            let segments = ([ox, oy, oz], [dx, dy, dz], o_err, t_max);
             let live = unsafe { lane_mask::<L>(self.tested) };
             let hidden = tr
                 .geometry
@@ -862,16 +857,8 @@ impl AreaRays {
         let seen = unsafe { lane_mask::<L>(self.tested & !blocked) };
         let (wi, le, pdf) = unsafe {
             (
-                [
-                    L::from_slice(&c.wi[0]),
-                    L::from_slice(&c.wi[1]),
-                    L::from_slice(&c.wi[2]),
-                ],
-                [
-                    L::from_slice(&c.le[0]),
-                    L::from_slice(&c.le[1]),
-                    L::from_slice(&c.le[2]),
-                ],
+                rows::<L, 3>(&c.wi),
+                rows::<L, 3>(&c.le),
                 L::from_slice(&c.pdf),
             )
         };
@@ -1042,19 +1029,7 @@ impl TrianglePoints {
         let b1 = L::select(lower, u2 - h1, h2);
         let b2 = (one - b0 - b1).max(zero);
         // The point, `b0 v0 + b1 v1 + b2 v2`, and the direction towards it.
-        let v: [L; 9] = unsafe {
-            [
-                L::from_slice(&self.v[0]),
-                L::from_slice(&self.v[1]),
-                L::from_slice(&self.v[2]),
-                L::from_slice(&self.v[3]),
-                L::from_slice(&self.v[4]),
-                L::from_slice(&self.v[5]),
-                L::from_slice(&self.v[6]),
-                L::from_slice(&self.v[7]),
-                L::from_slice(&self.v[8]),
-            ]
-        };
+        let v: [L; 9] = unsafe { rows(&self.v) };
         let q = [
             b0 * v[0] + b1 * v[3] + b2 * v[6],
             b0 * v[1] + b1 * v[4] + b2 * v[7],
@@ -1065,7 +1040,7 @@ impl TrianglePoints {
         let dist = d2.sqrt();
         let wi = [to[0] / dist, to[1] / dist, to[2] / dist];
         // `area_to_solid_angle`.
-        let nq = [load(&self.n[0]), load(&self.n[1]), load(&self.n[2])];
+        let nq: [L; 3] = unsafe { rows(&self.n) };
         let cos_q = dot(nq, wi).abs();
         let pdf = d2 / (load(&self.area) * cos_q);
         let inf = unsafe { L::splat(f32::INFINITY) };
@@ -1074,10 +1049,11 @@ impl TrianglePoints {
         // `emitted`: towards `-wi`, from the front or from both sides.
         let front = dot(nq, [-wi[0], -wi[1], -wi[2]]).cmpgt(zero);
         let lit = unsafe { lane_mask::<L>(self.two_sided) } | front;
+        let radiance: [L; 3] = unsafe { rows(&self.radiance) };
         let le = [
-            L::select(lit, load(&self.radiance[0]), zero),
-            L::select(lit, load(&self.radiance[1]), zero),
-            L::select(lit, load(&self.radiance[2]), zero),
+            L::select(lit, radiance[0], zero),
+            L::select(lit, radiance[1], zero),
+            L::select(lit, radiance[2], zero),
         ];
         TriangleSamples {
             wi: [array(wi[0]), array(wi[1]), array(wi[2])],
