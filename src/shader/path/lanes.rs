@@ -17,9 +17,9 @@
 //! (`tests/integration/path_waves.rs`). A spot or directional light's incident light
 //! (`Light::incident`) and an area-light or environment sample run the scalar code lane by
 //! lane (`surface::sample_area_light` or `EnvironmentLight::sample`, `light_ray` on
-//! `Interaction::flat`), except, where every light has its term at each vertex
-//! (`area_lights`), the point on an untextured triangle light, which is sampled in lanes
-//! (`AreaLight::sample`'s operations); its shadow ray is tested in
+//! `Interaction::flat`), except the point on an untextured triangle light (a rectangle's
+//! half, a mesh's face), which is sampled in lanes (`AreaLight::sample`'s operations), its
+//! shadow ray made in lanes too (`light_ray`'s). Every sample's shadow ray is tested in
 //! lanes, and its weight (`light_weighted`: the diffuse reflectance, the power heuristic
 //! against `brdf_pdf`) is computed in lanes too.
 
@@ -477,6 +477,7 @@ unsafe fn shade_in<L: Floats, R: Record, S: Streams>(
         let (u, u1, u2) = light_numbers(&mut rng, L::LANES);
         let place = choice_places(tr.emitters.cdf(), &u, L::LANES);
         let any_light = !tr.emitters.cdf().is_empty();
+        let mut on = TrianglePoints::default();
         for i in Bits(shaded) {
             let (u, u12) = (u[i], (u1[i], u2[i]));
             // The light and the factor of its term: `1 / pmf` by power, `1 / (share p)` by
@@ -491,9 +492,13 @@ unsafe fn shade_in<L: Floats, R: Record, S: Streams>(
                         .filter(|(_, w)| w.is_finite())
                 }
                 Some(Chosen::Point(j, w)) => Some((j, w)),
-                // An area light or the environment: its sample, for the lanes' shadow rays.
+                // An area light or the environment: its sample, for the lanes' shadow rays (an
+                // untextured triangle's point sampled in lanes below).
                 Some(c) if sample_area && tr.effects.emission => {
-                    area.sample(tr, at, (i, slots[i].st.ray.d), c, u12, &mut rng);
+                    match untextured_triangle(&c) {
+                        Some((t, light, pmf)) => on.put(i, t, light, pmf),
+                        None => area.sample(tr, at, (i, slots[i].st.ray.d), c, u12, &mut rng),
+                    }
                     None
                 }
                 // A light left to BRDF-sampled rays, or none.
@@ -552,6 +557,10 @@ unsafe fn shade_in<L: Floats, R: Record, S: Streams>(
             true => [term[0] * w, term[1] * w, term[2] * w],
             false => [term[0] / w, term[1] / w, term[2] / w],
         };
+        if on.lanes != 0 {
+            let samples = unsafe { on.sample::<L>(p_, &u1, &u2) };
+            unsafe { area.record_lanes(&surface, &samples, &on.pmf) };
+        }
         // The lanes that chose an area light take its term.
         let term = unsafe { area.terms(tr, &surface, mis, false) };
         let lanes = unsafe { lane_mask::<L>(area.lanes) };
@@ -612,10 +621,7 @@ unsafe fn shade_in<L: Floats, R: Record, S: Streams>(
             }
             if on.lanes != 0 {
                 let samples = unsafe { on.sample::<L>(p_, &u1, &u2) };
-                for i in Bits(on.lanes) {
-                    let ls = samples.get(i);
-                    area.record(tr, at, i, slots[i].st.ray.d, ls, on.pmf[i]);
-                }
+                unsafe { area.record_lanes(&surface, &samples, &on.pmf) };
             }
         }
         let area = unsafe { area.terms(tr, &surface, mis, true) };
@@ -815,6 +821,59 @@ impl AreaRays {
         self.tested |= 1 << i;
     }
 
+    /// The triangle lights' samples `s` of the lanes that chose one, each light chosen with
+    /// the chance in `pmf`: what [`AreaRays::record`] records for each, computed in lanes
+    /// (`light_ray` at `Interaction::flat`: no radiance, a direction not above the shading
+    /// normal or a density not positive leave no shadow ray; the ray leaves from the origin
+    /// on the side of the geometric normal it goes to and stops at `SHADOW_END` of the
+    /// distance).
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instruction set.
+    #[inline(always)]
+    unsafe fn record_lanes<L: Floats>(
+        &mut self,
+        at: &Surface<L>,
+        s: &TriangleSamples<L>,
+        pmf: &[f32; MAX_LANES],
+    ) {
+        self.lanes |= s.lanes;
+        // SAFETY: the caller's; so for every `unsafe` block below, each makes values of `L`.
+        let (zero, end) = unsafe { (L::splat(0.0), L::splat(SHADOW_END)) };
+        // `light_ray`'s tests: some radiance (`le != 0`), `wi` not below the shading normal
+        // (a Phong surface transmits nothing; a flat hit's normal is not bent, so nothing
+        // leaks), and `pmf pdf` neither NaN nor at most zero.
+        let lit = s.le[0].cmpne(zero) | s.le[1].cmpne(zero) | s.le[2].cmpne(zero);
+        let below = dot(s.wi, at.n).cmple(zero);
+        let pdf = unsafe { L::from_slice(pmf) } * s.pdf;
+        let ray = s.valid & lit & !below & pdf.cmpgt(zero);
+        let tested = L::bitmask(ray);
+        if tested == 0 {
+            return;
+        }
+        // `Origins::ray`: the origin on the side of the geometric normal `wi` leaves by.
+        let side = dot(at.nh, s.wi).cmpge(zero);
+        let o = [
+            L::select(side, at.front[0], at.back[0]),
+            L::select(side, at.front[1], at.back[1]),
+            L::select(side, at.front[2], at.back[2]),
+        ];
+        let c = self.columns.get_or_insert_with(Default::default);
+        // SAFETY: as above, for each `put`.
+        unsafe {
+            for x in 0..3 {
+                put(&mut c.ray[x], o[x], ray);
+                put(&mut c.ray[3 + x], s.wi[x], ray);
+                put(&mut c.wi[x], s.wi[x], ray);
+                put(&mut c.le[x], s.le[x], ray);
+            }
+            put(&mut c.ray[6], at.o_err, ray);
+            put(&mut c.ray[7], s.dist * end, ray);
+            put(&mut c.pdf, pdf, ray);
+        }
+        self.tested |= tested;
+    }
+
     /// The samples' terms `L_e r V w / (pmf pdf)` at the vertices of `at` (`light_term`: the
     /// shadow rays tested in lanes, then each visible sample weighted, `light_weighted`, in
     /// lanes too), zero in the lanes without a sample. With `summed`, each term as
@@ -890,6 +949,16 @@ impl AreaRays {
     }
 }
 
+/// Write `x` into the lanes of `row` that `mask` holds, keeping the others.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn put<L: Floats>(row: &mut [f32; MAX_LANES], x: L, mask: L::Mask) {
+    // SAFETY: the caller's.
+    L::select(mask, x, unsafe { L::from_slice(row) }).write_to(row);
+}
+
 /// `brdf_pdf` of a diffuse surface (every lane's material reflects diffusely only) in lanes,
 /// from the cosines `cos` of the directions with the shading normal: zero below the surface.
 ///
@@ -959,29 +1028,18 @@ struct TrianglePoints {
     pmf: [f32; MAX_LANES],
 }
 
-/// [`TrianglePoints::sample`]'s samples, a column per coordinate.
-struct TriangleSamples {
-    wi: [[f32; MAX_LANES]; 3],
-    dist: [f32; MAX_LANES],
-    le: [[f32; MAX_LANES]; 3],
-    pdf: [f32; MAX_LANES],
-    /// Lanes (bits) with a sample (a point apart from the vertex, of some density).
-    valid: u32,
-}
-
-impl TriangleSamples {
-    /// Lane `i`'s sample, as `AreaLight::sample` returns it.
-    #[inline(always)]
-    fn get(&self, i: usize) -> Option<LightSample> {
-        let at = |v: &[[f32; MAX_LANES]; 3]| Vec3A::new(v[0][i], v[1][i], v[2][i]);
-        (self.valid & (1 << i) != 0).then(|| LightSample {
-            wi: at(&self.wi),
-            dist: self.dist[i],
-            le: at(&self.le),
-            pdf: self.pdf[i],
-            uv: glam::Vec2::ZERO,
-        })
-    }
+/// [`TrianglePoints::sample`]'s samples in lanes: what `AreaLight::sample` returns, in the
+/// lanes of `valid`.
+struct TriangleSamples<L: Floats> {
+    wi: [L; 3],
+    dist: L,
+    le: [L; 3],
+    pdf: L,
+    /// Lanes with a sample (a point apart from the vertex, of some density) among those that
+    /// chose a triangle.
+    valid: L::Mask,
+    /// Lanes (bits) that chose a triangle.
+    lanes: u32,
 }
 
 impl TrianglePoints {
@@ -1017,7 +1075,7 @@ impl TrianglePoints {
         p: [L; 3],
         u1: &[f32; MAX_LANES],
         u2: &[f32; MAX_LANES],
-    ) -> TriangleSamples {
+    ) -> TriangleSamples<L> {
         // SAFETY: the caller's; so for every `unsafe` block below, each makes values of `L`.
         let (zero, one, two) = unsafe { (L::splat(0.0), L::splat(1.0), L::splat(2.0)) };
         let load = |row: &[f32; MAX_LANES]| unsafe { L::from_slice(row) };
@@ -1056,11 +1114,12 @@ impl TrianglePoints {
             L::select(lit, radiance[2], zero),
         ];
         TriangleSamples {
-            wi: [array(wi[0]), array(wi[1]), array(wi[2])],
-            dist: array(dist),
-            le: [array(le[0]), array(le[1]), array(le[2])],
-            pdf: array(pdf),
-            valid: L::bitmask(valid) & self.lanes,
+            wi,
+            dist,
+            le,
+            pdf,
+            valid: valid & unsafe { lane_mask::<L>(self.lanes) },
+            lanes: self.lanes,
         }
     }
 }
