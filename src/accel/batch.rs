@@ -472,7 +472,8 @@ impl Geometry {
                     )
                 };
                 let near = self.nearest_small(&ShearLanes::new(o, d, o_err), t_max);
-                hits.extend((0..n).map(|i| self.small_hit(&near, i, eight[i], tally)));
+                let records = self.small_records(&near, o, d);
+                hits.extend((0..n).map(|i| self.small_hit(&near, &records, i, eight[i], tally)));
                 continue;
             }
             let lanes = unsafe { RayLanes::<L>::gather(&eight) };

@@ -19,7 +19,7 @@ pub use simd::avx2::F8;
 #[cfg(target_arch = "x86_64")]
 pub use simd::avx512::F16;
 pub use simd::{Floats, Isa, MAX_LANES, require_all_isas};
-pub use small::{SMALL_SCENE, ShearLanes, SmallNearest};
+pub use small::{SMALL_SCENE, ShearLanes, SmallNearest, record_hit};
 pub use tally::{Tally, Traversal};
 pub use wide::{WideBvh, WideNode};
 

@@ -20,7 +20,7 @@
 //! compare the two on random scenes, grazing and spawned rays included.
 
 use super::block::Block;
-use super::lanes::array;
+use super::lanes::{array, dot};
 use super::simd::{Floats, Isa};
 use super::{Geometry, Tally};
 use crate::geometry::{Hit, Ray, gamma};
@@ -239,6 +239,21 @@ impl TriangleEach {
     }
 }
 
+/// Lane `i`'s hit on primitive `prim` at distance `t` ([`Geometry::small_met`]), its record
+/// read from the lanes' `records` ([`Geometry::small_records`]).
+#[inline(always)]
+pub fn record_hit(records: &[[f32; super::MAX_LANES]; 8], i: usize, (prim, t): (u32, f32)) -> Hit {
+    let r = |row: usize| records[row][i];
+    Hit {
+        t,
+        p: glam::Vec3A::new(r(0), r(1), r(2)),
+        n: glam::Vec3A::new(r(3), r(4), r(5)),
+        err: r(6),
+        err_along: r(7),
+        prim,
+    }
+}
+
 /// The nearest hits of rays in lanes among a small scene's triangles
 /// ([`Geometry::nearest_small`]).
 pub struct SmallNearest {
@@ -265,7 +280,8 @@ impl Geometry {
 
     /// The nearest hits of the rays in `r` within `t_max` among the triangles of a small scene
     /// ([`Geometry::is_small`]), as [`Geometry::intersect`] finds them (each lane tests
-    /// [`Geometry::lane_prims`] triangles). Read a lane's hit with [`Geometry::small_hit`].
+    /// [`Geometry::lane_prims`] triangles). Read a lane's hit with [`Geometry::small_hit`],
+    /// from the lanes' [`Geometry::small_records`].
     #[inline(always)]
     pub fn nearest_small<L: Floats>(&self, r: &ShearLanes<L>, t_max: L) -> SmallNearest {
         // SAFETY: `t_max` is a value of `L`, so the CPU runs its instruction set.
@@ -299,22 +315,119 @@ impl Geometry {
     }
 
     /// Lane `i`'s nearest hit in `near` ([`Geometry::nearest_small`]) of `ray`, the lane's
-    /// ray: its record as [`Geometry::intersect`] computes it, or that query's answer for a lane
-    /// the lanes could not settle.
+    /// ray, with `records` the lanes' [`Geometry::small_records`]: its record as
+    /// [`Geometry::intersect`] computes it, or that query's answer for a lane the lanes could
+    /// not settle.
     #[inline(always)]
     pub fn small_hit(
         &self,
         near: &SmallNearest,
+        records: &[[f32; super::MAX_LANES]; 8],
         i: usize,
         ray: &Ray,
         tally: &impl Tally,
     ) -> Option<Hit> {
-        if near.alone & (1 << i) != 0 {
-            return self.intersect_tallied(ray, tally);
+        match self.small_met(near, i) {
+            None => self.intersect_tallied(ray, tally),
+            Some(met) => met.map(|met| record_hit(records, i, met)),
         }
-        let tri = self.triangle_each.get(near.slot[i] as usize)?;
-        let n = glam::Vec3A::from_array(tri.n);
-        Some(self.nearest_record(ray, tri.prim, near.t[i], Some(n)))
+    }
+
+    /// What lane `i` of `near` ([`Geometry::nearest_small`]) found: `None` where the one-ray
+    /// query must answer it, else the primitive and distance of the triangle it met, if any.
+    #[inline(always)]
+    pub fn small_met(&self, near: &SmallNearest, i: usize) -> Option<Option<(u32, f32)>> {
+        if near.alone & (1 << i) != 0 {
+            return None;
+        }
+        Some(
+            self.triangle_each
+                .get(near.slot[i] as usize)
+                .map(|tri| (tri.prim, near.t[i])),
+        )
+    }
+
+    /// The records of the nearest hits in `near` ([`Geometry::nearest_small`]) of the rays
+    /// from `o` along `d` in lanes, as rows: the point (rows 0 to 2), the normal (3 to 5), and
+    /// the error bounds across and along the surface (6 and 7). `Triangle::surface`'s
+    /// operations in lanes, each lane on its own triangle, so a lane that met one (and that
+    /// the one-ray query need not answer) has the record [`Geometry::intersect`] computes, to
+    /// the bit ([`Geometry::small_hit`] reads it); the other lanes hold zeros.
+    #[inline(always)]
+    pub fn small_records<L: Floats>(
+        &self,
+        near: &SmallNearest,
+        o: [L; 3],
+        d: [L; 3],
+    ) -> [[f32; super::MAX_LANES]; 8] {
+        // Each lane's triangle: its vertices and normal, a column per coordinate.
+        let (mut v, mut n) = (
+            [[0.0f32; super::MAX_LANES]; 9],
+            [[0.0f32; super::MAX_LANES]; 3],
+        );
+        let mut met = 0u32;
+        for i in 0..L::LANES {
+            let Some(Some(_)) = self.small_met(near, i) else {
+                continue;
+            };
+            let tri = &self.triangle_each[near.slot[i] as usize];
+            for axis in 0..3 {
+                for (j, vertex) in tri.v.iter().enumerate() {
+                    v[3 * j + axis][i] = vertex[axis];
+                }
+                n[axis][i] = tri.n[axis];
+            }
+            met |= 1 << i;
+        }
+        // SAFETY: `o` holds values of `L`, so the CPU runs its instruction set; so for every
+        // `unsafe` block below, each makes values of `L`.
+        let (v, n, t): ([L; 9], [L; 3], L) = unsafe {
+            (
+                super::lanes::rows(&v),
+                super::lanes::rows(&n),
+                L::from_slice(&near.t),
+            )
+        };
+        let v0 = [v[0], v[1], v[2]];
+        // `Ray::at`, then the point moved onto the triangle's plane along its normal.
+        let p = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+        let s = dot(n, [p[0] - v0[0], p[1] - v0[1], p[2] - v0[2]]);
+        let p = [p[0] - s * n[0], p[1] - s * n[1], p[2] - s * n[2]];
+        // The error bounds: across the surface, by the largest coordinate of the vertices and
+        // the point; along it, by the distance's error (`gamma(5)` of the plane's terms over
+        // the cosine) and the point's. (Maxima of magnitudes are exact in any order.)
+        let mut m = [p[0].abs(), p[1].abs(), p[2].abs()];
+        for (axis, m) in m.iter_mut().enumerate() {
+            *m = v[axis]
+                .abs()
+                .max(v[3 + axis].abs())
+                .max(v[6 + axis].abs())
+                .max(*m);
+        }
+        let scale = m[0].max(m[1]).max(m[2]);
+        let an = [n[0].abs(), n[1].abs(), n[2].abs()];
+        let ao = [o[0].abs(), o[1].abs(), o[2].abs()];
+        // SAFETY: as above.
+        let (g3, g5, g7) = unsafe { (L::splat(gamma(3)), L::splat(gamma(5)), L::splat(gamma(7))) };
+        let reach = [
+            v0[0].abs() + ao[0],
+            v0[1].abs() + ao[1],
+            v0[2].abs() + ao[2],
+        ];
+        let dt = g5 * dot(an, reach) / dot(n, d).abs();
+        let err = g7 * scale;
+        let err_along = dt + g3 * (ao[0].max(ao[1]).max(ao[2]) + t.abs());
+        // Zeros where no triangle was met.
+        // SAFETY: as above.
+        let (zero, met) = unsafe { (L::splat(0.0), super::lanes::lane_mask::<L>(met)) };
+        let mut out = [[0.0f32; super::MAX_LANES]; 8];
+        for (row, x) in [p[0], p[1], p[2], n[0], n[1], n[2], err, err_along]
+            .into_iter()
+            .enumerate()
+        {
+            L::select(met, x, zero).write_to(&mut out[row]);
+        }
+        out
     }
 
     /// Which rays in `r`, of the lanes of `live`, are blocked within `t_max` by the

@@ -26,7 +26,7 @@
 use super::{Path, PathState};
 use crate::accel::lanes::SurfaceLanes;
 use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins, rows};
-use crate::accel::{Floats, Geometry, Isa, MAX_LANES, ShearLanes, Tally};
+use crate::accel::{Floats, Geometry, Isa, MAX_LANES, ShearLanes, Tally, record_hit};
 use crate::geometry::{Hit, Ray};
 use crate::light::{
     AreaLight, Chosen, Emitting, Light, LightSample, NO_LIGHT, choose_by_importance,
@@ -242,7 +242,7 @@ unsafe fn round_in<L: Floats, R: Record>(
             }
             near.hit
         } else {
-            // A small scene's triangles met in the lanes, each ray's record computed alone.
+            // A small scene's triangles met in the lanes, and their records computed there.
             let small = match geometry.is_small() {
                 true => {
                     tr.traversal.prims(count as u64 * geometry.lane_prims());
@@ -251,13 +251,22 @@ unsafe fn round_in<L: Floats, R: Record>(
                 }
                 false => None,
             };
-            let mut rows = [[0.0f32; MAX_LANES]; 8];
+            // The records of the triangles met in lanes, in rows (zeros elsewhere); the rays
+            // the lanes leave to the one-ray query, and every ray through the BVH, each alone.
+            let mut rows = match &small {
+                Some(near) => geometry.small_records(near, o, d),
+                None => [[0.0f32; MAX_LANES]; 8],
+            };
             for (i, hit) in hits.iter_mut().enumerate().take(count) {
                 let ray = &slots[c + i].st.ray;
-                *hit = match (&small, tr.traversal) {
-                    (Some(near), t) => geometry.small_hit(near, i, ray, &t),
-                    (None, None) => geometry.intersect(ray),
-                    (None, Some(t)) => geometry.intersect_tallied(ray, t),
+                // (`Geometry::small_hit`'s reading, with the one-ray query apart.)
+                if let Some(met) = small.as_ref().and_then(|near| geometry.small_met(near, i)) {
+                    *hit = met.map(|met| record_hit(&rows, i, met));
+                    continue;
+                }
+                *hit = match tr.traversal {
+                    None => geometry.intersect(ray),
+                    Some(t) => geometry.intersect_tallied(ray, t),
                 };
                 if let Some(h) = hit {
                     for x in 0..3 {
