@@ -870,8 +870,8 @@ impl AreaRays {
         let c = self.columns.get_or_insert_with(Default::default);
         // SAFETY: as above, for each `put`.
         unsafe {
-            for x in 0..3 {
-                put(&mut c.ray[x], o[x], ray);
+            for (x, o) in o.into_iter().enumerate() {
+                put(&mut c.ray[x], o, ray);
                 put(&mut c.ray[3 + x], s.wi[x], ray);
                 put(&mut c.wi[x], s.wi[x], ray);
                 put(&mut c.le[x], s.le[x], ray);
