@@ -20,7 +20,7 @@
 //! compare the two on random scenes, grazing and spawned rays included.
 
 use super::block::Block;
-use super::lanes::{array, dot};
+use super::lanes::{abs_max, array, dot};
 use super::simd::{Floats, Isa};
 use super::{Geometry, Tally};
 use crate::geometry::{Hit, Ray, gamma};
@@ -395,7 +395,8 @@ impl Geometry {
         let p = [p[0] - s * n[0], p[1] - s * n[1], p[2] - s * n[2]];
         // The error bounds: across the surface, by the largest coordinate of the vertices and
         // the point; along it, by the distance's error (`gamma(5)` of the plane's terms over
-        // the cosine) and the point's. (Maxima of magnitudes are exact in any order.)
+        // the cosine) and the point's. (Maxima in glam's operand order, `Vec3A::max` then
+        // `max_element`: the same even where a NaN makes the order matter.)
         let mut m = [p[0].abs(), p[1].abs(), p[2].abs()];
         for (axis, m) in m.iter_mut().enumerate() {
             *m = v[axis]
@@ -404,7 +405,7 @@ impl Geometry {
                 .max(v[6 + axis].abs())
                 .max(*m);
         }
-        let scale = m[0].max(m[1]).max(m[2]);
+        let scale = m[0].max(m[2]).max(m[1].max(m[2]));
         let an = [n[0].abs(), n[1].abs(), n[2].abs()];
         let ao = [o[0].abs(), o[1].abs(), o[2].abs()];
         // SAFETY: as above.
@@ -416,7 +417,7 @@ impl Geometry {
         ];
         let dt = g5 * dot(an, reach) / dot(n, d).abs();
         let err = g7 * scale;
-        let err_along = dt + g3 * (ao[0].max(ao[1]).max(ao[2]) + t.abs());
+        let err_along = dt + g3 * (abs_max(o) + t.abs());
         // Zeros where no triangle was met.
         // SAFETY: as above.
         let (zero, met) = unsafe { (L::splat(0.0), super::lanes::lane_mask::<L>(met)) };

@@ -135,6 +135,33 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
         let sums = waves::sums(s, &pixels, 0..21, p, &mut tiled);
         assert_eq!(sums, first, "{what} ({isa:?}): a tile's pixels");
         assert_eq!(tiled, first_stats, "{what} ({isa:?}): a tile's ray counts");
+        // The same rays, field for field: origins and error bounds too, which a pixel's sum
+        // may not show (an origin off by less than its error band meets the same surfaces).
+        let rays_of = |run: &dyn Fn(&rtis::RenderScene)| {
+            let mut rays: Vec<_> = common::rays_traced(s, run)
+                .into_iter()
+                .map(|(r, kind)| {
+                    let v = [r.o.to_array(), r.d.to_array(), [r.t_max, r.o_err, 0.0]];
+                    (format!("{kind:?}"), v.map(|v| v.map(f32::to_bits)))
+                })
+                .collect();
+            rays.sort();
+            rays
+        };
+        let waved_rays = rays_of(&|a| {
+            waves::sums(a, &pixels, 0..21, p, &mut RayStats::default());
+        });
+        let alone_rays = rays_of(&|a| {
+            for &(col, row) in &pixels {
+                for k in 0..21 {
+                    render_sample(a, col, row, k, &mut RayStats::default());
+                }
+            }
+        });
+        assert!(
+            waved_rays == alone_rays,
+            "{what} ({isa:?}): the rays traced"
+        );
         // (Without point lights, BRDF sampling alone traces no shadow ray.)
         let no_shadows = what.contains("shadows: false")
             || (what.contains("lights: Brdf") && what.contains("point light false"));
@@ -253,13 +280,17 @@ fn waves_give_the_one_ray_pixels_with_area_lights() {
         "entities: [",
         "entities: [\n            (shape: TriangleMesh(vertices: [(-1, -0.9, -1), (1, -0.9, -1), (0, 0.2, -0.8)], faces: [(0, 1, 2)]), material: Phong(kd: (0.4, 0.5, 0.6))),
             (shape: TriangleMesh(vertices: [(1.5, -0.9, -1), (1.5, 0.5, -1), (1.2, -0.9, 0.5)], faces: [(0, 1, 2)], normals: [(-0.9, 0.1, 0.3), (-0.8, 0, 0.5), (-1, 0.2, 0)]), material: Phong(kd: (0.6, 0.5, 0.4))),
-            (shape: Rectangle(corner: (-1.5, 1.3, -1), u: (0.3, 0, 0), v: (0, 0, 0.3)), emitter: (radiance: Checkerboard(color0: (0.9, 0.8, 0.7), color1: (0.1, 0.2, 0.3)))),",
+            (shape: Rectangle(corner: (-1.5, 1.3, -1), u: (0.3, 0, 0), v: (0, 0, 0.3)), emitter: (radiance: Checkerboard(color0: (0.9, 0.8, 0.7), color1: (0.1, 0.2, 0.3)))),
+            (shape: TriangleMesh(vertices: [(-1.3, -0.9, 0.4), (-0.3, -0.9, 0.2), (-0.8, 0.1, 0.1)], faces: [(0, 2, 1)]), material: Phong(kd: (0.5, 0.6, 0.4))),
+            (shape: Rectangle(corner: (0.5, 1.3, -0.6), u: (0.4, 0, 0), v: (0, 0, 0.4)), emitter: (radiance: (3, 3, 2.5))),",
     );
     assert!(mixed.contains("normals:"), "room() changed");
     let s = rtis::extract(&scene(&mixed));
     assert!(!s.geometry.bvh.is_empty());
-    // (A smooth triangle, and a textured rectangle light, among them; with every light at
-    // each vertex too, where untextured triangle lights are sampled in lanes.)
+    // (A smooth triangle, a triangle facing away from the camera (its hits' normals turned
+    // to the viewer, their shadow rays leaving from the back origin), and a textured and an
+    // untextured rectangle light, among them; with one light or every light at each vertex,
+    // untextured triangle lights sampled and their shadow rays made in lanes.)
     agrees(&s, "sphere light, meshes, textured light");
     let all = mixed.replace("lights_per_vertex: One", "lights_per_vertex: All");
     assert!(all.contains("lights_per_vertex: All"));

@@ -868,17 +868,17 @@ impl AreaRays {
             L::select(side, at.front[2], at.back[2]),
         ];
         let c = self.columns.get_or_insert_with(Default::default);
-        // SAFETY: as above, for each `put`.
+        // SAFETY: as above, for each `blend_into`.
         unsafe {
             for (x, o) in o.into_iter().enumerate() {
-                put(&mut c.ray[x], o, ray);
-                put(&mut c.ray[3 + x], s.wi[x], ray);
-                put(&mut c.wi[x], s.wi[x], ray);
-                put(&mut c.le[x], s.le[x], ray);
+                blend_into(&mut c.ray[x], o, ray);
+                blend_into(&mut c.ray[3 + x], s.wi[x], ray);
+                blend_into(&mut c.wi[x], s.wi[x], ray);
+                blend_into(&mut c.le[x], s.le[x], ray);
             }
-            put(&mut c.ray[6], at.o_err, ray);
-            put(&mut c.ray[7], s.dist * end, ray);
-            put(&mut c.pdf, pdf, ray);
+            blend_into(&mut c.ray[6], at.o_err, ray);
+            blend_into(&mut c.ray[7], s.dist * end, ray);
+            blend_into(&mut c.pdf, pdf, ray);
         }
         self.tested |= tested;
     }
@@ -963,7 +963,7 @@ impl AreaRays {
 /// # Safety
 /// The CPU must run `L`'s instruction set.
 #[inline(always)]
-unsafe fn put<L: Floats>(row: &mut [f32; MAX_LANES], x: L, mask: L::Mask) {
+unsafe fn blend_into<L: Floats>(row: &mut [f32; MAX_LANES], x: L, mask: L::Mask) {
     // SAFETY: the caller's.
     L::select(mask, x, unsafe { L::from_slice(row) }).write_to(row);
 }
