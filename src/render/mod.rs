@@ -339,7 +339,7 @@ pub fn render_pass(
 
 /// `each` of the exact sum of the samples `samples` of every pixel, each tile's paths traced
 /// in waves ([`waves::sums`]); `None` where the waves do not apply.
-fn in_waves<T: Clone + Default + Send>(
+fn in_waves<T: Clone + Default + Send + Sync>(
     scene: &RenderScene,
     samples: std::ops::Range<u32>,
     on_tile: &(dyn Fn() + Sync),
@@ -376,7 +376,7 @@ pub struct Tiled<T> {
 
 /// Run `pixel` over every pixel in 16x16 tiles on the current rayon pool; tiles not started
 /// when `stop` is set keep `T::default()`.
-fn by_tiles<T: Clone + Default + Send>(
+fn by_tiles<T: Clone + Default + Send + Sync>(
     scene: &RenderScene,
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
@@ -393,7 +393,7 @@ fn by_tiles<T: Clone + Default + Send>(
 
 /// [`by_tiles`] with a state per tile that `pixel` updates (for what a tile keeps of its
 /// pixels, as its largest samples), handed to `finished` as the tile finishes.
-fn by_tiles_with<T: Clone + Default + Send, S: Default + Send>(
+fn by_tiles_with<T: Clone + Default + Send + Sync, S: Default + Send>(
     scene: &RenderScene,
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
@@ -411,7 +411,7 @@ fn by_tiles_with<T: Clone + Default + Send, S: Default + Send>(
 
 /// [`by_tiles_with`] with a function of all of a tile's pixels (in rows, top to bottom) that
 /// gives their values in that order.
-fn by_tile_pixels<T: Clone + Default + Send, S: Default + Send>(
+fn by_tile_pixels<T: Clone + Default + Send + Sync, S: Default + Send>(
     scene: &RenderScene,
     on_tile: &(dyn Fn() + Sync),
     stop: &AtomicBool,
@@ -444,18 +444,29 @@ fn by_tile_pixels<T: Clone + Default + Send, S: Default + Send>(
             Some((px, stats))
         })
         .collect();
-    let mut pixels = vec![T::default(); w as usize * h as usize];
     let mut stats = RayStats::default();
     let mut tiles_done = 0;
-    for (&(x0, y0), (px, st)) in tiles.iter().zip(done).filter_map(|(t, d)| Some((t, d?))) {
-        stats += st;
+    for (_, st) in done.iter().flatten() {
+        stats += *st;
         tiles_done += 1;
-        let tw = (x0 + TILE).min(w) - x0;
-        for (i, p) in px.into_iter().enumerate() {
-            let (col, row) = (x0 + i as u32 % tw, y0 + i as u32 / tw);
-            pixels[(row * w + col) as usize] = p;
-        }
     }
+    // The image, row by row from the tiles, in parallel: each pixel written once where it
+    // lies (no zeroed image first; a tile not rendered gives `T::default()`). Done on one
+    // thread, this copy and the image's page faults held the other threads idle at the end of
+    // every round.
+    let mut pixels = Vec::new();
+    (0..w as usize * h as usize)
+        .into_par_iter()
+        .map(|k| {
+            let (col, row) = ((k % w as usize) as u32, (k / w as usize) as u32);
+            let (tx, ty) = (col / TILE, row / TILE);
+            let tw = (tx * TILE + TILE).min(w) - tx * TILE;
+            let i = (row - ty * TILE) * tw + (col - tx * TILE);
+            done[(ty * tiles_x + tx) as usize]
+                .as_ref()
+                .map_or_else(T::default, |(px, _)| px[i as usize].clone())
+        })
+        .collect_into_vec(&mut pixels);
     Tiled {
         pixels,
         stats,
