@@ -135,6 +135,22 @@ fn agrees(s: &rtis::RenderScene, what: &str) {
         let sums = waves::sums(s, &pixels, 0..21, p, &mut tiled);
         assert_eq!(sums, first, "{what} ({isa:?}): a tile's pixels");
         assert_eq!(tiled, first_stats, "{what} ({isa:?}): a tile's ray counts");
+        // More samples per pixel than a wave holds: the wave holds one pixel's last samples
+        // and the next one's first.
+        let many = 3..s.film.spp;
+        let three = &pixels[..3];
+        let want: Vec<RgbSum> = three
+            .iter()
+            .map(|&(col, row)| {
+                let mut sum = RgbSum::default();
+                for k in many.clone() {
+                    sum += render_sample(s, col, row, k, &mut RayStats::default());
+                }
+                sum
+            })
+            .collect();
+        let got = waves::sums(s, three, many, p, &mut RayStats::default());
+        assert_eq!(got, want, "{what} ({isa:?}): pixels of many samples");
         // The same rays, field for field: origins and error bounds too, which a pixel's sum
         // may not show (an origin off by less than its error band meets the same surfaces).
         let rays_of = |run: &dyn Fn(&rtis::RenderScene)| {
