@@ -367,10 +367,11 @@ impl Geometry {
         );
         let mut met = 0u32;
         for i in 0..L::LANES {
-            let Some(Some(_)) = self.small_met(near, i) else {
+            // (The lanes `small_met` reads as having met a triangle.)
+            let tri = self.triangle_each.get(near.slot[i] as usize);
+            let Some(tri) = tri.filter(|_| near.alone & (1 << i) == 0) else {
                 continue;
             };
-            let tri = &self.triangle_each[near.slot[i] as usize];
             for axis in 0..3 {
                 for (j, vertex) in tri.v.iter().enumerate() {
                     v[3 * j + axis][i] = vertex[axis];

@@ -566,10 +566,7 @@ unsafe fn shade_in<L: Floats, R: Record, S: Streams>(
             true => [term[0] * w, term[1] * w, term[2] * w],
             false => [term[0] / w, term[1] / w, term[2] / w],
         };
-        if on.lanes != 0 {
-            let samples = unsafe { on.sample::<L>(p_, &u1, &u2) };
-            unsafe { area.record_lanes(&surface, &samples, &on.pmf) };
-        }
+        unsafe { area.record_triangles(&surface, &on, p_, (&u1, &u2)) };
         // The lanes that chose an area light take its term.
         let term = unsafe { area.terms(tr, &surface, mis, false) };
         let lanes = unsafe { lane_mask::<L>(area.lanes) };
@@ -628,10 +625,7 @@ unsafe fn shade_in<L: Floats, R: Record, S: Streams>(
                     }
                 }
             }
-            if on.lanes != 0 {
-                let samples = unsafe { on.sample::<L>(p_, &u1, &u2) };
-                unsafe { area.record_lanes(&surface, &samples, &on.pmf) };
-            }
+            unsafe { area.record_triangles(&surface, &on, p_, (&u1, &u2)) };
         }
         let area = unsafe { area.terms(tr, &surface, mis, true) };
         [sum[0] + area[0], sum[1] + area[1], sum[2] + area[2]]
@@ -759,11 +753,11 @@ struct AreaRays {
     columns: Option<AreaColumns>,
 }
 
-/// The samples' shadow rays, directions, radiances and densities, a column per coordinate.
+/// The samples' shadow rays (whose directions are the samples' `wi`), radiances and
+/// densities, a column per coordinate.
 #[derive(Default)]
 struct AreaColumns {
     ray: [[f32; MAX_LANES]; 8],
-    wi: [[f32; MAX_LANES]; 3],
     le: [[f32; MAX_LANES]; 3],
     pdf: [f32; MAX_LANES],
 }
@@ -823,38 +817,42 @@ impl AreaRays {
         for x in 0..3 {
             c.ray[x][i] = r.o[x];
             c.ray[3 + x][i] = r.d[x];
-            c.wi[x][i] = ls.wi[x];
             c.le[x][i] = ls.le[x];
         }
         (c.ray[6][i], c.ray[7][i], c.pdf[i]) = (r.o_err, r.t_max, pdf);
         self.tested |= 1 << i;
     }
 
-    /// The triangle lights' samples `s` of the lanes that chose one, each light chosen with
-    /// the chance in `pmf`: what [`AreaRays::record`] records for each, computed in lanes
-    /// (`light_ray` at `Interaction::flat`: no radiance, a direction not above the shading
-    /// normal or a density not positive leave no shadow ray; the ray leaves from the origin
-    /// on the side of the geometric normal it goes to and stops at `SHADOW_END` of the
-    /// distance).
+    /// The samples of the lanes of `on` (none may have chosen a triangle) from the points
+    /// `p` of `at` with the numbers `u` ([`TrianglePoints::sample`]): what [`AreaRays::record`]
+    /// records for each, computed in lanes (`light_ray` at `Interaction::flat`: no radiance, a
+    /// direction not above the shading normal or a density not positive leave no shadow ray;
+    /// the ray leaves from the origin on the side of the geometric normal it goes to and stops
+    /// at `SHADOW_END` of the distance).
     ///
     /// # Safety
     /// The CPU must run `L`'s instruction set.
     #[inline(always)]
-    unsafe fn record_lanes<L: Floats>(
+    unsafe fn record_triangles<L: Floats>(
         &mut self,
         at: &Surface<L>,
-        s: &TriangleSamples<L>,
-        pmf: &[f32; MAX_LANES],
+        on: &TrianglePoints,
+        p: [L; 3],
+        (u1, u2): (&[f32; MAX_LANES], &[f32; MAX_LANES]),
     ) {
-        self.lanes |= s.lanes;
+        if on.lanes == 0 {
+            return;
+        }
+        self.lanes |= on.lanes;
         // SAFETY: the caller's; so for every `unsafe` block below, each makes values of `L`.
+        let s = unsafe { on.sample::<L>(p, u1, u2) };
         let (zero, end) = unsafe { (L::splat(0.0), L::splat(SHADOW_END)) };
         // `light_ray`'s tests: some radiance (`le != 0`), `wi` not below the shading normal
         // (a Phong surface transmits nothing; a flat hit's normal is not bent, so nothing
         // leaks), and `pmf pdf` neither NaN nor at most zero.
         let lit = s.le[0].cmpne(zero) | s.le[1].cmpne(zero) | s.le[2].cmpne(zero);
         let below = dot(s.wi, at.n).cmple(zero);
-        let pdf = unsafe { L::from_slice(pmf) } * s.pdf;
+        let pdf = unsafe { L::from_slice(&on.pmf) } * s.pdf;
         let ray = s.valid & lit & !below & pdf.cmpgt(zero);
         let tested = L::bitmask(ray);
         if tested == 0 {
@@ -873,7 +871,6 @@ impl AreaRays {
             for (x, o) in o.into_iter().enumerate() {
                 blend_into(&mut c.ray[x], o, ray);
                 blend_into(&mut c.ray[3 + x], s.wi[x], ray);
-                blend_into(&mut c.wi[x], s.wi[x], ray);
                 blend_into(&mut c.le[x], s.le[x], ray);
             }
             blend_into(&mut c.ray[6], at.o_err, ray);
@@ -905,11 +902,12 @@ impl AreaRays {
         let Some(c) = self.columns.as_ref().filter(|_| self.lanes != 0) else {
             return [zero; 3];
         };
-        // The shadow rays, in lanes.
+        // The shadow rays, in lanes; their directions are the samples' `wi`.
+        let [ox, oy, oz, dx, dy, dz, o_err, t_max] = unsafe { rows::<L, 8>(&c.ray) };
+        let wi = [dx, dy, dz];
         let mut blocked = 0u32;
         if tr.effects.shadows && self.tested != 0 {
-            let [ox, oy, oz, dx, dy, dz, o_err, t_max] = unsafe { rows::<L, 8>(&c.ray) };
-            let segments = ([ox, oy, oz], [dx, dy, dz], o_err, t_max);
+            let segments = ([ox, oy, oz], wi, o_err, t_max);
             let live = unsafe { lane_mask::<L>(self.tested) };
             let hidden = tr
                 .geometry
@@ -923,13 +921,7 @@ impl AreaRays {
         // BRDF-sampled direction's density under MIS (else 1). The pdf holds the light's
         // chance.
         let seen = unsafe { lane_mask::<L>(self.tested & !blocked) };
-        let (wi, le, pdf) = unsafe {
-            (
-                rows::<L, 3>(&c.wi),
-                rows::<L, 3>(&c.le),
-                L::from_slice(&c.pdf),
-            )
-        };
+        let (le, pdf) = unsafe { (rows::<L, 3>(&c.le), L::from_slice(&c.pdf)) };
         let cos = dot(wi, at.n);
         let above = cos.cmpgt(zero) & at.wo_above;
         let r = [
@@ -1047,8 +1039,6 @@ struct TriangleSamples<L: Floats> {
     /// Lanes with a sample (a point apart from the vertex, of some density) among those that
     /// chose a triangle.
     valid: L::Mask,
-    /// Lanes (bits) that chose a triangle.
-    lanes: u32,
 }
 
 impl TrianglePoints {
@@ -1128,7 +1118,6 @@ impl TrianglePoints {
             le,
             pdf,
             valid: valid & unsafe { lane_mask::<L>(self.lanes) },
-            lanes: self.lanes,
         }
     }
 }
