@@ -104,6 +104,28 @@ fn agree_in(name: &str, rs: &RenderScene, g: &Global, count: usize) {
         walk_stats.total() > 2 * rays.len() as u64,
         "{name}: traced little"
     );
+    // The same rays, field for field and kind by kind, in whatever order each traces them.
+    let seen = |order: Order| {
+        let mut seen: Vec<_> = common::rays_traced(rs, |audited| {
+            trace(audited, &g, &rays, order);
+        })
+        .into_iter()
+        .map(|(r, kind)| {
+            let [ox, oy, oz] = r.o.to_array().map(f32::to_bits);
+            let [dx, dy, dz] = r.d.to_array().map(f32::to_bits);
+            (
+                [ox, oy, oz, dx, dy, dz, r.o_err.to_bits(), r.t_max.to_bits()],
+                format!("{kind:?}"),
+            )
+        })
+        .collect();
+        seen.sort();
+        seen
+    };
+    assert!(
+        seen(Order::Waves) == seen(Order::DepthFirst),
+        "{name}: the rays traced differ"
+    );
 }
 
 /// `rs`'s emitters with no hit sampling them (`light_samples` 0, which a scene file cannot

@@ -8,15 +8,17 @@
 //! reaches the queue's end before the bounces of earlier chunks join it does not). The nearest hits
 //! come with their records in lanes ([`crate::accel::Geometry::nearest_lanes`], which
 //! `intersect_batch` runs too); the interaction (orientation, the origins and their error bound),
-//! the light pass ([`super::point_sums`]), each Phong node's sum and the two rays of task 2 with
-//! their weights run in lanes. What each primitive's material is comes from a table built once per
-//! call ([`Slot`]). Scalar, lane by lane: the tree's bookkeeping (storing a node's sum, its
-//! children's nodes), the mirror and glass bounces, the light emitted by a surface a chain meets,
-//! and every reflectance but the course's diffuse one (a specular lobe, the Physical model), in the
-//! light terms and the children's weights. Every lane computes what the scalar code computes for
-//! its ray, operation for operation (`Geometry::intersect`'s order and tie rule, `Sphere::surface`,
-//! `Plane::surface`, `Interaction::new`, `Origins`, `reflect`, `course_reflectance`), so the result
-//! is the depth-first walk's to the bit.
+//! the light pass ([`super::point_sums`]), each Phong node's sum, the two rays of task 2 with
+//! their weights, and the mirror and glass bounces ([`bounce_lanes`]) run in lanes. What each
+//! primitive's material is comes from a table built once per call ([`Slot`]). Scalar, lane by
+//! lane: the tree's bookkeeping (storing a node's sum, its children's nodes, a chain's tint), a
+//! metal's bounce and any bounce with reflection or refraction off, the light emitted by a surface
+//! a chain meets, and every reflectance but the course's diffuse one (a specular lobe, the
+//! Physical model), in the light terms and the children's weights. Every lane computes what the
+//! scalar code computes for its ray, operation for operation (`Geometry::intersect`'s order and
+//! tie rule, `Sphere::surface`, `Plane::surface`, `Interaction::new`, `Origins`, `reflect`,
+//! `Transmissive::refract`, `course_reflectance`), so the result is the depth-first walk's to the
+//! bit.
 
 use super::{LightLanes, Scratch, point_sums};
 use crate::accel::Tally;
@@ -141,6 +143,27 @@ pub(super) struct Slot {
     /// A Phong material whose reflectance is the course's diffuse `kd max(w.n, 0)` (the Course
     /// model, `ks` zero): computed in lanes.
     lambert: bool,
+    /// A mirror or the course's glass, whose bounces run in lanes; `None` for the other
+    /// materials (a metal's bounce is the scalar `specular_bounce`).
+    bounce: Option<Bounce>,
+}
+
+/// The specular materials whose bounces the lanes compute: `specular_bounce`'s mirror and glass.
+#[derive(Clone, Copy)]
+enum Bounce {
+    /// A mirror of this tint.
+    Mirror(Vec3A),
+    /// The course's glass: its index of refraction and its tint.
+    Glass(f32, Vec3A),
+}
+
+impl Bounce {
+    /// The tint a chain takes at the bounce.
+    fn tint(self) -> Vec3A {
+        match self {
+            Bounce::Mirror(tint) | Bounce::Glass(_, tint) => tint,
+        }
+    }
 }
 
 /// The slot table of `tr`'s packed primitives, into `slots`.
@@ -165,6 +188,11 @@ fn slot_table(tr: &Tracer, slots: &mut Vec<Slot>) {
             is_phong: phong.is_some(),
             lit: phong.is_some_and(|p| !p.is_black()),
             lambert: phong.is_some_and(|p| tr.model == Model::Course && p.ks == Vec3A::ZERO),
+            bounce: match tr.materials[p.material as usize] {
+                Material::Mirror(m) => Some(Bounce::Mirror(m.color)),
+                Material::Transmissive(g) => Some(Bounce::Glass(g.ior, g.color)),
+                _ => None,
+            },
         });
     }
 }
@@ -229,6 +257,113 @@ unsafe fn trace_in<L: Floats>(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mu
             k += unsafe { chunk::<L>(tr, g, s, depth, k) };
         }
         std::mem::swap(&mut s.queue, &mut s.next);
+    }
+}
+
+/// The mirror and glass bounces of a chunk's lanes `mirror` and `glass` (glass of index of
+/// refraction `ior`, lane by lane), queued behind the wave's rays with their nodes (`nodes`),
+/// and counted: what `specular_bounce` computes for each, operation for operation. A mirror
+/// reflects `wo` about the shading normal `ns` (`reflect`); glass refracts `wo` through the
+/// geometric normal `nh` (`Transmissive::refract`: Snell's law, `eta = 1 / ior` entering and
+/// `ior` leaving, the direction normalised as glam divides, and the mirror direction under
+/// total internal reflection). Each ray leaves from the origin on its side (`Origins::ray`).
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn bounce_lanes<L: Floats>(
+    tr: &mut Tracer,
+    s: &mut Scratch,
+    nodes: &[u32; MAX_LANES],
+    (mirror, glass, ior): (u32, u32, [f32; MAX_LANES]),
+    (wo, ns, nh): ([L; 3], [L; 3], [L; 3]),
+    (front, back, o_err): ([L; 3], [L; 3], L),
+) {
+    // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block below.
+    let (zero, one, two, inf) = unsafe {
+        (
+            L::splat(0.0),
+            L::splat(1.0),
+            L::splat(2.0),
+            L::splat(f32::INFINITY),
+        )
+    };
+    // `Transmissive::refract(wo, nh)`: the normal on `wo`'s side and the ratio of indices.
+    let ior = unsafe { L::from_array(ior) };
+    let entering = dot(wo, nh).cmpgt(zero);
+    let eta = L::select(entering, one / ior, ior);
+    let n = [
+        L::select(entering, nh[0], -nh[0]),
+        L::select(entering, nh[1], -nh[1]),
+        L::select(entering, nh[2], -nh[2]),
+    ];
+    // Snell: sin^2(theta_t) = eta^2 sin^2(theta_i) (`max` gives 0 for NaN, as `f32::max`).
+    let cos_i = dot(wo, n);
+    let sin2_t = eta * eta * (one - cos_i * cos_i).max(zero);
+    let tir = sin2_t.cmpgt(one);
+    // `(-wo eta + (eta cos_i - cos_t) n).normalize()`, each coordinate divided by the length.
+    let cos_t = (one - sin2_t).sqrt();
+    let k = eta * cos_i - cos_t;
+    let v = [
+        -wo[0] * eta + k * n[0],
+        -wo[1] * eta + k * n[1],
+        -wo[2] * eta + k * n[2],
+    ];
+    let len = dot(v, v).sqrt();
+    // Under total internal reflection, `reflect(wo, n)`: `2 (n.wo) n - wo`.
+    let two_cos = two * dot(n, wo);
+    let wt = [
+        L::select(tir, two_cos * n[0] - wo[0], v[0] / len),
+        L::select(tir, two_cos * n[1] - wo[1], v[1] / len),
+        L::select(tir, two_cos * n[2] - wo[2], v[2] / len),
+    ];
+    // A mirror's `reflect(wo, ns)`.
+    let is_mirror = unsafe { lane_mask::<L>(mirror) };
+    let two_cos = two * dot(ns, wo);
+    let w = [
+        L::select(is_mirror, two_cos * ns[0] - wo[0], wt[0]),
+        L::select(is_mirror, two_cos * ns[1] - wo[1], wt[1]),
+        L::select(is_mirror, two_cos * ns[2] - wo[2], wt[2]),
+    ];
+    // `Origins::ray(w, inf)`: the origin on the side `w` leaves by.
+    let side = dot(nh, w).cmpge(zero);
+    let bounced = mirror | glass;
+    let n_rays = bounced.count_ones() as usize;
+    let queue = &mut s.queue;
+    queue.reserve(n_rays);
+    let at = queue.len;
+    for x in 0..3 {
+        L::select(side, front[x], back[x]).compress(bounced, &mut queue.rows[OX + x][at..]);
+        w[x].compress(bounced, &mut queue.rows[DX + x][at..]);
+    }
+    o_err.compress(bounced, &mut queue.rows[OE][at..]);
+    inf.compress(bounced, &mut queue.rows[TM][at..]);
+    let mut bits = bounced;
+    let mut k = at;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        queue.nodes[k] = nodes[i];
+        k += 1;
+    }
+    queue.len += n_rays;
+    // The rays counted by kind: a mirror's and a totally reflected one are reflections.
+    let reflected = mirror | (glass & L::bitmask(tir));
+    tr.stats.reflection += u64::from(reflected.count_ones());
+    tr.stats.refraction += u64::from((glass & !reflected).count_ones());
+    if let Some(audit) = tr.audit {
+        let mut bits = bounced;
+        let mut k = at;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let kind = match reflected & (1 << i) != 0 {
+                true => RayKind::Reflection,
+                false => RayKind::Refraction,
+            };
+            audit(&queue.ray(k), kind);
+            k += 1;
+        }
     }
 }
 
@@ -298,11 +433,15 @@ unsafe fn chunk<L: Floats>(
     ];
     let (front, back, o_err) = origins(p, nh, hit.err, hit.err_along);
     // The tree's bookkeeping, lane by lane (`shade`): misses end at the background; a chain's
-    // ray adds what its surface emits; Phong hits gather their weights and `kd`; the rest
-    // (mirror and glass, emitters) wait for their whole interaction below.
+    // ray adds what its surface emits; Phong hits gather their weights and `kd`; mirror and
+    // glass bounces take their tint (`Node::bounce`), their rays made in lanes below; the rest
+    // (metals, emitters a chain meets, effects off) wait for their whole interaction below.
     let (mut phong_lanes, mut lit_lanes, mut lambert, mut whole) = (0u32, 0u32, 0u32, 0u32);
     // The chains' rays that meet an emitter (a subset of `whole`).
     let mut emitting = 0u32;
+    // The mirror and glass bounces made in lanes, and each glass lane's index of refraction.
+    let (mut mirror, mut glass, mut ior) = (0u32, 0u32, [1.0f32; MAX_LANES]);
+    let lane_bounces = tr.effects.reflection && tr.effects.refraction;
     let mut beta = [Vec3A::ZERO; MAX_LANES];
     let mut kd = [Vec3A::ZERO; MAX_LANES];
     for i in 0..count {
@@ -322,7 +461,25 @@ unsafe fn chunk<L: Floats>(
             }
         }
         if !e.is_phong {
-            whole |= 1 << i;
+            match e.bounce {
+                // Both effects on, `specular_bounce` always bounces a mirror or glass.
+                Some(b)
+                    if lane_bounces
+                        && emitting & (1 << i) == 0
+                        && node.bounces < g.max_specular =>
+                {
+                    node.tint *= b.tint();
+                    node.bounces += 1;
+                    match b {
+                        Bounce::Mirror(_) => mirror |= 1 << i,
+                        Bounce::Glass(x, _) => {
+                            glass |= 1 << i;
+                            ior[i] = x;
+                        }
+                    }
+                }
+                _ => whole |= 1 << i,
+            }
             continue;
         }
         beta[i] = node.beta * node.tint;
@@ -332,6 +489,19 @@ unsafe fn chunk<L: Floats>(
         lambert |= u32::from(e.lambert) << i;
     }
     let parents = if end { 0 } else { phong_lanes };
+    if mirror | glass != 0 {
+        // SAFETY: as above.
+        unsafe {
+            bounce_lanes::<L>(
+                tr,
+                s,
+                &nodes,
+                (mirror, glass, ior),
+                (wo, ns, nh),
+                (front, back, o_err),
+            )
+        };
+    }
     // The lanes that need their whole interaction: emitters a chain meets, and mirror and
     // glass bounces, queued behind this wave's rays.
     if whole != 0 {
