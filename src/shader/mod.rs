@@ -13,6 +13,7 @@ mod normal;
 pub mod path;
 pub mod record;
 pub mod surface;
+pub mod warps;
 
 pub use global::Global;
 pub use path::Path;

@@ -89,18 +89,20 @@ fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Ve
             // The same directions, drawn in order, and the same sums; each group's rays
             // traced together in waves.
             let group = waves::group(g);
-            let (mut w, mut rays) = (Vec::with_capacity(group), Vec::with_capacity(group));
+            let (mut us, mut w, mut rays) = (
+                Vec::with_capacity(group),
+                Vec::with_capacity(group),
+                Vec::with_capacity(group),
+            );
             let mut left = g.samples as usize;
             while left > 0 {
                 let k = left.min(group);
                 left -= k;
-                w.clear();
-                w.extend((0..k).map(|_| {
-                    let (u1, u2) = tr.sampler.next_2d();
-                    frame.to_world(hemisphere::uniform(u1, u2))
-                }));
-                rays.clear();
-                rays.extend(w.iter().map(|&wj| si.spawn(wj)));
+                // The numbers drawn in order; the directions and their rays made in lanes.
+                us.clear();
+                us.extend((0..k).map(|_| tr.sampler.next_2d()));
+                (w.clear(), rays.clear());
+                waves::hemisphere_rays(tr, &frame, &si.origins, &us, (&mut w, &mut rays));
                 let l = incident_all(tr, g, &rays, Order::Waves);
                 for (l_i, &wj) in l.iter().zip(&w) {
                     sum += *l_i * reflectance(model, phong, wj, wo, n);

@@ -16,6 +16,8 @@
 
 mod lanes;
 
+pub use lanes::hemisphere_rays;
+
 use super::Global;
 use crate::accel::lanes::dot;
 use crate::accel::{Floats, Isa, MAX_LANES};

@@ -13,7 +13,7 @@
 //! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
 //! draws its random numbers from its own stream in the same order (drawn in lanes by
 //! `sampling::Streams`; the light choice runs lane by lane, `sin_cos_turns` is repeated in
-//! lanes), so each path adds the same contributions and goes on with the same ray, to the bit
+//! lanes by `shader::warps`), so each path adds the same contributions and goes on with the same ray, to the bit
 //! (`tests/integration/path_waves.rs`). A spot or directional light's incident light
 //! (`Light::incident`) and an area-light or environment sample run the scalar code lane by
 //! lane (`surface::sample_area_light` or `EnvironmentLight::sample`, `light_ray` on
@@ -38,6 +38,7 @@ use crate::shader::record::{Record, Technique};
 use crate::shader::surface::{
     Interaction, SHADOW_END, diffuse_probability, light_ray, sample_area_light,
 };
+use crate::shader::warps::sin_cos_turns;
 use crate::shape::Triangle;
 use crate::stats::RayKind;
 use glam::Vec3A;
@@ -1281,53 +1282,6 @@ unsafe fn incidents_by_lane<'a, L: Floats>(
     }
 }
 
-/// [`crate::sampling::sin_cos_turns`] in lanes, operation for operation (the quarter chosen
-/// by the same thresholds, the same Taylor polynomials in the same order, the same exact
-/// swaps and sign flips), so each lane's pair is the scalar function's to the bit.
-///
-/// # Safety
-/// The CPU must run `L`'s instruction set.
-#[inline(always)]
-unsafe fn sin_cos_turns<L: Floats>(u: L) -> (L, L) {
-    // (`L::splat` written out below: no closure in a kernel of another instruction set.)
-    use crate::sampling::trig::{COS_TAYLOR as C, SIN_TAYLOR as S};
-    // The nearest quarter turn.
-    let (m1, m2, m3, m4) = unsafe {
-        (
-            u.cmpge(L::splat(0.125)),
-            u.cmpge(L::splat(0.375)),
-            u.cmpge(L::splat(0.625)),
-            u.cmpge(L::splat(0.875)),
-        )
-    };
-    let quarter = unsafe {
-        let q = L::select(m1, L::splat(0.25), L::splat(0.0));
-        let q = L::select(m2, L::splat(0.5), q);
-        let q = L::select(m3, L::splat(0.75), q);
-        L::select(m4, L::splat(1.0), q)
-    };
-    let a = (u - quarter) * unsafe { L::splat(TAU) };
-    // `sin_cos_eighth`: Horner's form.
-    let a2 = a * a;
-    let (sin, cos) = unsafe {
-        let s = L::splat(S[2]) + a2 * L::splat(S[3]);
-        let s = L::splat(S[1]) + a2 * s;
-        let s = L::splat(S[0]) + a2 * s;
-        let c = L::splat(C[4]) + a2 * L::splat(C[5]);
-        let c = L::splat(C[3]) + a2 * c;
-        let c = L::splat(C[2]) + a2 * c;
-        let c = L::splat(C[1]) + a2 * c;
-        (a + a * (a2 * s), L::splat(C[0]) + a2 * c)
-    };
-    // Rotate by the quarters.
-    let odd = (m1 & !m2) | (m3 & !m4);
-    let (sin, cos) = (L::select(odd, cos, sin), L::select(odd, sin, cos));
-    (
-        L::select(m2 & !m4, -sin, sin),
-        L::select(m1 & !m3, -cos, cos),
-    )
-}
-
 /// `point_light` in lanes: each lane's light's term `L_i r(wi, wo) V` at its vertex from its
 /// incident light `inc` (zero where the light is behind the surface, gives none, or is
 /// hidden), its shadow ray tested in lanes (`Tracer::unoccluded`, or `unoccluded_in_room` in
@@ -1377,52 +1331,4 @@ unsafe fn light_term<L: Floats>(tr: &mut Tracer, inc: &Incidents<L>, at: &Surfac
         L::select(seen, li[1] * r[1], zero),
         L::select(seen, li[2] * r[2], zero),
     ]
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// [`sin_cos_turns`] in lanes gives [`crate::sampling::sin_cos_turns`]'s bits for every
-    /// number the sampler draws (multiples of `2^-24`) and for 1, in each instruction set.
-    #[test]
-    fn sin_cos_turns_in_lanes_is_the_scalar_function() {
-        crate::accel::require_all_isas();
-        // SAFETY: `Vec4` runs everywhere; the others only where the CPU has them.
-        unsafe { agrees::<glam::Vec4>() };
-        #[cfg(target_arch = "x86_64")]
-        if Isa::Avx2.available() {
-            unsafe { agrees::<crate::accel::F8>() };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if Isa::Avx512.available() {
-            unsafe { agrees::<crate::accel::F16>() };
-        }
-    }
-
-    /// # Safety
-    /// The CPU must run `L`'s instruction set.
-    unsafe fn agrees<L: Floats>() {
-        let n = 1u32 << 24;
-        let mut u = [0.0f32; MAX_LANES];
-        let (mut s, mut c) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
-        for first in (0..=n).step_by(L::LANES) {
-            for (i, u) in u.iter_mut().enumerate().take(L::LANES) {
-                *u = (first + i as u32).min(n) as f32 / n as f32;
-            }
-            let (sl, cl) = unsafe { sin_cos_turns(L::from_slice(&u)) };
-            sl.write_to(&mut s);
-            cl.write_to(&mut c);
-            for i in 0..L::LANES {
-                let (es, ec) = crate::sampling::sin_cos_turns(u[i]);
-                assert_eq!(
-                    (s[i].to_bits(), c[i].to_bits()),
-                    (es.to_bits(), ec.to_bits()),
-                    "u = {} in {} lanes",
-                    u[i],
-                    L::LANES
-                );
-            }
-        }
-    }
 }

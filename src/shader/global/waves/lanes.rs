@@ -24,12 +24,13 @@ use super::{LightLanes, Scratch, point_sums};
 use crate::accel::Tally;
 use crate::accel::lanes::{RayLanes, array, dot, lane_mask, origins};
 use crate::accel::{Floats, Isa, MAX_LANES};
-use crate::geometry::{Hit, Origins, Ray};
+use crate::geometry::{Frame, Hit, Origins, Ray};
 use crate::light::NO_LIGHT;
 use crate::material::{Material, Model, Phong};
 use crate::shader::Tracer;
 use crate::shader::global::Global;
 use crate::shader::surface::{Interaction, emitted, reflectance};
+use crate::shader::warps::uniform_hemisphere;
 use crate::stats::RayKind;
 use glam::Vec3A;
 use std::f32::consts::PI;
@@ -210,6 +211,94 @@ pub fn trace(tr: &mut Tracer, g: &Global, roots: &[Ray], s: &mut Scratch) {
         Isa::Avx512 => unsafe { trace_avx512(tr, g, roots, s) },
         // SAFETY: `Vec4` runs on every CPU.
         _ => unsafe { trace_in::<glam::Vec4>(tr, g, roots, s) },
+    }
+}
+
+/// The rays of Eq. 4 at a first hit for the numbers `us`, drawn in order: each direction
+/// `frame.to_world(hemisphere::uniform(u1, u2))` made in `tr`'s lanes
+/// ([`crate::shader::warps::uniform_hemisphere`], the scalar warp's bits), into `w`, and its
+/// ray from `origins` (`Interaction::spawn`), into `rays`.
+pub fn hemisphere_rays(
+    tr: &Tracer,
+    frame: &Frame,
+    origins: &Origins,
+    us: &[(f32, f32)],
+    (w, rays): (&mut Vec<Vec3A>, &mut Vec<Ray>),
+) {
+    match tr.geometry.bvh.isa() {
+        // SAFETY: the BVH's instruction set is one the CPU runs (`WideBvh::set_isa`).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { hemisphere_avx2(frame, origins, us, w, rays) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { hemisphere_avx512(frame, origins, us, w, rays) },
+        // SAFETY: `Vec4` runs on every CPU.
+        _ => unsafe { hemisphere_in::<glam::Vec4>(frame, origins, us, w, rays) },
+    }
+}
+
+/// [`hemisphere_rays`] in eight AVX2 lanes.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn hemisphere_avx2(
+    frame: &Frame,
+    origins: &Origins,
+    us: &[(f32, f32)],
+    w: &mut Vec<Vec3A>,
+    rays: &mut Vec<Ray>,
+) {
+    // SAFETY: this function runs only where AVX2 was found.
+    unsafe { hemisphere_in::<crate::accel::F8>(frame, origins, us, w, rays) }
+}
+
+/// [`hemisphere_rays`] in sixteen AVX-512 lanes.
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn hemisphere_avx512(
+    frame: &Frame,
+    origins: &Origins,
+    us: &[(f32, f32)],
+    w: &mut Vec<Vec3A>,
+    rays: &mut Vec<Ray>,
+) {
+    // SAFETY: this function runs only where AVX-512F was found.
+    unsafe { hemisphere_in::<crate::accel::F16>(frame, origins, us, w, rays) }
+}
+
+/// [`hemisphere_rays`], `L::LANES` directions at a time.
+///
+/// # Safety
+/// The CPU must run `L`'s instruction set.
+#[inline(always)]
+unsafe fn hemisphere_in<L: Floats>(
+    frame: &Frame,
+    origins: &Origins,
+    us: &[(f32, f32)],
+    w: &mut Vec<Vec3A>,
+    rays: &mut Vec<Ray>,
+) {
+    let mut rows = [[0.0f32; MAX_LANES]; 3];
+    for chunk in us.chunks(L::LANES) {
+        let (mut u1, mut u2) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
+        for (i, &(a, b)) in chunk.iter().enumerate() {
+            (u1[i], u2[i]) = (a, b);
+        }
+        // SAFETY: the caller vouches for the instruction set.
+        let wl = unsafe { uniform_hemisphere(frame, L::from_array(u1), L::from_array(u2)) };
+        for (row, x) in rows.iter_mut().zip(wl) {
+            x.write_to(row);
+        }
+        for i in 0..chunk.len() {
+            let wj = Vec3A::new(rows[0][i], rows[1][i], rows[2][i]);
+            w.push(wj);
+            rays.push(origins.ray(wj, f32::INFINITY));
+        }
     }
 }
 
