@@ -528,7 +528,7 @@ def commits(_runs):
         "|---|---|---|---|---|---|---|---|",
     ]
     all_same = True
-    # The last two rows: issue 43's base (b61337b keeps the scene's height unless told).
+    # The last row: issue 43's base (b61337b keeps the scene's height unless told).
     for scene, base, film in [("scenes/cornell-n-bounce.ron", COMPARE_BASE, ["--width", "360"]),
                               ("scenes/cornell-two-bounce.ron", COMPARE_BASE, ["--width", "360"]),
                               ("scenes/cornell-n-bounce.ron", ISSUE_BASE, ["--width", "360", "--height", "288"])]:

@@ -15,6 +15,8 @@ use std::f32::consts::TAU;
 #[inline(always)]
 pub unsafe fn sin_cos_turns<L: Floats>(u: L) -> (L, L) {
     // (`L::splat` written out below: no closure in a kernel of another instruction set.)
+    // SAFETY: the caller vouches for the instruction set; so for every `unsafe` block below,
+    // each makes values of `L`.
     use crate::sampling::trig::{COS_TAYLOR as C, SIN_TAYLOR as S};
     // The nearest quarter turn.
     let (m1, m2, m3, m4) = unsafe {
@@ -157,6 +159,7 @@ mod tests {
                 for (i, &(a, b)) in chunk.iter().enumerate() {
                     (u1[i], u2[i]) = (a, b);
                 }
+                // SAFETY: the caller's.
                 let w = unsafe { uniform_hemisphere(&frame, L::from_array(u1), L::from_array(u2)) };
                 for (row, x) in rows.iter_mut().zip(w) {
                     x.write_to(row);
@@ -185,6 +188,7 @@ mod tests {
             for (i, u) in u.iter_mut().enumerate().take(L::LANES) {
                 *u = (first + i as u32).min(n) as f32 / n as f32;
             }
+            // SAFETY: the caller's.
             let (sl, cl) = unsafe { sin_cos_turns(L::from_slice(&u)) };
             sl.write_to(&mut s);
             cl.write_to(&mut c);

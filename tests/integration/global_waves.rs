@@ -155,6 +155,69 @@ fn unsampled_emitter_seen_by(name: &str, rs: &RenderScene, count: usize) {
     agree_on(name, rs, &g, count);
 }
 
+/// The first hit's rays of Eq. 4, made in lanes (`hemisphere_rays`), are the scalar warp's and
+/// `Interaction::spawn`'s to the bit, in every instruction set, at hits on every surface of the
+/// course's box (both sides of the glass ball), for numbers that reach 0 and 1.
+#[test]
+fn first_hit_rays_in_lanes_are_the_scalar_ones() {
+    use rtis::geometry::{Frame, Origins};
+    use rtis::sampling::hemisphere;
+    let cornell = scenes_dir().join("cornell.ron");
+    let rs = rtis::extract(&scene(&format!(
+        "Scene(extends: {:?})",
+        cornell.to_str().unwrap()
+    )));
+    let mut s = Sampler::new(3, 0, 0);
+    let mut us: Vec<(f32, f32)> = (0..61).map(|_| s.next_2d()).collect();
+    us.extend([(0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)]);
+    rtis::accel::require_all_isas();
+    let mut hits = 0;
+    for ray in rays(&rs, 200, 7) {
+        let Some(hit) = rs.geometry.intersect(&ray) else {
+            continue;
+        };
+        hits += 1;
+        let n = if hit.n.dot(-ray.d) < 0.0 {
+            -hit.n
+        } else {
+            hit.n
+        };
+        let (frame, origins) = (Frame::from_normal(n), Origins::new(&hit));
+        let want: Vec<_> = us
+            .iter()
+            .map(|&(u1, u2)| {
+                let w = frame.to_world(hemisphere::uniform(u1, u2));
+                (w, origins.ray(w, f32::INFINITY))
+            })
+            .collect();
+        for isa in rtis::accel::Isa::all_available() {
+            let mut rs = rs.clone();
+            assert!(rs.geometry.bvh.set_isa(isa));
+            let mut stats = RayStats::default();
+            let tr = rs.tracer(Sampler::new(0, 0, 0), &mut stats);
+            let (mut w, mut rays) = (Vec::new(), Vec::new());
+            rtis::shader::global::hemisphere_rays(&tr, &frame, &origins, &us, (&mut w, &mut rays));
+            assert_eq!(w.len(), us.len());
+            for (k, ((w, r), (want_w, want_r))) in w.iter().zip(&rays).zip(&want).enumerate() {
+                let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+                assert_eq!(bits(*w), bits(*want_w), "{}: direction {k}", isa.name());
+                assert_eq!(
+                    (bits(r.o), bits(r.d), r.o_err.to_bits(), r.t_max.to_bits()),
+                    (
+                        bits(want_r.o),
+                        bits(want_r.d),
+                        want_r.o_err.to_bits(),
+                        want_r.t_max.to_bits()
+                    ),
+                    "{}: ray {k}",
+                    isa.name()
+                );
+            }
+        }
+    }
+    assert!(hits > 100, "few hits: {hits}");
+}
+
 /// The Sobol' sampler: the waves draw each node's numbers in the walk's order, so they give
 /// its bits with Sobol' points too (each draw a dimension of its own), at depths 1 to 3.
 #[test]
@@ -404,6 +467,9 @@ fn each_wave_kernel_gives_the_walk_on_every_material_it_serves() {
          emitter: Emitter(radiance: (2, 1.5, 1))), \
          (shape: Sphere(center: (-2.2, 2, 7.5), radius: 0.7), material: Phong(kd: (0.2, 0.6, 0.3), ks: (0.5, 0.4, 0.3), shininess: 12)), \
          (shape: Sphere(center: (2.2, -2.2, 2.5), radius: 0.7), material: Conductor(material: \"Cu\")), \
+         (shape: Sphere(center: (-0.5, 2, 8), radius: 0.7), material: Transmissive(ior: 1.8, color: (0.9, 1, 0.85))), \
+         (shape: Sphere(center: (2.3, 2.1, 1.2), radius: 0.6), material: Mirror(color: (0.9, 0.95, 1)), \
+         emitter: Emitter(radiance: (1, 0.6, 0.3))), \
          (light: Point(position: (1, 2.5, 4), intensity: (9, 3, 0.5)))";
     let meshes = "(shape: TriangleMesh(vertices: [(-1.6, -3, 1), (-0.4, -3, 1), (-1, -3, 2), (-1.6, -1.6, 1), (-0.4, -1.6, 1), (-1, -1.6, 2)], \
          faces: [(0, 1, 2), (3, 5, 4), (0, 3, 4), (0, 4, 1), (1, 4, 5), (1, 5, 2), (2, 5, 3), (2, 3, 0)]), material: Transmissive(ior: 1.3, color: (0.9, 1, 0.95))), \

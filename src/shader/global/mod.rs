@@ -27,6 +27,8 @@
 
 mod waves;
 
+pub use waves::hemisphere_rays;
+
 use super::Tracer;
 use super::surface::{ChainEnd, Interaction, direct_light, follow_specular, reflectance};
 use crate::geometry::{Frame, Ray};
@@ -101,7 +103,8 @@ fn first_hit(tr: &mut Tracer, g: &Global, si: &Interaction, phong: &Phong) -> Ve
                 // The numbers drawn in order; the directions and their rays made in lanes.
                 us.clear();
                 us.extend((0..k).map(|_| tr.sampler.next_2d()));
-                (w.clear(), rays.clear());
+                w.clear();
+                rays.clear();
                 waves::hemisphere_rays(tr, &frame, &si.origins, &us, (&mut w, &mut rays));
                 let l = incident_all(tr, g, &rays, Order::Waves);
                 for (l_i, &wj) in l.iter().zip(&w) {

@@ -13,8 +13,8 @@
 //! `Frame::from_normal` (glam's `any_orthonormal_pair`), `hemisphere::cosine`, `brdf_pdf`), and
 //! draws its random numbers from its own stream in the same order (drawn in lanes by
 //! `sampling::Streams`; the light choice runs lane by lane, `sin_cos_turns` is repeated in
-//! lanes by `shader::warps`), so each path adds the same contributions and goes on with the same ray, to the bit
-//! (`tests/integration/path_waves.rs`). A spot or directional light's incident light
+//! lanes by `shader::warps`), so each path adds the same contributions and goes on with the
+//! same ray, to the bit (`tests/integration/path_waves.rs`). A spot or directional light's incident light
 //! (`Light::incident`) and an area-light or environment sample run the scalar code lane by
 //! lane (`surface::sample_area_light` or `EnvironmentLight::sample`, `light_ray` on
 //! `Interaction::flat`), except the point on an untextured triangle light (a rectangle's

@@ -1,5 +1,6 @@
 //! The waves traced and shaded in SIMD lanes, for scenes whose primitives are all packed (no
-//! BVH): a ray per lane from the nearest hit to its children, the rays queued in columns
+//! BVH), and the first hit's directions in lanes for every scene the waves serve
+//! ([`hemisphere_rays`]): a ray per lane from the nearest hit to its children, the rays queued in columns
 //! ([`Columns`]) so that a chunk loads with one load per coordinate and the children are
 //! written with one left-packing store per coordinate ([`crate::accel::Floats::compress`]).
 //!
@@ -294,8 +295,8 @@ unsafe fn hemisphere_in<L: Floats>(
         for (row, x) in rows.iter_mut().zip(wl) {
             x.write_to(row);
         }
-        for i in 0..chunk.len() {
-            let wj = Vec3A::new(rows[0][i], rows[1][i], rows[2][i]);
+        for ((&x, &y), &z) in rows[0].iter().zip(&rows[1]).zip(&rows[2]).take(chunk.len()) {
+            let wj = Vec3A::new(x, y, z);
             w.push(wj);
             rays.push(origins.ray(wj, f32::INFINITY));
         }
@@ -456,8 +457,8 @@ unsafe fn bounce_lanes<L: Floats>(
     }
 }
 
-/// Rows of a chunk's lane arrays, for the lanes whose whole interaction is built (a mirror or
-/// glass bounce, an emitter a chain meets): hit point, geometric normal, shading normal (the
+/// Rows of a chunk's lane arrays, for the lanes whose whole interaction is built (a metal's
+/// bounce, a bounce with an effect off, an emitter a chain meets): hit point, geometric normal, shading normal (the
 /// geometric one on the viewer's side), front and back origins (three each), then the
 /// origins' error, the distance and the hit's two error bounds.
 const P: usize = 0;
@@ -530,7 +531,11 @@ unsafe fn chunk<L: Floats>(
     let mut emitting = 0u32;
     // The mirror and glass bounces made in lanes, and each glass lane's index of refraction.
     let (mut mirror, mut glass, mut ior) = (0u32, 0u32, [1.0f32; MAX_LANES]);
-    let lane_bounces = tr.effects.reflection && tr.effects.refraction;
+    // A mirror bounces with reflection on; glass refracts or reflects, so it needs both.
+    let (lane_mirror, lane_glass) = (
+        tr.effects.reflection,
+        tr.effects.reflection && tr.effects.refraction,
+    );
     let mut beta = [Vec3A::ZERO; MAX_LANES];
     let mut kd = [Vec3A::ZERO; MAX_LANES];
     for i in 0..count {
@@ -551,10 +556,12 @@ unsafe fn chunk<L: Floats>(
         }
         if !e.is_phong {
             match e.bounce {
-                // Both effects on, `specular_bounce` always bounces a mirror or glass.
+                // With its effects on, `specular_bounce` always bounces a mirror or glass.
                 Some(b)
-                    if lane_bounces
-                        && emitting & (1 << i) == 0
+                    if match b {
+                        Bounce::Mirror(_) => lane_mirror,
+                        Bounce::Glass(..) => lane_glass,
+                    } && emitting & (1 << i) == 0
                         && node.bounces < g.max_specular =>
                 {
                     node.tint *= b.tint();
@@ -591,8 +598,8 @@ unsafe fn chunk<L: Floats>(
             )
         };
     }
-    // The lanes that need their whole interaction: emitters a chain meets, and mirror and
-    // glass bounces, queued behind this wave's rays.
+    // The lanes that need their whole interaction: emitters a chain meets, metals' bounces and
+    // bounces with an effect off, queued behind this wave's rays.
     if whole != 0 {
         let mut v = [[0.0f32; MAX_LANES]; ROWS];
         for (row, x) in [
