@@ -14,9 +14,9 @@
 //! draws its random numbers from its own stream in the same order (drawn in lanes by
 //! `sampling::Streams`; the light choice runs lane by lane, `sin_cos_turns` is repeated in
 //! lanes by `shader::warps`), so each path adds the same contributions and goes on with the
-//! same ray, to the bit (`tests/integration/path_waves.rs`). A spot or directional light's incident light
-//! (`Light::incident`) and an area-light or environment sample run the scalar code lane by
-//! lane (`surface::sample_area_light` or `EnvironmentLight::sample`, `light_ray` on
+//! same ray, to the bit (`tests/integration/path_waves.rs`). A spot or directional light's
+//! incident light (`Light::incident`) and an area-light or environment sample run the scalar
+//! code lane by lane (`surface::sample_area_light` or `EnvironmentLight::sample`, `light_ray` on
 //! `Interaction::flat`), except the point on an untextured triangle light (a rectangle's
 //! half, a mesh's face), which is sampled in lanes (`AreaLight::sample`'s operations), its
 //! shadow ray made in lanes too (`light_ray`'s). Every sample's shadow ray is tested in
